@@ -1,1 +1,35 @@
+"""Covariant node-to-surface contact: projection, contact element, analytic rigid surfaces."""
 
+from covcontact.contact.analytic import Cylinder, Plane, Sphere
+from covcontact.contact.element import (
+    CASE_A,
+    CASE_B,
+    CASE_C,
+    CASE_D,
+    CASE_EXACT,
+    CASES,
+    PART_NAMES,
+    ContactResult,
+    node_to_surface,
+)
+from covcontact.contact.kernels import contact_batch
+from covcontact.contact.projection import project_on_facet
+from covcontact.contact.rigid import RigidMotion
+
+__all__ = [
+    "CASES",
+    "CASE_A",
+    "CASE_B",
+    "CASE_C",
+    "CASE_D",
+    "CASE_EXACT",
+    "PART_NAMES",
+    "ContactResult",
+    "Cylinder",
+    "Plane",
+    "RigidMotion",
+    "Sphere",
+    "contact_batch",
+    "node_to_surface",
+    "project_on_facet",
+]

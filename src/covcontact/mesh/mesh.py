@@ -46,3 +46,35 @@ class Mesh:
     @property
     def face_type(self) -> str:
         return FACE_TYPE[self.cell_type]
+
+    def node_set(self, name: str) -> np.ndarray:
+        """Node indices of set ``name``; a KeyError lists the known names."""
+        return _lookup(self.node_sets, name, "node set")
+
+    def face_set(self, name: str) -> np.ndarray:
+        """Outward-ordered faces of set ``name``; a KeyError lists the known names."""
+        return _lookup(self.face_sets, name, "face set")
+
+    def element_set(self, name: str) -> np.ndarray:
+        """Element indices of set ``name``; a KeyError lists the known names."""
+        return _lookup(self.element_sets, name, "element set")
+
+    def add_node_set(self, name: str, nodes: np.ndarray) -> None:
+        """Store ``nodes`` (any order, repeats allowed) as sorted unique indices."""
+        self.node_sets[name] = np.unique(np.asarray(nodes, dtype=np.int64))
+
+    def add_face_set(self, name: str, faces: np.ndarray) -> None:
+        """Store outward-ordered faces (nface, 4 or 9) under ``name``."""
+        f = np.ascontiguousarray(faces, dtype=np.int64)
+        nfn = 4 if self.face_type == "quad4" else 9
+        if f.ndim != 2 or f.shape[1] != nfn:
+            raise ValueError(f"face set {name!r} needs shape (nface, {nfn}), got {f.shape}")
+        self.face_sets[name] = f
+
+
+def _lookup(sets: dict[str, np.ndarray], name: str, kind: str) -> np.ndarray:
+    try:
+        return sets[name]
+    except KeyError:
+        known = ", ".join(sorted(sets)) or "none"
+        raise KeyError(f"no {kind} named {name!r}; known: {known}") from None

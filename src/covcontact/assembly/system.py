@@ -1,0 +1,157 @@
+"""The global system of a problem: dof numbering, the body tangent pattern, loads, Dirichlet elimination.
+
+All deformable bodies share one node numbering: body k's node a is global node ``offset[k] + a`` with dofs
+``3 * (offset[k] + a) + i``. Rigid bodies carry no unknowns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..elements.solid import SolidBody
+from ..fem.quadrature import default_rule
+from ..fem.shapes import shape_functions
+from .pattern import Pattern
+
+
+class InvertedElementError(RuntimeError):
+    """An element has det F <= 0 at a Gauss point (triggers a cutback)."""
+
+    def __init__(self, body: str, element: int):
+        super().__init__(f"element {element} of body {body!r} inverted (det F <= 0)")
+        self.body = body
+        self.element = element
+
+
+@dataclass
+class BodyBlock:
+    """A deformable body placed in the global numbering."""
+
+    name: str
+    offset: int
+    n_nodes: int
+    solid: SolidBody
+
+
+def face_load_vector(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Integral of N_a (rho_1 x rho_2) dxi over reference faces: (nnode, 3) nodal vectors.
+
+    A dead pressure p gives nodal forces -p times this (positive pressure pushes into the body).
+    """
+    nfn = faces.shape[1]
+    cell = "quad4" if nfn == 4 else "quad9"
+    pts, w = default_rule(cell)
+    N, dN, _ = shape_functions(cell, pts)
+    xf = X[faces]  # (nf, nfn, 3)
+    r1 = np.einsum("pa,fai->fpi", dN[:, :, 0], xf)
+    r2 = np.einsum("pa,fai->fpi", dN[:, :, 1], xf)
+    nda = np.cross(r1, r2) * w[None, :, None]  # (nf, np, 3)
+    fa = np.einsum("pa,fpi->fai", N, nda)
+    out = np.zeros_like(X)
+    np.add.at(out, faces.ravel(), fa.reshape(-1, 3))
+    return out
+
+
+class System:
+    """Global arrays of a problem's deformable bodies, their loads and Dirichlet conditions."""
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.blocks: list[BodyBlock] = []
+        offset = 0
+        for body in problem.bodies:
+            solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material)
+            self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
+            offset += body.mesh.n_nodes
+        self.n_nodes = offset
+        self.n_dofs = 3 * offset
+        self.X = np.zeros((self.n_nodes, 3))
+        for blk, body in zip(self.blocks, problem.bodies):
+            self.X[blk.offset: blk.offset + blk.n_nodes] = body.mesh.points
+        self.pattern = Pattern(self.n_nodes, [body.mesh.cells + blk.offset
+                                              for blk, body in zip(self.blocks, problem.bodies)])
+        self._build_loads()
+        self._build_dirichlet()
+
+    # -- numbering ------------------------------------------------------------------------------
+    def offset(self, body: str) -> int:
+        for blk in self.blocks:
+            if blk.name == body:
+                return blk.offset
+        raise KeyError(body)
+
+    def global_nodes(self, body: str, set_name: str) -> np.ndarray:
+        mesh = self.problem.body(body).mesh
+        return mesh.node_sets[set_name] + self.offset(body)
+
+    # -- loads ----------------------------------------------------------------------------------
+    def _build_loads(self) -> None:
+        f = np.zeros((self.n_nodes, 3))
+        for load in self.problem.forces:
+            nodes = self.global_nodes(load.body, load.set)
+            value = np.asarray(load.value, dtype=float)
+            if load.distribution == "total":
+                value = value / len(nodes)
+            np.add.at(f, nodes, value[None, :])
+        for pr in self.problem.pressures:
+            mesh = self.problem.body(pr.body).mesh
+            faces = mesh.face_sets[pr.set]
+            off = self.offset(pr.body)
+            f[off: off + mesh.n_nodes] -= pr.value * face_load_vector(mesh.points, faces)
+        self.f_ext = f.ravel()
+
+    # -- Dirichlet ------------------------------------------------------------------------------
+    def _build_dirichlet(self) -> None:
+        value = {}
+        for bc in self.problem.dirichlet:
+            nodes = self.global_nodes(bc.body, bc.set)
+            for comp, val in zip(bc.components, bc.values):
+                for dof in 3 * nodes + comp:
+                    value[int(dof)] = float(val)
+        dofs = np.array(sorted(value), dtype=np.int64)
+        self.bc_dofs = dofs
+        self.bc_values = np.array([value[int(d)] for d in dofs], dtype=float)
+        self.constrained = np.zeros(self.n_dofs, dtype=bool)
+        self.constrained[dofs] = True
+        self.free = ~self.constrained
+        self._mask_cache: tuple | None = None
+
+    def prescribed(self, lam: float) -> np.ndarray:
+        """Displacement vector that is zero on free dofs and lam * value on constrained ones."""
+        u = np.zeros(self.n_dofs)
+        u[self.bc_dofs] = lam * self.bc_values
+        return u
+
+    # -- evaluation -----------------------------------------------------------------------------
+    def internal(self, u: np.ndarray, want_K: bool = True):
+        """Internal forces (n_dofs,) and body tangent CSR (or None) at displacement u."""
+        data = np.zeros(self.pattern.nnz) if want_K else np.zeros(1)
+        r = np.zeros(self.n_dofs)
+        U = u.reshape(-1, 3)
+        for blk in self.blocks:
+            bad = blk.solid.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, self.pattern,
+                                     node_offset=blk.offset, want_K=want_K)
+            if bad >= 0:
+                raise InvertedElementError(blk.name, int(bad))
+        K = self.pattern.csr(data) if want_K else None
+        return r, K
+
+    def energy(self, u: np.ndarray) -> float:
+        U = u.reshape(-1, 3)
+        return float(sum(blk.solid.energy(U[blk.offset: blk.offset + blk.n_nodes]) for blk in self.blocks))
+
+    def eliminate(self, K: sp.csr_matrix) -> sp.csr_matrix:
+        """Zero the rows and columns of constrained dofs and put 1 on their diagonal (in place if possible)."""
+        if not self.constrained.any():
+            return K
+        K = K.tocsr()
+        rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+        mask = self.constrained[rows] | self.constrained[K.indices]
+        K.data[mask] = 0.0
+        diag = rows[mask] == K.indices[mask]
+        idx = np.flatnonzero(mask)[diag]
+        K.data[idx] = 1.0
+        return K

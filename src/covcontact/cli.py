@@ -1,0 +1,130 @@
+"""Command line: covcontact run | study | check-tangent | info.
+
+Exit codes: 0 done; 1 a step did not converge even after cutbacks (converged steps are written);
+2 bad input (one line on stderr); 3 anything else (a bug: the traceback is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import traceback
+from pathlib import Path
+
+from . import __version__
+from .io.validate import InputError
+from .problem import TANGENT_CASES
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2
+        print(f"covcontact: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="covcontact", description="Covariant node-to-surface contact for large deformations.")
+    p.add_argument("--version", action="version", version=f"covcontact {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    r = sub.add_parser("run", help="solve a problem file")
+    r.add_argument("problem")
+    r.add_argument("--out", default=None)
+    r.add_argument("--tangent", choices=TANGENT_CASES, default=None)
+    r.add_argument("--solver", default=None)
+    r.add_argument("--quiet", action="store_true")
+    s = sub.add_parser("study", help="run a problem once per tangent case and tabulate the iterations")
+    s.add_argument("problem")
+    s.add_argument("--cases", default="a,b,c,d,exact")
+    s.add_argument("--out", default=None)
+    s.add_argument("--solver", default=None)
+    s.add_argument("--quiet", action="store_true")
+    c = sub.add_parser("check-tangent", help="compare the assembled tangent with finite differences")
+    c.add_argument("problem")
+    c.add_argument("--step", type=int, default=1)
+    c.add_argument("--tangent", choices=TANGENT_CASES, default="exact")
+    c.add_argument("--columns", type=int, default=60)
+    sub.add_parser("info", help="version, linear solvers, threads")
+    return p
+
+
+def _check_solver(name: str | None) -> None:
+    if name is None or name == "auto":
+        return
+    from .solvers.linear import available
+
+    if name not in available():
+        raise InputError(f"--solver: unknown or unavailable linear solver {name!r} "
+                         f"(available here: {', '.join(available())})")
+
+
+def cmd_run(args) -> int:
+    from .io.loader import load_problem
+
+    problem = load_problem(args.problem)
+    _check_solver(args.solver or problem.solver.linear)
+    result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver)
+    if not args.quiet:
+        print(f"results in {result.out}", file=sys.stderr)
+    return result.exit_code
+
+
+def cmd_study(args) -> int:
+    from .io.loader import load_problem
+    from .study import run_study
+
+    problem = load_problem(args.problem)
+    _check_solver(args.solver or problem.solver.linear)
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    bad = [c for c in cases if c not in TANGENT_CASES]
+    if bad or not cases:
+        raise InputError(f"--cases: unknown case {bad[0] if bad else '(none)'!r} "
+                         f"(choose from {', '.join(TANGENT_CASES)})")
+    out = Path(args.out) if args.out else Path("results") / f"{problem.name}-study"
+    return run_study(problem, cases, out, solver=args.solver, quiet=args.quiet)
+
+
+def cmd_check_tangent(args) -> int:
+    from .io.loader import load_problem
+    from .tangent_check import check_tangent
+
+    problem = load_problem(args.problem)
+    if args.step < 0 or args.step > len(problem.steps.factors):
+        raise InputError(f"--step: must lie between 0 and {len(problem.steps.factors)}, got {args.step}")
+    rep = check_tangent(problem, step=args.step, tangent=args.tangent, columns=args.columns)
+    print(f"step {args.step}  tangent {args.tangent}  columns {rep['columns']}  "
+          f"relative error {rep['relative_error']:.3e}")
+    return 0
+
+
+def cmd_info(args) -> int:
+    import numba
+
+    from .solvers.linear import describe
+
+    print(f"covcontact {__version__}")
+    print(f"numba {numba.__version__}, threads {numba.get_num_threads()}")
+    print("linear solvers:")
+    for d in describe():
+        mark = "yes" if d.get("available") else "no "
+        print(f"  {mark}  {d['name']:<10} {d.get('version') or '':<12} {d.get('note', '')}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    handler = {"run": cmd_run, "study": cmd_study, "check-tangent": cmd_check_tangent,
+               "info": cmd_info}[args.command]
+    try:
+        return handler(args)
+    except InputError as exc:
+        print(f"covcontact: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    except Exception:
+        traceback.print_exc()
+        return 3
+
+
+if __name__ == "__main__":
+    sys.exit(main())

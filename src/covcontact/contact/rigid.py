@@ -1,0 +1,66 @@
+"""Prescribed rigid-body motion of an analytic surface, scaled by a load factor.
+
+    x(lam) = c + R(lam theta) (X - c) + lam T
+
+with R the rotation by the rotation vector lam theta (Rodrigues' formula) about the centre c.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def _vec3(v, what):
+    a = np.asarray(v, dtype=np.float64)
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise ValueError(f"{what} must be 3 finite numbers, got {v!r}")
+    return a
+
+
+def rotation_matrix(theta) -> np.ndarray:
+    """Rotation matrix of the rotation vector ``theta`` (axis * angle in radians), Rodrigues."""
+    w = np.asarray(theta, dtype=np.float64)
+    t = float(np.linalg.norm(w))
+    K = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    if t < 1e-8:  # series: sin t / t = 1 - t^2/6, (1 - cos t) / t^2 = 1/2 - t^2/24
+        return np.eye(3) + (1.0 - t * t / 6.0) * K + (0.5 - t * t / 24.0) * (K @ K)
+    return np.eye(3) + (np.sin(t) / t) * K + ((1.0 - np.cos(t)) / (t * t)) * (K @ K)
+
+
+@dataclass
+class RigidMotion:
+    """Rigid motion: translation T, rotation vector theta (radians) about ``center``.
+
+    Attributes:
+        translation: (3,) translation at lam = 1.
+        rotation: (3,) rotation vector at lam = 1 (axis times angle).
+        center: (3,) centre of rotation.
+    """
+
+    translation: tuple | np.ndarray = (0.0, 0.0, 0.0)
+    rotation: tuple | np.ndarray = (0.0, 0.0, 0.0)
+    center: tuple | np.ndarray = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        self.translation = _vec3(self.translation, "translation")
+        self.rotation = _vec3(self.rotation, "rotation")
+        self.center = _vec3(self.center, "center")
+
+    def matrix(self, lam: float = 1.0) -> np.ndarray:
+        """Rotation matrix R(lam theta)."""
+        return rotation_matrix(float(lam) * self.rotation)
+
+    def apply(self, X, lam: float = 1.0) -> np.ndarray:
+        """Positions (..., 3) moved to load factor ``lam``."""
+        X = np.asarray(X, dtype=np.float64)
+        if X.shape[-1] != 3:
+            raise ValueError(f"points must have 3 coordinates in the last axis, got shape {X.shape}")
+        Rm = self.matrix(lam)
+        return self.center + (X - self.center) @ Rm.T + float(lam) * self.translation
+
+    def rotate(self, V, lam: float = 1.0) -> np.ndarray:
+        """Directions (..., 3) rotated to load factor ``lam`` (no translation)."""
+        V = np.asarray(V, dtype=np.float64)
+        return V @ self.matrix(lam).T

@@ -1,0 +1,230 @@
+"""Topology of a master surface made of mesh facets (quad4 or quad9).
+
+A :class:`MeshSurface` holds the facets (global node ids, VTK order, corners counter-clockwise seen
+from outside so that ``rho_1 x rho_2`` points out of the body) and the connectivity the contact
+search and the projection driver need:
+
+- edge adjacency: local edge ``e`` of a facet runs from corner ``e`` to corner ``(e + 1) % 4``
+  (quad9: mid-node ``4 + e``); ``nbr_facet[f, e]`` is the facet across it and ``nbr_edge[f, e]`` that
+  facet's local edge, both -1 on a boundary edge (and on a non-manifold edge shared by more than two
+  facets, which the driver then treats as a boundary);
+- node-to-facet incidence as CSR (``node_ptr``, ``node_facets``) over every facet node;
+- ``node_on_boundary``: nodes of boundary (or non-manifold) edges.
+
+Positions are not stored: they change every iteration and are passed to the functions that need them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit, prange
+
+from ..fem.quadrature import gauss_quad
+from ..fem.shapes import IDX, NODES, shape_functions
+
+#: element coordinates of the start of local edge e and its direction (edge parameter t in [-1, 1])
+EDGE_START = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+EDGE_DIR = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+
+
+@dataclass
+class MeshSurface:
+    """Facets of a master surface and their adjacency.
+
+    Args:
+        faces: (nf, 4) or (nf, 9) global node ids, outward ordered.
+        n_nodes: number of global nodes (defaults to ``faces.max() + 1``).
+    """
+
+    faces: np.ndarray
+    n_nodes: int = -1
+    nbr_facet: np.ndarray = field(init=False, repr=False)
+    nbr_edge: np.ndarray = field(init=False, repr=False)
+    node_ptr: np.ndarray = field(init=False, repr=False)
+    node_facets: np.ndarray = field(init=False, repr=False)
+    node_on_boundary: np.ndarray = field(init=False, repr=False)
+    n_nonmanifold: int = field(init=False, default=0)
+
+    def __post_init__(self) -> None:
+        faces = np.ascontiguousarray(self.faces, dtype=np.int64)
+        if faces.ndim != 2 or faces.shape[1] not in (4, 9):
+            raise ValueError(f"faces must be (nf, 4) or (nf, 9), got {faces.shape}")
+        if faces.size and faces.min() < 0:
+            raise ValueError("faces contain negative node ids")
+        self.faces = faces
+        if self.n_nodes < 0:
+            self.n_nodes = int(faces.max()) + 1 if faces.size else 0
+        elif faces.size and faces.max() >= self.n_nodes:
+            raise ValueError("faces reference nodes beyond n_nodes")
+        self._build_adjacency()
+        self._build_incidence()
+
+    @property
+    def nen(self) -> int:
+        """Nodes per facet (4 or 9)."""
+        return int(self.faces.shape[1])
+
+    @property
+    def n_facets(self) -> int:
+        return int(self.faces.shape[0])
+
+    @property
+    def cell_type(self) -> str:
+        return "quad4" if self.nen == 4 else "quad9"
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """Sorted global ids of the nodes on the surface."""
+        return np.flatnonzero(np.diff(self.node_ptr) > 0)
+
+    def _build_adjacency(self) -> None:
+        nf = self.faces.shape[0]
+        c = self.faces[:, :4]
+        a, b = c, np.roll(c, -1, axis=1)
+        key = (np.minimum(a, b) * np.int64(self.n_nodes) + np.maximum(a, b)).ravel()
+        order = np.argsort(key, kind="stable")
+        sk = key[order]
+        # runs of equal edge keys
+        brk = np.flatnonzero(np.diff(sk) != 0) + 1
+        starts = np.concatenate(([0], brk))
+        lengths = np.diff(np.concatenate((starts, [sk.size])))
+        nbr_facet = np.full(4 * nf, -1, dtype=np.int64)
+        nbr_edge = np.full(4 * nf, -1, dtype=np.int64)
+        s2 = starts[lengths == 2]
+        i, j = order[s2], order[s2 + 1]
+        nbr_facet[i], nbr_edge[i] = j // 4, j % 4
+        nbr_facet[j], nbr_edge[j] = i // 4, i % 4
+        self.nbr_facet = nbr_facet.reshape(nf, 4)
+        self.nbr_edge = nbr_edge.reshape(nf, 4)
+        self.n_nonmanifold = int(np.count_nonzero(lengths > 2))
+        # boundary nodes: both corners (and the quad9 mid-node) of every unpaired edge
+        bf, be = np.nonzero(self.nbr_facet < 0)
+        on_b = np.zeros(self.n_nodes, dtype=np.bool_)
+        on_b[self.faces[bf, be]] = True
+        on_b[self.faces[bf, (be + 1) % 4]] = True
+        if self.nen == 9:
+            on_b[self.faces[bf, 4 + be]] = True
+        self.node_on_boundary = on_b
+
+    def _build_incidence(self) -> None:
+        nen = self.faces.shape[1]
+        flat = self.faces.ravel()
+        order = np.argsort(flat, kind="stable")
+        counts = np.bincount(flat, minlength=self.n_nodes)
+        self.node_ptr = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
+        self.node_facets = (order // nen).astype(np.int64)
+
+    def facets_of_node(self, node: int) -> np.ndarray:
+        """Facets that contain global node ``node``."""
+        return self.node_facets[self.node_ptr[node] : self.node_ptr[node + 1]]
+
+    def vertex_normals(self, x_nodes: np.ndarray) -> np.ndarray:
+        """Outward unit normal per node: the average of the unit normals of its facets at that node.
+
+        Returns (n_nodes, 3); zero rows for nodes not on the surface.
+        """
+        x = np.asarray(x_nodes, dtype=np.float64)
+        _, dN, _ = shape_functions(self.cell_type, NODES[self.cell_type])
+        xf = x[self.faces]  # (nf, nen, 3)
+        t = np.einsum("pad,fai->fpdi", dN, xf)  # (nf, nen pts, 2, 3)
+        n = np.cross(t[:, :, 0, :], t[:, :, 1, :])
+        ln = np.linalg.norm(n, axis=2, keepdims=True)
+        n = np.divide(n, ln, out=np.zeros_like(n), where=ln > 0)
+        out = np.zeros((self.n_nodes, 3))
+        for k in range(3):
+            out[:, k] = np.bincount(self.faces.ravel(), n[:, :, k].ravel(), minlength=self.n_nodes)
+        ln = np.linalg.norm(out, axis=1, keepdims=True)
+        return np.divide(out, ln, out=np.zeros_like(out), where=ln > 0)
+
+
+def tributary_area(x_nodes: np.ndarray, faces: np.ndarray, n_gauss: int | None = None) -> np.ndarray:
+    """Per-node area of a surface: the integral of N_a over the facets around node a.
+
+    Args:
+        x_nodes: (n, 3) positions.
+        faces: (nf, 4|9) global node ids.
+        n_gauss: Gauss points per direction (default 3 for quad4, 4 for quad9).
+
+    Returns:
+        (n,) areas; they sum to the surface area integrated with the same rule.
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    x = np.asarray(x_nodes, dtype=np.float64)
+    nen = faces.shape[1]
+    pts, w = gauss_quad(n_gauss or (3 if nen == 4 else 4))
+    N, dN, _ = shape_functions("quad4" if nen == 4 else "quad9", pts)
+    xf = x[faces]
+    t = np.einsum("pad,fai->fpdi", dN, xf)
+    jac = np.linalg.norm(np.cross(t[:, :, 0, :], t[:, :, 1, :]), axis=2)  # (nf, npts)
+    contrib = np.einsum("fp,p,pa->fa", jac, w, N)
+    return np.bincount(faces.ravel(), contrib.ravel(), minlength=x.shape[0])
+
+
+# Lagrange (p(-1), p(0), p(1)) -> Bernstein control values of a 1D quadratic
+_L2B = np.array([[1.0, 0.0, 0.0], [-0.5, 2.0, -0.5], [0.0, 0.0, 1.0]])
+# quad9 node -> (i, j) position in a 3 x 3 grid ordered -1, 0, 1 per direction
+_Q9_GRID = np.array([[0, 2, 1][k] for k in IDX["quad9"].ravel()]).reshape(9, 2)
+
+
+@njit(cache=True, parallel=True)
+def _boxes_kernel(x, faces, l2b, q9grid, lo, hi):
+    nf, nen = faces.shape
+    for f in prange(nf):
+        if nen == 4:
+            for p in range(3):
+                a = x[faces[f, 0], p]
+                b = a
+                for k in range(1, 4):
+                    v = x[faces[f, k], p]
+                    a = min(a, v)
+                    b = max(b, v)
+                lo[f, p] = a
+                hi[f, p] = b
+        else:
+            grid = np.empty((3, 3))
+            tmp = np.empty((3, 3))
+            for p in range(3):
+                for k in range(9):
+                    grid[q9grid[k, 0], q9grid[k, 1]] = x[faces[f, k], p]
+                for i in range(3):  # control net = L2B grid L2B^T
+                    for j in range(3):
+                        tmp[i, j] = l2b[i, 0] * grid[0, j] + l2b[i, 1] * grid[1, j] + l2b[i, 2] * grid[2, j]
+                a = np.inf
+                b = -np.inf
+                for i in range(3):
+                    for j in range(3):
+                        v = tmp[i, 0] * l2b[j, 0] + tmp[i, 1] * l2b[j, 1] + tmp[i, 2] * l2b[j, 2]
+                        a = min(a, v)
+                        b = max(b, v)
+                lo[f, p] = a
+                hi[f, p] = b
+
+
+def facet_boxes(x_nodes: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned boxes that contain each facet (not only its nodes).
+
+    A bilinear facet lies in the convex hull of its corners. A biquadratic facet lies in the convex
+    hull of its Bernstein control net, computed here from the nine Lagrange nodes, so the box is a
+    rigorous bound even where the surface bulges beyond its nodes.
+
+    Returns:
+        lo, hi: (nf, 3) each.
+    """
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    x = np.ascontiguousarray(x_nodes, dtype=np.float64)
+    lo = np.empty((faces.shape[0], 3))
+    hi = np.empty((faces.shape[0], 3))
+    if faces.shape[0]:
+        _boxes_kernel(x, faces, _L2B, _Q9_GRID, lo, hi)
+    return lo, hi
+
+
+def facet_sizes(x_nodes: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Characteristic size per facet: the longer of its two corner diagonals."""
+    faces = np.asarray(faces, dtype=np.int64)
+    x = np.asarray(x_nodes, dtype=np.float64)
+    d1 = np.linalg.norm(x[faces[:, 2]] - x[faces[:, 0]], axis=1)
+    d2 = np.linalg.norm(x[faces[:, 3]] - x[faces[:, 1]], axis=1)
+    return np.maximum(d1, d2)

@@ -1,0 +1,283 @@
+"""Read a TOML problem file into a ``covcontact.problem.Problem``, validating everything first.
+
+The schema is documented in docs/input.md. Every error is an ``InputError`` whose message names the file,
+the key path (or line) and what is wrong.
+"""
+
+from __future__ import annotations
+
+import inspect
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from ..problem import (COMPONENTS, TANGENT_CASES, Body, ContactPair, Dirichlet, NodalForce, OutputOptions,
+                       Pressure, Problem, RigidBody, RigidMotion, SolverOptions, Steps)
+from .validate import InputError, Section
+
+CELLS = ("hex8", "hex18", "hex27")
+RIGID_SHAPES = ("plane", "cylinder", "sphere", "mesh")
+
+
+def _generators() -> dict:
+    from ..mesh import generators
+
+    return {name: fn for name, fn in vars(generators).items()
+            if inspect.isfunction(fn) and not name.startswith("_") and fn.__module__ == generators.__name__
+            and "cell" in inspect.signature(fn).parameters}
+
+
+def build_mesh(sec: Section, base: Path, element: str | None):
+    """Mesh from ``generator = ...`` plus its arguments, or ``file = ...`` (read through meshio)."""
+    from ..mesh.io import MeshError, read_mesh
+
+    if sec.has("file") == sec.has("generator"):
+        sec.fail("give exactly one of 'file' or 'generator'")
+    if sec.has("file"):
+        fname = sec.get("file", "str")
+        sec.done()
+        path = (base / fname) if not Path(fname).is_absolute() else Path(fname)
+        if not path.exists():
+            sec.fail(f"mesh file {fname} does not exist", "file")
+        try:
+            mesh = read_mesh(path)
+        except (MeshError, ValueError, KeyError, OSError) as exc:
+            sec.fail(f"cannot read mesh file {fname}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}",
+                     "file")
+        if element is not None and mesh.cell_type != element:
+            sec.fail(f"element {element!r} does not match the mesh file's cells ({mesh.cell_type})", "file")
+        return mesh
+    gens = _generators()
+    name = sec.get("generator", "str", choices=tuple(sorted(gens)))
+    fn = gens[name]
+    params = inspect.signature(fn).parameters
+    kwargs = {}
+    for key, value in sec.rest().items():
+        if key not in params or key == "cell":
+            allowed = ", ".join(k for k in params if k != "cell")
+            sec.fail(f"unknown key for generator {name!r} (allowed: {allowed})", key)
+        if isinstance(value, bool) or not isinstance(value, (int, float, str, list)):
+            sec.fail(f"must be a number, string or array", key)
+        if isinstance(value, list):
+            value = tuple(value)
+        kwargs[key] = value
+    missing = [k for k, p in params.items() if p.default is inspect.Parameter.empty and k not in kwargs
+               and k != "cell"]
+    if missing:
+        sec.fail(f"generator {name!r} needs {', '.join(missing)}")
+    try:
+        return fn(cell=element or "hex8", **kwargs)
+    except (ValueError, TypeError) as exc:
+        sec.fail(f"generator {name!r}: {exc}")
+
+
+def _material(sec: Section):
+    from ..materials import material_from_name
+
+    model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke"))
+    E = sec.get("E", "float", positive=True)
+    nu = sec.get("nu", "float")
+    sec.done()
+    if not -1.0 < nu < 0.5:
+        sec.fail(f"must lie in (-1, 0.5), got {nu}", "nu")
+    try:
+        return material_from_name(model, E=E, nu=nu)
+    except ValueError as exc:
+        sec.fail(str(exc))
+
+
+def _motion(sec: Section | None) -> RigidMotion:
+    if sec is None:
+        return RigidMotion()
+    m = RigidMotion(translation=sec.get("translation", "vector", (0.0, 0.0, 0.0)),
+                    rotation=sec.get("rotation", "vector", (0.0, 0.0, 0.0)),
+                    center=sec.get("center", "vector", (0.0, 0.0, 0.0)))
+    sec.done()
+    return m
+
+
+def _split_ref(sec: Section, key: str, value: str) -> tuple[str, str]:
+    if "." in value:
+        body, name = value.split(".", 1)
+        return body, name
+    return value, ""
+
+
+def load_problem(path: str | Path) -> Problem:
+    """Parse and validate a problem file; raise InputError with a one-line message on any problem."""
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: file does not exist")
+    try:
+        raw = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: TOML syntax error: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: cannot read: {exc}") from None
+    return problem_from_dict(raw, path)
+
+
+def problem_from_dict(raw: dict, path: Path) -> Problem:
+    base = path.parent
+    top = Section(raw, "", path)
+    meta = top.get("problem", "table")
+    name = meta.get("name", "str")
+    description = meta.get("description", "str", "")
+    meta.done()
+
+    bodies: list[Body] = []
+    for b in top.get("bodies", "array", []):
+        bname = b.get("name", "str")
+        if any(x.name == bname for x in bodies):
+            b.fail(f"duplicate body name {bname!r}", "name")
+        element = b.get("element", "str", None, choices=CELLS)
+        formulation = b.get("formulation", "str", "solid", choices=("solid",))
+        material = _material(b.get("material", "table"))
+        mesh = build_mesh(b.get("mesh", "table"), base, element)
+        b.done()
+        bodies.append(Body(bname, mesh, material, formulation))
+    if not bodies:
+        top.fail("at least one [[bodies]] entry is needed")
+
+    rigid: list[RigidBody] = []
+    for r in top.get("rigid", "array", []):
+        rname = r.get("name", "str")
+        if any(x.name == rname for x in rigid) or any(x.name == rname for x in bodies):
+            r.fail(f"duplicate body name {rname!r}", "name")
+        shape = r.get("shape", "str", choices=RIGID_SHAPES)
+        params: dict = {}
+        mesh = None
+        if shape == "plane":
+            params = {"point": r.get("point", "vector"), "normal": r.get("normal", "vector")}
+            if np.linalg.norm(params["normal"]) == 0:
+                r.fail("must not be zero", "normal")
+        elif shape == "cylinder":
+            params = {"center": r.get("center", "vector"), "axis": r.get("axis", "vector"),
+                      "radius": r.get("radius", "float", positive=True),
+                      "outside": r.get("outside", "bool", True)}
+            if np.linalg.norm(params["axis"]) == 0:
+                r.fail("must not be zero", "axis")
+        elif shape == "sphere":
+            params = {"center": r.get("center", "vector"), "radius": r.get("radius", "float", positive=True),
+                      "outside": r.get("outside", "bool", True)}
+        else:
+            element = r.get("element", "str", None, choices=CELLS)
+            mesh = build_mesh(r.get("mesh", "table"), base, element)
+        motion = _motion(r.get("motion", "table", None))
+        r.done()
+        rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params))
+
+    def body_set(sec: Section, key: str, kind: str) -> tuple[str, str]:
+        ref = sec.get(key, "str")
+        bname, sname = _split_ref(sec, key, ref)
+        owner = next((b.mesh for b in bodies if b.name == bname), None)
+        if owner is None:
+            owner = next((r.mesh for r in rigid if r.name == bname and r.mesh is not None), None)
+        if owner is None:
+            sec.fail(f"{ref!r}: no body named {bname!r}", key)
+        sets = owner.node_sets if kind == "node" else owner.face_sets
+        if sname not in sets:
+            known = ", ".join(sorted(sets)) or "none"
+            sec.fail(f"{ref!r}: body {bname!r} has no {kind} set {sname!r} (known: {known})", key)
+        if len(sets[sname]) == 0:
+            sec.fail(f"{ref!r}: {kind} set is empty", key)
+        return bname, sname
+
+    def deformable(sec: Section, key: str, bname: str) -> None:
+        if not any(b.name == bname for b in bodies):
+            sec.fail(f"{bname!r} is not a deformable body", key)
+
+    dirichlet = []
+    for d in top.get("dirichlet", "array", []):
+        bname, sname = body_set(d, "set", "node")
+        deformable(d, "set", bname)
+        comps = d.get("components", "str", "xyz")
+        if not comps or any(c not in COMPONENTS for c in comps) or len(set(comps)) != len(comps):
+            d.fail(f"must be a non-empty combination of x, y, z, got {comps!r}", "components")
+        if d.has("value") and isinstance(d.data["value"], list):
+            values = d.get("value", "floats", length=len(comps))
+        else:
+            values = (d.get("value", "float", 0.0),) * len(comps)
+        d.done()
+        dirichlet.append(Dirichlet(bname, sname, tuple(COMPONENTS[c] for c in comps), tuple(values)))
+
+    forces = []
+    for f in top.get("force", "array", []):
+        bname, sname = body_set(f, "set", "node")
+        deformable(f, "set", bname)
+        value = f.get("value", "vector")
+        dist = f.get("distribution", "str", "per_node", choices=("per_node", "total"))
+        f.done()
+        forces.append(NodalForce(bname, sname, value, dist))
+
+    pressures = []
+    for p in top.get("pressure", "array", []):
+        bname, sname = body_set(p, "set", "face")
+        deformable(p, "set", bname)
+        value = p.get("value", "float")
+        p.done()
+        pressures.append(Pressure(bname, sname, value))
+
+    contacts = []
+    for i, c in enumerate(top.get("contact", "array", [])):
+        cname = c.get("name", "str", f"contact{i + 1}")
+        slave = body_set(c, "slave", "node")
+        mref = c.get("master", "str")
+        mbody, mset = _split_ref(c, "master", mref)
+        analytic = next((r for r in rigid if r.name == mbody and r.mesh is None), None)
+        if analytic is not None:
+            if mset:
+                c.fail(f"{mref!r}: the analytic surface {mbody!r} has no sets; name it alone", "master")
+            master = (mbody, "")
+        else:
+            c.data["master"] = mref
+            master = body_set(c, "master", "face")
+        if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
+            c.fail("slave and master are the same rigid body")
+        penalty = c.get("penalty", "float", positive=True)
+        weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area"))
+        tangent = c.get("tangent", "str", "a", choices=TANGENT_CASES)
+        two_pass = c.get("two_pass", "bool", False)
+        c.done()
+        contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass))
+
+    steps_sec = top.get("steps", "table", None)
+    if steps_sec is None:
+        steps = Steps.equal(1)
+    elif steps_sec.has("factors"):
+        factors = steps_sec.get("factors", "floats")
+        steps_sec.done()
+        if not factors or any(b <= a for a, b in zip((0.0,) + factors, factors)):
+            steps_sec.fail("must be a non-empty, strictly increasing list of positive load factors", "factors")
+        steps = Steps(factors)
+    else:
+        n = steps_sec.get("count", "int", 1, positive=True)
+        final = steps_sec.get("final", "float", 1.0, positive=True)
+        steps_sec.done()
+        steps = Steps.equal(n, final)
+
+    s = top.get("solver", "table", None)
+    solver = SolverOptions()
+    if s is not None:
+        solver = SolverOptions(
+            linear=s.get("linear", "str", solver.linear),
+            max_iterations=s.get("max_iterations", "int", solver.max_iterations, positive=True),
+            rtol=s.get("rtol", "float", solver.rtol, positive=True),
+            atol=s.get("atol", "float", solver.atol, nonnegative=True),
+            etol=s.get("etol", "float", solver.etol, nonnegative=True),
+            max_cutbacks=s.get("max_cutbacks", "int", solver.max_cutbacks, nonnegative=True),
+            line_search=s.get("line_search", "bool", solver.line_search),
+            divergence_factor=s.get("divergence_factor", "float", solver.divergence_factor, positive=True),
+        )
+        s.done()
+    o = top.get("output", "table", None)
+    output = OutputOptions()
+    if o is not None:
+        output = OutputOptions(vtu=o.get("vtu", "bool", True), every=o.get("every", "int", 1, positive=True),
+                               pictures=o.get("pictures", "bool", False))
+        o.done()
+    top.done()
+    return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
+                   pressures=pressures, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
+                   output=output, source=path)

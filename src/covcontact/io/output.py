@@ -1,0 +1,107 @@
+"""Result files: one VTU per converged step, result.pvd, summary.json, convergence.csv, all atomic."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+# hex18 has no VTK type: each element is written as four linear hexahedra over its 3x3 node grid
+_HEX18_SPLIT = np.array([
+    [0, 4, 8, 7, 9, 13, 17, 16],
+    [4, 1, 5, 8, 13, 10, 14, 17],
+    [8, 5, 2, 6, 17, 14, 11, 15],
+    [7, 8, 6, 3, 16, 17, 15, 12],
+])
+_VTK_NAME = {"hex8": "hexahedron", "hex27": "hexahedron27", "quad4": "quad", "quad9": "quad9"}
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write text to ``path`` through a temporary file in the same folder and a rename."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def vtk_cells(cell_type: str, cells: np.ndarray) -> tuple[str, np.ndarray, np.ndarray]:
+    """VTK cell name, connectivity and parent-element index for a covcontact cell block."""
+    if cell_type == "hex18":
+        sub = cells[:, _HEX18_SPLIT].reshape(-1, 8)
+        return "hexahedron", sub, np.repeat(np.arange(len(cells)), 4)
+    return _VTK_NAME[cell_type], cells, np.arange(len(cells))
+
+
+class ResultWriter:
+    """Writes the output folder of one run, one converged step at a time."""
+
+    def __init__(self, out: Path):
+        self.out = Path(out)
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.pvd_entries: list[tuple[float, str]] = []
+        self.csv_rows: list[str] = ["step,iteration,residual_norm,energy_norm,active_contacts"]
+
+    def write_vtu(self, step: int, time_value: float, points: np.ndarray,
+                  blocks: list[tuple[str, np.ndarray, dict[str, np.ndarray]]],
+                  point_data: dict[str, np.ndarray]) -> None:
+        """Write ``step_NNNN.vtu``; blocks are (covcontact cell type, global connectivity, cell data)."""
+        cells = []
+        cdata: dict[str, list[np.ndarray]] = {}
+        names = set()
+        for _, _, cd in blocks:
+            names.update(cd)
+        for ctype, conn, cd in blocks:
+            vname, vconn, parent = vtk_cells(ctype, conn)
+            cells.append((vname, vconn))
+            for key in names:
+                if key in cd:
+                    arr = np.asarray(cd[key])[parent]
+                else:
+                    width = next(np.asarray(c[key]).shape[1:] for _, _, c in blocks if key in c)
+                    arr = np.full((len(parent),) + width, np.nan)
+                cdata.setdefault(key, []).append(arr)
+        mesh = meshio.Mesh(points, cells, point_data=point_data, cell_data=cdata)
+        name = f"step_{step:04d}.vtu"
+        fd, tmp = tempfile.mkstemp(dir=self.out, prefix="." + name, suffix=".vtu")
+        os.close(fd)
+        try:
+            meshio.write(tmp, mesh, file_format="vtu", binary=True)
+            os.replace(tmp, self.out / name)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        self.pvd_entries.append((time_value, name))
+        lines = ['<?xml version="1.0"?>',
+                 '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+                 "  <Collection>"]
+        for t, f in self.pvd_entries:
+            lines.append(f'    <DataSet timestep="{t:.10g}" group="" part="0" file="{f}"/>')
+        lines += ["  </Collection>", "</VTKFile>", ""]
+        atomic_write_text(self.out / "result.pvd", "\n".join(lines))
+
+    def add_iterations(self, step: int, records) -> None:
+        for r in records:
+            self.csv_rows.append(f"{step},{r.iteration},{r.residual:.6e},{r.energy:.6e},{r.active}")
+        atomic_write_text(self.out / "convergence.csv", "\n".join(self.csv_rows) + "\n")
+
+    def write_summary(self, summary: dict) -> None:
+        atomic_write_text(self.out / "summary.json", json.dumps(summary, indent=2, default=_jsonable) + "\n")
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

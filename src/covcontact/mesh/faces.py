@@ -1,0 +1,124 @@
+"""Local face tables, boundary faces and orientation checks of hexahedral meshes.
+
+A face is listed with the node order of a ``quad4`` or ``quad9`` facet (corners counter-clockwise
+seen from outside, then edge mid-nodes 0-1, 1-2, 2-3, 3-0, then the centre), so that the facet
+normal rho_1 x rho_2 points out of the element. The tables are built from the natural node
+coordinates of ``covcontact.fem.shapes``: each face is a map (xi1, xi2) -> (r, s, t) of the
+reference cube whose tangents have an outward cross product.
+
+``hex8`` and ``hex27`` have six faces (x-, x+, y-, y+, z-, z+). ``hex18`` has only its two quad9
+faces t = -1 and t = +1: its side faces are 3 x 2 nodes and are never contact faces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..fem.quadrature import default_rule
+from ..fem.shapes import NODES, shape_functions
+from .mesh import Mesh
+
+# face label -> (fixed axis, fixed value, axis of xi1, axis of xi2); tangents e_(xi1) x e_(xi2)
+# equal the outward normal (sign of the fixed value) times e_(fixed axis)
+_FACE_MAPS = {
+    "x-": (0, -1.0, 2, 1),
+    "x+": (0, 1.0, 1, 2),
+    "y-": (1, -1.0, 0, 2),
+    "y+": (1, 1.0, 2, 0),
+    "z-": (2, -1.0, 1, 0),
+    "z+": (2, 1.0, 0, 1),
+}
+
+#: local face labels of each cell type, in the order of the rows of ``FACES``
+FACE_LABELS = {
+    "hex8": ("x-", "x+", "y-", "y+", "z-", "z+"),
+    "hex27": ("x-", "x+", "y-", "y+", "z-", "z+"),
+    "hex18": ("z-", "z+"),
+}
+
+
+def _face_table(cell: str, face: str) -> np.ndarray:
+    ftype = "quad4" if cell == "hex8" else "quad9"
+    axis, value, a1, a2 = _FACE_MAPS[face]
+    nat = NODES[cell]
+    rows = []
+    for xi1, xi2 in NODES[ftype]:
+        x = np.empty(3)
+        x[axis], x[a1], x[a2] = value, xi1, xi2
+        hit = np.nonzero(np.all(np.abs(nat - x) < 1e-12, axis=1))[0]
+        rows.append(int(hit[0]))
+    return np.array(rows, dtype=np.int64)
+
+
+#: cell type -> (nface, 4 | 9) local node indices of its contact faces, outward ordered
+FACES = {c: np.stack([_face_table(c, f) for f in labels]) for c, labels in FACE_LABELS.items()}
+
+
+def boundary_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Faces used by exactly one element (for hex18 only the t = -1 and t = +1 faces).
+
+    Returns:
+        faces (nf, 4 | 9) outward ordered, elem (nf,) owning element, local_face (nf,) row of
+        ``FACES[mesh.cell_type]``.
+    """
+    table = FACES[mesh.cell_type]
+    nlf, nfn = table.shape
+    allf = mesh.cells[:, table].reshape(-1, nfn)
+    corners = np.sort(allf[:, :4], axis=1)
+    _, inv, cnt = np.unique(corners, axis=0, return_inverse=True, return_counts=True)
+    idx = np.nonzero(cnt[inv.ravel()] == 1)[0]
+    return np.ascontiguousarray(allf[idx]), idx // nlf, idx % nlf
+
+
+def faces_on_nodes(mesh: Mesh, node_ids: np.ndarray) -> np.ndarray:
+    """Boundary faces (outward ordered) whose nodes all lie in ``node_ids``."""
+    faces, _, _ = boundary_faces(mesh)
+    mask = np.zeros(mesh.n_nodes, dtype=bool)
+    mask[np.asarray(node_ids, dtype=np.int64)] = True
+    return np.ascontiguousarray(faces[np.all(mask[faces], axis=1)])
+
+
+def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Outward-ordered boundary faces with the same corners as ``faces`` (any order, >= 4 nodes).
+
+    Returns:
+        matched (nm, 4 | 9) boundary faces in the order of ``faces``, and found (nf,) bool.
+    """
+    bf, _, _ = boundary_faces(mesh)
+    query = np.sort(np.asarray(faces, dtype=np.int64)[:, :4], axis=1)
+    if query.shape[0] == 0 or bf.shape[0] == 0:
+        return np.empty((0, bf.shape[1]), dtype=np.int64), np.zeros(query.shape[0], dtype=bool)
+    keys = np.sort(bf[:, :4], axis=1)
+    both = np.concatenate([keys, query])
+    _, inv = np.unique(both, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    owner = np.full(inv.max() + 1, -1, dtype=np.int64)
+    owner[inv[: keys.shape[0]]] = np.arange(keys.shape[0])
+    hit = owner[inv[keys.shape[0]:]]
+    found = hit >= 0
+    return np.ascontiguousarray(bf[hit[found]]), found
+
+
+def face_normals(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Unnormalised normals rho_1 x rho_2 at the centre (0, 0) of each face, (nf, 3)."""
+    ftype = "quad4" if faces.shape[1] == 4 else "quad9"
+    _, dN, _ = shape_functions(ftype, np.zeros((1, 2)))
+    rho = np.einsum("fai,aj->fji", points[faces], dN[0])
+    return np.cross(rho[:, 0], rho[:, 1])
+
+
+def jacobian_determinants(mesh: Mesh, points: np.ndarray | None = None) -> np.ndarray:
+    """det(dX/dxi) of every element at natural ``points`` (npts, 3), (nelem, npts).
+
+    The default points are the full Gauss rule of the cell type.
+    """
+    pts = default_rule(mesh.cell_type)[0] if points is None else np.atleast_2d(points)
+    _, dN, _ = shape_functions(mesh.cell_type, pts)
+    J = np.einsum("eai,paj->epij", mesh.points[mesh.cells], dN)
+    return np.asarray(np.linalg.det(J))
+
+
+def check_orientation(mesh: Mesh) -> list[int]:
+    """Elements whose Jacobian at the element centre is not positive (inverted node order)."""
+    det = jacobian_determinants(mesh, np.zeros((1, 3)))[:, 0]
+    return [int(e) for e in np.nonzero(~(det > 0.0))[0]]

@@ -1,0 +1,214 @@
+"""Mesh files through meshio: read Gmsh, Abaqus .inp, VTU and the rest; write VTU atomically.
+
+Reading keeps one volume cell type ("hexahedron" -> hex8, "hexahedron27" -> hex27; meshio
+already turns Gmsh's hex27 node order into the VTK order used here, which the tests check on a
+hand-written Gmsh file), drops nodes no volume cell uses and carries named groups over:
+
+- point sets (Abaqus NSET) become node sets;
+- cell sets (Abaqus ELSET) and Gmsh physical groups (named by $PhysicalNames, else by their tag
+  number) become element sets for their volume cells and face sets for their quadrilaterals that
+  match boundary faces (re-ordered outward); the nodes of every group become a node set unless a
+  point set of that name exists.
+
+hex18 has no VTK cell type: it is written as a hex27 whose nine mid-thickness nodes are
+interpolated linearly between its two quad9 layers (exact, since hex18 is linear through the
+thickness), so ParaView shows the true geometry; point data is interpolated the same way. The
+extra nodes are appended after the mesh nodes, so node indices of the mesh are unchanged.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+from ..fem.shapes import NODES
+from .faces import match_boundary_faces
+from .mesh import Mesh
+
+_VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27"}
+_TO_MESHIO = {"hex8": "hexahedron", "hex27": "hexahedron27"}
+_FACE_CELLS = ("quad", "quad8", "quad9")
+_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
+        "quad9": 2}
+
+
+class MeshError(ValueError):
+    """A mesh file that cannot be read or holds no supported volume cells."""
+
+
+def _fail(path: Path, problem: str) -> MeshError:
+    return MeshError(f"{path}: {' '.join(str(problem).split())}")
+
+
+def _hex18_to_hex27() -> tuple[np.ndarray, np.ndarray]:
+    """For each hex27 node, the pair of hex18 nodes whose mean it is (equal pair: that node)."""
+    h18, h27 = NODES["hex18"], NODES["hex27"]
+    pairs = np.empty((27, 2), dtype=np.int64)
+    for a, x in enumerate(h27):
+        lo = np.array([x[0], x[1], -1.0 if x[2] == 0.0 else x[2]])
+        hi = np.array([x[0], x[1], 1.0 if x[2] == 0.0 else x[2]])
+        pairs[a, 0] = np.nonzero(np.all(h18 == lo, axis=1))[0][0]
+        pairs[a, 1] = np.nonzero(np.all(h18 == hi, axis=1))[0][0]
+    return pairs[:, 0], pairs[:, 1]
+
+
+_H27_LO, _H27_HI = _hex18_to_hex27()
+
+
+def _expand_hex18(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """hex27 connectivity of a hex18 mesh; returns (cells27, lo, hi) with new node k = mean(lo, hi)."""
+    lo, hi = mesh.cells[:, _H27_LO], mesh.cells[:, _H27_HI]
+    mid = lo != hi
+    key = np.stack([np.minimum(lo[mid], hi[mid]), np.maximum(lo[mid], hi[mid])], axis=1)
+    uniq, inv = np.unique(key, axis=0, return_inverse=True)
+    cells = lo.copy()
+    cells[mid] = mesh.n_nodes + inv.ravel()
+    return cells, uniq[:, 0], uniq[:, 1]
+
+
+def to_meshio(
+    mesh: Mesh, point_data: Mapping[str, np.ndarray] | None = None,
+    cell_data: Mapping[str, np.ndarray] | None = None,
+) -> meshio.Mesh:
+    """A meshio.Mesh of ``mesh`` with its node and element sets (hex18 becomes hex27, see above)."""
+    pdata = {k: np.asarray(v) for k, v in (point_data or {}).items()}
+    for k, v in pdata.items():
+        if v.shape[0] != mesh.n_nodes:
+            raise ValueError(f"point data {k!r} has {v.shape[0]} rows for {mesh.n_nodes} nodes")
+    for k, v in (cell_data or {}).items():
+        if np.shape(v)[0] != mesh.n_cells:
+            raise ValueError(f"cell data {k!r} has {np.shape(v)[0]} rows for {mesh.n_cells} cells")
+    points, cells, ctype = mesh.points, mesh.cells, mesh.cell_type
+    if ctype == "hex18":
+        cells, lo, hi = _expand_hex18(mesh)
+        points = np.concatenate([points, 0.5 * (points[lo] + points[hi])])
+        pdata = {k: np.concatenate([v, 0.5 * (v[lo] + v[hi])]) for k, v in pdata.items()}
+        ctype = "hex27"
+    return meshio.Mesh(
+        points, [(_TO_MESHIO[ctype], cells)], point_data=pdata,
+        cell_data={k: [np.asarray(v)] for k, v in (cell_data or {}).items()},
+        point_sets={k: v.copy() for k, v in mesh.node_sets.items()},
+        cell_sets={k: [v.copy()] for k, v in mesh.element_sets.items()},
+    )
+
+
+def write_vtu(
+    path: str | os.PathLike[str], mesh: Mesh, point_data: Mapping[str, np.ndarray] | None = None,
+    cell_data: Mapping[str, np.ndarray] | None = None,
+) -> None:
+    """Write ``mesh`` with optional data to a VTU file, atomically (temp file, then replace)."""
+    m = to_meshio(mesh, point_data, cell_data)
+    m.point_sets, m.cell_sets = {}, {}
+    target = Path(path)
+    fd, tmp = tempfile.mkstemp(suffix=".vtu", prefix=f".{target.name}.", dir=target.parent or ".")
+    os.close(fd)
+    try:
+        meshio.write(tmp, m, file_format="vtu")
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def _groups(m: meshio.Mesh) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """Named groups as name -> [(cell block index, indices within the block)].
+
+    meshio's cell sets (Abaqus ELSET, named Gmsh 4 physical groups) first; failing those, the
+    "gmsh:physical" tags of each cell (Gmsh 2), named through $PhysicalNames.
+    """
+    out: dict[str, list[tuple[int, np.ndarray]]] = {}
+    for name, per_block in m.cell_sets.items():
+        if name.startswith("gmsh:"):
+            continue
+        for b, ids in enumerate(per_block):
+            if ids is not None and b < len(m.cells) and np.size(ids):
+                out.setdefault(name, []).append((b, np.asarray(ids, dtype=np.int64)))
+    phys = m.cell_data.get("gmsh:physical")
+    if out or phys is None or len(phys) != len(m.cells):
+        return out
+    names = {(int(v[0]), int(v[1])): k for k, v in m.field_data.items() if np.size(v) == 2}
+    for b, (block, tags) in enumerate(zip(m.cells, phys, strict=True)):
+        tags = np.asarray(tags)
+        for tag in np.unique(tags):
+            name = names.get((int(tag), _DIM.get(block.type, 3)), str(int(tag)))
+            out.setdefault(name, []).append((b, np.nonzero(tags == tag)[0]))
+    return out
+
+
+def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mesh:
+    """Read a mesh file through meshio (Gmsh v2/v4, Abaqus .inp, VTU, ...).
+
+    Args:
+        path: the file.
+        cell_type: "hex8" or "hex27" when the file holds both; by default its only one.
+
+    Raises:
+        MeshError: the file does not parse or holds no (or an ambiguous) supported volume cell.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise _fail(p, "no such file")
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            m = meshio.read(p)
+    except (Exception, SystemExit) as exc:  # meshio raises many kinds, or exits, on bad input
+        lines = [ln for ln in said.getvalue().splitlines() if ln.strip()]
+        why = lines[0] if lines else f"{type(exc).__name__}: {exc}"
+        raise _fail(p, f"cannot read mesh ({why})") from exc
+    found = sorted({_VOLUME[b.type] for b in m.cells if b.type in _VOLUME})
+    if cell_type is not None and cell_type not in _TO_MESHIO:
+        raise _fail(p, f"cell_type must be 'hex8' or 'hex27', got {cell_type!r}")
+    if not found:
+        kinds = ", ".join(sorted({b.type for b in m.cells})) or "none"
+        raise _fail(p, f"no supported volume cells (hexahedron, hexahedron27); found: {kinds}")
+    if cell_type is None:
+        if len(found) > 1:
+            raise _fail(p, f"holds {' and '.join(found)} cells; choose one with cell_type")
+        cell_type = found[0]
+    elif cell_type not in found:
+        raise _fail(p, f"no {cell_type} cells; found: {', '.join(found)}")
+    vol = [b for b, blk in enumerate(m.cells) if blk.type == _TO_MESHIO[cell_type]]
+    first = np.cumsum([0] + [len(m.cells[b].data) for b in vol])
+    cells = np.concatenate([m.cells[b].data for b in vol]).astype(np.int64)
+    pts = np.zeros((len(m.points), 3))
+    pts[:, : min(3, m.points.shape[1])] = m.points[:, :3]
+    used = np.unique(cells)
+    new = np.full(len(pts), -1, dtype=np.int64)
+    new[used] = np.arange(used.size)
+    mesh = Mesh(pts[used], cell_type, new[cells])
+
+    def keep(nodes: np.ndarray) -> np.ndarray:
+        k = new[np.asarray(nodes, dtype=np.int64)]
+        return k[k >= 0]
+
+    for name, ids in m.point_sets.items():
+        mesh.add_node_set(name, keep(ids))
+    for name, parts in _groups(m).items():
+        elems, faces, nodes = [], [], []
+        for b, ids in parts:
+            data = m.cells[b].data[ids]
+            nodes.append(data.ravel())
+            if b in vol:
+                elems.append(first[vol.index(b)] + ids)
+            elif m.cells[b].type in _FACE_CELLS and len(data):
+                faces.append(new[data[:, :4]])
+        if elems:
+            mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)
+        if faces:
+            f = np.concatenate(faces)
+            matched, _ = match_boundary_faces(mesh, f[np.all(f >= 0, axis=1)])
+            if matched.shape[0]:
+                mesh.add_face_set(name, matched)
+        kept = keep(np.concatenate(nodes))
+        if name not in mesh.node_sets and kept.size:
+            mesh.add_node_set(name, kept)
+    return mesh

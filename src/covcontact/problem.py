@@ -1,0 +1,158 @@
+"""The Python API: a Problem made of bodies, boundary conditions, loads, contact pairs and steps.
+
+The TOML loader (``covcontact.io.loader``) builds exactly these objects; ``Problem.run`` does what
+``covcontact run`` does.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .contact.rigid import RigidMotion
+from .mesh import Mesh
+
+COMPONENTS = {"x": 0, "y": 1, "z": 2}
+TANGENT_CASES = ("a", "b", "c", "d", "exact")
+
+
+@dataclass
+class Body:
+    """A deformable body: a mesh, its element formulation and its material."""
+
+    name: str
+    mesh: Mesh
+    material: Any
+    formulation: str = "solid"
+
+
+@dataclass
+class RigidBody:
+    """A rigid body: an analytic surface (plane, cylinder, sphere) or a mesh moving rigidly.
+
+    ``surface`` is an analytic surface object from ``covcontact.contact`` or None; ``mesh`` a Mesh whose
+    nodes carry no unknowns (slave nodes and/or master faces of contact pairs).
+    """
+
+    name: str
+    motion: RigidMotion = field(default_factory=RigidMotion)
+    surface: Any = None
+    mesh: Mesh | None = None
+    shape: str = ""
+    params: dict = field(default_factory=dict)
+
+
+@dataclass
+class Dirichlet:
+    """Prescribed displacement u_i = lam * value_i on the nodes of ``body``'s node set ``set``."""
+
+    body: str
+    set: str
+    components: tuple[int, ...]
+    values: tuple[float, ...]
+
+
+@dataclass
+class NodalForce:
+    """Force ``lam * value`` on every node of a node set (``per_node``) or spread evenly (``total``)."""
+
+    body: str
+    set: str
+    value: tuple[float, float, float]
+    distribution: str = "per_node"
+
+
+@dataclass
+class Pressure:
+    """Dead pressure ``lam * value`` on a face set (positive pushes against the outward normal)."""
+
+    body: str
+    set: str
+    value: float
+
+
+@dataclass
+class ContactPair:
+    """A node-to-surface contact pair.
+
+    slave: (body name, node set name); the body may be deformable or a rigid meshed body.
+    master: (body name, face set name) of a deformable or rigid meshed body, or (rigid body name, "")
+    for an analytic surface.
+    """
+
+    name: str
+    slave: tuple[str, str]
+    master: tuple[str, str]
+    penalty: float
+    weighting: str = "nodal"
+    tangent: str = "a"
+    two_pass: bool = False
+    max_penetration: float | None = None
+
+
+@dataclass
+class Steps:
+    """Load-factor schedule: ``factors`` are the load factors at the end of each step."""
+
+    factors: tuple[float, ...]
+
+    @classmethod
+    def equal(cls, n: int, final: float = 1.0) -> "Steps":
+        return cls(tuple(float(final) * (k + 1) / n for k in range(n)))
+
+
+@dataclass
+class SolverOptions:
+    """Newton and linear solver settings."""
+
+    linear: str = "auto"
+    max_iterations: int = 25
+    rtol: float = 1e-8
+    atol: float = 1e-12
+    etol: float = 1e-16
+    max_cutbacks: int = 6
+    line_search: bool = False
+    divergence_factor: float = 1e4
+
+
+@dataclass
+class OutputOptions:
+    """What to write: VTU every ``every`` converged steps (the last one always)."""
+
+    vtu: bool = True
+    every: int = 1
+    pictures: bool = False
+
+
+@dataclass
+class Problem:
+    """A complete problem; ``run`` solves it and writes the results."""
+
+    name: str
+    bodies: list[Body]
+    dirichlet: list[Dirichlet] = field(default_factory=list)
+    forces: list[NodalForce] = field(default_factory=list)
+    pressures: list[Pressure] = field(default_factory=list)
+    rigid: list[RigidBody] = field(default_factory=list)
+    contacts: list[ContactPair] = field(default_factory=list)
+    steps: Steps = field(default_factory=lambda: Steps.equal(1))
+    solver: SolverOptions = field(default_factory=SolverOptions)
+    output: OutputOptions = field(default_factory=OutputOptions)
+    description: str = ""
+    source: Path | None = None
+
+    def body(self, name: str) -> Body:
+        for b in self.bodies:
+            if b.name == name:
+                return b
+        raise KeyError(f"no deformable body named {name!r}")
+
+    def run(self, out: str | Path | None = None, tangent: str | None = None, quiet: bool = True,
+            solver: str | None = None):
+        """Solve the problem and write the results to ``out`` (default ``results/<name>``)."""
+        from .solvers.run import solve_problem
+
+        return solve_problem(self, out=out, tangent=tangent, quiet=quiet, linear=solver)

@@ -1,0 +1,144 @@
+"""Run a Problem: load steps, Newton with cutbacks, progress lines and result files."""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..io.output import ResultWriter
+from .model import Model
+from .newton import Newton
+
+
+@dataclass
+class Result:
+    """What a run produced: the summary dict, the final displacement and the exit code (0 or 1)."""
+
+    summary: dict
+    u: np.ndarray
+    out: Path
+    exit_code: int
+    model: Model = field(repr=False, default=None)
+
+
+def _reactions(model: Model, u: np.ndarray, lam: float) -> dict:
+    R, _ = model.evaluate(u, lam, want_K=False)
+    out = {}
+    for bc in model.problem.dirichlet:
+        nodes = model.system.global_nodes(bc.body, bc.set)
+        out[f"{bc.body}.{bc.set}"] = R.reshape(-1, 3)[nodes].sum(axis=0).tolist()
+    return out
+
+
+def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, step: int) -> None:
+    sysm = model.system
+    U = u.reshape(-1, 3)
+    n = sysm.n_nodes
+    cauchy = np.zeros((n, 6))
+    blocks = []
+    for blk, body in zip(sysm.blocks, model.problem.bodies):
+        sl = slice(blk.offset, blk.offset + blk.n_nodes)
+        st = blk.solid.stress(U[sl])
+        cauchy[sl] = st.cauchy_nodal
+        cd = st.cell_data()
+        cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
+        blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
+    points = sysm.X.copy()
+    pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
+    extra_pts, extra_blocks, extra_pdata = model.contact.visual(lam) if hasattr(model.contact, "visual") \
+        else (None, [], {})
+    cpd = model.contact.point_data(n)
+    pdata.update(cpd)
+    if extra_pts is not None and len(extra_pts):
+        m = len(extra_pts)
+        points = np.vstack([points, extra_pts])
+        for key, arr in list(pdata.items()):
+            pad_shape = (m,) + arr.shape[1:]
+            pad = extra_pdata.get(key, np.zeros(pad_shape) if key == "displacement" else np.full(pad_shape, np.nan))
+            pdata[key] = np.concatenate([arr, pad])
+        for ctype, conn, cd in extra_blocks:
+            blocks.append((ctype, conn + n, cd))
+    writer.write_vtu(step, lam, points, blocks, pdata)
+
+
+def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> Result:
+    """Solve ``problem`` and write its results; see ``Problem.run``."""
+    t_start = time.perf_counter()
+    tangent = tangent or (problem.contacts[0].tangent if problem.contacts else "a")
+    out = Path(out) if out is not None else Path("results") / problem.name
+    model = Model(problem, tangent=tangent)
+    newton = Newton(model, problem.solver, linear=linear)
+    writer = ResultWriter(out)
+    u = model.prescribed(0.0)
+    summary = {
+        "problem": problem.name,
+        "converged": False,
+        "tangent": tangent,
+        "dofs": model.n_dofs,
+        "free_dofs": int(model.free.sum()),
+        "linear_solver": newton.linear.name,
+        "total_iterations": 0,
+        "wall_time_s": 0.0,
+        "steps": [],
+    }
+    t_out = 0.0
+    if problem.output.vtu:
+        t0 = time.perf_counter()
+        _write_vtu(writer, model, u, 0.0, 0)
+        t_out += time.perf_counter() - t0
+    lam_prev = 0.0
+    ok = True
+    nsteps = len(problem.steps.factors)
+    for k, lam in enumerate(problem.steps.factors, start=1):
+        success, outcomes, cutbacks, why = newton.advance(u, lam_prev, lam)
+        conv = [o for o in outcomes if o.converged]
+        iters = sum(o.iterations for o in outcomes)
+        entry = {
+            "step": k,
+            "load_factor": lam,
+            "converged": success,
+            "iterations": iters,
+            "residual_norms": [r / max(o.residual_norms[0], 1e-300) for o in conv[-1:] for r in o.residual_norms]
+            if conv else [],
+            "cutbacks": cutbacks,
+        }
+        if success:
+            entry.update(model.contact.step_report(model.positions(u), lam))
+            entry["reactions"] = _reactions(model, u, lam)
+        else:
+            entry["failure"] = why
+        summary["steps"].append(entry)
+        summary["total_iterations"] += iters
+        writer.add_iterations(k, [r for o in outcomes for r in o.records])
+        if not quiet:
+            rn = conv[-1].residual_norms[-1] if conv else float("nan")
+            msg = (f"step {k:4d}/{nsteps}  lambda {lam:.4g}  iterations {iters:3d}  residual {rn:.2e}"
+                   f"  active {model.active_count():5d}" + (f"  cutbacks {cutbacks}" if cutbacks else ""))
+            if not success:
+                msg += f"  FAILED: {why}"
+            print(msg, file=sys.stderr, flush=True)
+        if not success:
+            ok = False
+            break
+        lam_prev = lam
+        if problem.output.vtu and (k % problem.output.every == 0 or k == nsteps):
+            t0 = time.perf_counter()
+            _write_vtu(writer, model, u, lam, k)
+            t_out += time.perf_counter() - t0
+        summary["wall_time_s"] = time.perf_counter() - t_start
+        writer.write_summary(summary)
+    summary["converged"] = ok
+    timing = dict(newton.timing)
+    timing["output"] = t_out
+    timing["total"] = time.perf_counter() - t_start
+    summary["timing"] = {k: round(v, 4) for k, v in timing.items()}
+    summary["wall_time_s"] = timing["total"]
+    writer.write_summary(summary)
+    if not quiet:
+        split = "  ".join(f"{k} {v:.2f}s" for k, v in summary["timing"].items())
+        print(f"time: {split}", file=sys.stderr, flush=True)
+    return Result(summary=summary, u=u, out=out, exit_code=0 if ok else 1, model=model)
