@@ -239,3 +239,20 @@ def test_hysteresis_on_shared_edge():
     x2[x2[:, 0] > 0.75, 2] = 0.05
     r = project_slaves(x2, s, xs[:1], ptr[:2], fac, np.array([0]), np.array([[1.0, 0.0]]))
     assert r.facet[0] == 2 and r.g[0] == pytest.approx(0.1 / np.sqrt(1.01), rel=1e-12)
+
+
+def test_degenerate_facet_and_nan_slave():
+    x, faces = grid(np.linspace(0, 1, 3), np.linspace(0, 1, 3), lambda X, Y: 0 * X)
+    x = np.r_[x, np.full((4, 3), 0.25)]  # a collapsed facet (four equal nodes) overlapping facet 0
+    faces = np.r_[faces, [[9, 10, 11, 12]]]
+    s = MeshSurface(faces)
+    xs = np.array([[0.25, 0.25, 0.1], [np.nan, 0.2, 0.1], [0.7, 0.7, 0.1]])
+    ptr, fac = candidates(x, s, xs, 0.5)
+    assert 4 in fac[ptr[0] : ptr[1]]
+    r = project_slaves(
+        x, s, xs, ptr, fac, np.array([4, 0, -1]), np.array([[0.0, 0.0], [np.nan, 0.0], [0.0, 0.0]])
+    )
+    assert r.kind[0] == FACET and r.facet[0] == 0 and r.g[0] == pytest.approx(0.1)
+    assert r.kind[1] == NO_CONTACT and np.isinf(r.g[1])
+    assert r.kind[2] == FACET and r.facet[2] == 3
+    assert np.isfinite(r.xi).all() and np.isfinite(r.normal).all()

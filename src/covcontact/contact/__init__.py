@@ -1,4 +1,4 @@
-"""Covariant node-to-surface contact: projection, contact element, analytic rigid surfaces."""
+"""Covariant node-to-surface contact: projection, search, contact element, analytic rigid surfaces."""
 
 from covcontact.contact.analytic import Cylinder, Plane, Sphere
 from covcontact.contact.element import (
@@ -15,8 +15,22 @@ from covcontact.contact.element import (
 from covcontact.contact.kernels import contact_batch
 from covcontact.contact.projection import project_on_facet
 from covcontact.contact.rigid import RigidMotion
+from covcontact.contact.search import candidates
+from covcontact.contact.surface import MeshSurface, tributary_area
+from covcontact.contact.driver import (EDGE, FACET, NO_CONTACT, VERTEX, ProjectionResult, closest_points,
+                                       project_slaves)
 
 __all__ = [
+    "EDGE",
+    "FACET",
+    "NO_CONTACT",
+    "VERTEX",
+    "MeshSurface",
+    "ProjectionResult",
+    "candidates",
+    "closest_points",
+    "project_slaves",
+    "tributary_area",
     "CASES",
     "CASE_A",
     "CASE_B",

@@ -17,8 +17,8 @@ single-facet projection on each:
   (1D Newton on (r_s - r(t)) . r' = 0, t in [-1, 1]); the closest one gives an *edge* point, or a
   *vertex* point when it lies at an end of the edge. Such a point counts only when the slave lies in
   the wedge of that edge or vertex (the distance does not decrease into any facet around it, the
-  first-order condition of a constrained minimum), not over a facet. Boundary edges and vertices of an open surface
-  never give contact (the point is off the surface). The gap is the distance with the sign of the
+  first-order condition of a constrained minimum), not over a facet. Boundary edges and vertices of
+  an open surface never give contact (the point is off the surface). The gap is the distance with the sign of the
   averaged outward normal there (both facets' normals at the edge point; all facets' normals at the
   vertex); ``normal`` is then the unit vector from the edge/vertex point to the slave (times that
   sign), the direction of the distance, and ``xi`` the point on ``facet``'s boundary.
@@ -35,10 +35,19 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from ..fem.shapes import IDX, NODES, lagrange1d
+from ..fem.shapes import NODES
 from .projection import project_on_facet
 from .search import _box_dist2, candidates
-from .surface import EDGE_DIR, EDGE_START, MeshSurface, facet_boxes, facet_sizes
+from .surface import (
+    EDGE_DIR,
+    EDGE_START,
+    MeshSurface,
+    edge_closest_point,
+    facet_boxes,
+    facet_frame,
+    facet_sizes,
+    gather_facet,
+)
 
 NO_CONTACT = 0
 FACET = 1
@@ -47,44 +56,8 @@ VERTEX = 3
 
 _MAX_VISITED = 64
 _MAX_EDGES = 32
-_IDX4 = IDX["quad4"]
-_IDX9 = IDX["quad9"]
 _ES = EDGE_START
 _ED = EDGE_DIR
-
-
-@njit(cache=True)
-def _frame(xyz, xi1, xi2, rho, t1, t2, nrm):
-    """rho(xi), rho_1, rho_2 and the unit normal there (zero normal at a degenerate point)."""
-    nen = xyz.shape[0]
-    order = 1 if nen == 4 else 2
-    for p in range(3):
-        rho[p] = 0.0
-        t1[p] = 0.0
-        t2[p] = 0.0
-    for a in range(nen):
-        i = _IDX4[a, 0] if nen == 4 else _IDX9[a, 0]
-        j = _IDX4[a, 1] if nen == 4 else _IDX9[a, 1]
-        v1, d1, _ = lagrange1d(order, i, xi1)
-        v2, d2, _ = lagrange1d(order, j, xi2)
-        for p in range(3):
-            rho[p] += v1 * v2 * xyz[a, p]
-            t1[p] += d1 * v2 * xyz[a, p]
-            t2[p] += v1 * d2 * xyz[a, p]
-    nrm[0] = t1[1] * t2[2] - t1[2] * t2[1]
-    nrm[1] = t1[2] * t2[0] - t1[0] * t2[2]
-    nrm[2] = t1[0] * t2[1] - t1[1] * t2[0]
-    ln = np.sqrt(nrm[0] ** 2 + nrm[1] ** 2 + nrm[2] ** 2)
-    for p in range(3):
-        nrm[p] = nrm[p] / ln if ln > 0.0 else 0.0
-
-
-@njit(cache=True)
-def _point_normal(xyz, xi1, xi2, rho, nrm):
-    """rho(xi) and the unit normal there."""
-    t1 = np.empty(3)
-    t2 = np.empty(3)
-    _frame(xyz, xi1, xi2, rho, t1, t2, nrm)
 
 
 @njit(cache=True)
@@ -95,104 +68,14 @@ def _kkt_ok(d, t, sgn, tol):
 
 
 @njit(cache=True)
-def _edge_closest(xyz, e, xs, c):
-    """Closest point c on the curve of local edge e (t in [-1, 1]); returns (t, squared distance)."""
-    nen = xyz.shape[0]
-    a0 = e
-    a1 = (e + 1) % 4
-    am = 4 + e
-    best_t = 0.0
-    best_d2 = np.inf
-    # Newton from the middle, then compare with both ends (curved edges may have several minima)
-    for start in range(3):
-        t = 0.0 if start == 0 else (-1.0 if start == 1 else 1.0)
-        if start == 0:
-            for it in range(30):
-                r = np.zeros(3)
-                r1 = np.zeros(3)
-                r2 = np.zeros(3)
-                _edge_eval(xyz, nen, a0, a1, am, t, r, r1, r2)
-                fp = 0.0
-                aa = 0.0
-                bb = 0.0
-                for p in range(3):
-                    d = xs[p] - r[p]
-                    fp -= d * r1[p]
-                    aa += r1[p] * r1[p]
-                    bb += d * r2[p]
-                if not (aa > 0.0):
-                    break
-                fpp = aa - bb
-                dt = -fp / fpp if fpp > 1e-12 * aa else -fp / aa
-                if not np.isfinite(dt):
-                    break
-                dt = min(max(dt, -1.0), 1.0)
-                tn = min(max(t + dt, -1.0), 1.0)
-                done = abs(tn - t) < 1e-13
-                t = tn
-                if done:
-                    break
-        r = np.zeros(3)
-        r1 = np.zeros(3)
-        r2 = np.zeros(3)
-        _edge_eval(xyz, nen, a0, a1, am, t, r, r1, r2)
-        d2 = (xs[0] - r[0]) ** 2 + (xs[1] - r[1]) ** 2 + (xs[2] - r[2]) ** 2
-        if d2 < best_d2:
-            best_d2 = d2
-            best_t = t
-            for p in range(3):
-                c[p] = r[p]
-    return best_t, best_d2
+def _walk(f, xi, xs, x, topo, prm, use_dir, ndir, scr, vis, nvis, edges, nedge):
+    """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge).
 
-
-@njit(cache=True, inline="always")
-def _edge_eval(xyz, nen, a0, a1, am, t, r, r1, r2):
-    if nen == 4:
-        for p in range(3):
-            r[p] = 0.5 * (1.0 - t) * xyz[a0, p] + 0.5 * (1.0 + t) * xyz[a1, p]
-            r1[p] = 0.5 * (xyz[a1, p] - xyz[a0, p])
-            r2[p] = 0.0
-    else:
-        for p in range(3):
-            x0 = xyz[a0, p]
-            x1 = xyz[a1, p]
-            xm = xyz[am, p]
-            r[p] = 0.5 * t * (t - 1.0) * x0 + 0.5 * t * (t + 1.0) * x1 + (1.0 - t * t) * xm
-            r1[p] = (t - 0.5) * x0 + (t + 0.5) * x1 - 2.0 * t * xm
-            r2[p] = x0 + x1 - 2.0 * xm
-
-
-@njit(cache=True, inline="always")
-def _gather(x, faces, f, xyz):
-    for a in range(faces.shape[1]):
-        for p in range(3):
-            xyz[a, p] = x[faces[f, a], p]
-
-
-@njit(cache=True)
-def _walk(
-    f,
-    xi,
-    xs,
-    x,
-    faces,
-    nbr_facet,
-    nbr_edge,
-    gmax,
-    tol_in,
-    max_hops,
-    use_dir,
-    ndir,
-    min_cos,
-    xyz,
-    rho,
-    nrm,
-    vis,
-    nvis,
-    edges,
-    nedge,
-):
-    """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge)."""
+    Records every edge a projection left through in ``edges`` (for the blind-spot rule).
+    """
+    faces, nbr_facet, nbr_edge = topo[0], topo[1], topo[2]
+    gmax, tol_in, min_cos, max_hops = prm[0], prm[1], prm[3], prm[4]
+    xyz, rho, t1, t2, nrm = scr
     for hop in range(max_hops + 1):
         for k in range(nvis):
             if vis[k] == f:
@@ -200,7 +83,7 @@ def _walk(
         if nvis < vis.shape[0]:
             vis[nvis] = f
             nvis += 1
-        _gather(x, faces, f, xyz)
+        gather_facet(x, faces, f, xyz)
         status, g = project_on_facet(xyz, xs, xi)
         if status == 2 or not (np.isfinite(xi[0]) and np.isfinite(xi[1]) and np.isfinite(g)):
             return -1, 0.0, nvis, nedge
@@ -210,18 +93,17 @@ def _walk(
             if status != 0 or not (g > -gmax[f]):
                 return -1, 0.0, nvis, nedge
             if use_dir:
-                _point_normal(xyz, xi[0], xi[1], rho, nrm)
+                facet_frame(xyz, xi[0], xi[1], rho, t1, t2, nrm)
                 if nrm[0] * ndir[0] + nrm[1] * ndir[1] + nrm[2] * ndir[2] < min_cos:
                     return -1, 0.0, nvis, nedge
             return f, g, nvis, nedge
-        ea = 1 if xi[0] > 0.0 else 3
+        ea = 1 if xi[0] > 0.0 else 3  # edges 1 / 3 lie at xi1 = +1 / -1, edges 2 / 0 at xi2 = +1 / -1
         eb = 2 if xi[1] > 0.0 else 0
-        for e in (ea, eb):
-            if (o1 if e == ea else o2) > tol_in and nedge < edges.shape[0]:
+        for e, o in ((ea, o1), (eb, o2)):
+            if o > tol_in and nedge < edges.shape[0]:
                 dup = False
                 for k in range(nedge):
-                    if edges[k, 0] == f and edges[k, 1] == e:
-                        dup = True
+                    dup = dup or (edges[k, 0] == f and edges[k, 1] == e)
                 if not dup:
                     edges[nedge, 0] = f
                     edges[nedge, 1] = e
@@ -230,6 +112,8 @@ def _walk(
         nb = nbr_facet[f, e]
         if nb < 0 or hop == max_hops:
             return -1, 0.0, nvis, nedge
+        # same point of the shared edge on the neighbour (edges of consistently oriented facets run
+        # in opposite directions)
         c1 = min(max(xi[0], -1.0), 1.0)
         c2 = min(max(xi[1], -1.0), 1.0)
         t = (c1 - _ES[e, 0]) * _ED[e, 0] + (c2 - _ES[e, 1]) * _ED[e, 1] - 1.0
@@ -243,39 +127,21 @@ def _walk(
 
 
 @njit(cache=True)
-def _blind_spot(
-    xs,
-    x,
-    faces,
-    nbr_facet,
-    nbr_edge,
-    on_bnd,
-    n2f_ptr,
-    n2f_fac,
-    gmax,
-    tol_in,
-    edges,
-    nedge,
-    xyz,
-    c,
-    xi_out,
-    n_out,
-):
+def _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out):
     """Closest interior edge or vertex among the recorded exit edges; returns (kind, facet, g).
 
     An edge point c (or vertex v) counts only where it is a constrained local minimum of the distance
     on every facet around it (first-order condition: (r_s - c) . m <= 0 for each inward tangent m),
     i.e. the slave lies in the wedge of that edge or vertex, not over a facet of it.
     """
-    rho = np.empty(3)
-    t1 = np.empty(3)
-    t2 = np.empty(3)
-    nrm = np.empty(3)
+    faces, nbr_facet, nbr_edge, on_bnd, n2f_ptr, n2f_fac = topo
+    gmax, tol_in = prm[0], prm[1]
+    xyz, rho, t1, t2, nrm = scr
     nsum = np.empty(3)
     d = np.empty(3)
-    cb = np.zeros(3)
     best_d2 = np.inf
     best_kind = NO_CONTACT
+    best_sign = 1.0
     bf = -1
     for k in range(nedge):
         f = edges[k, 0]
@@ -283,8 +149,8 @@ def _blind_spot(
         nb = nbr_facet[f, e]
         if nb < 0:
             continue
-        _gather(x, faces, f, xyz)
-        t, d2 = _edge_closest(xyz, e, xs, c)
+        gather_facet(x, faces, f, xyz)
+        t, d2 = edge_closest_point(xyz, e, xs, c)
         if not (d2 < best_d2):
             continue
         dist = np.sqrt(d2)
@@ -299,11 +165,11 @@ def _blind_spot(
             if on_bnd[v]:
                 continue
             for m in range(n2f_ptr[v], n2f_ptr[v + 1]):
-                g_f = n2f_fac[m]
+                fv = n2f_fac[m]
                 for a in range(4):
-                    if faces[g_f, a] == v:
-                        _gather(x, faces, g_f, xyz)
-                        _frame(xyz, _ES[a, 0], _ES[a, 1], rho, t1, t2, nrm)
+                    if faces[fv, a] == v:
+                        gather_facet(x, faces, fv, xyz)
+                        facet_frame(xyz, _ES[a, 0], _ES[a, 1], rho, t1, t2, nrm)
                         ok = ok and _kkt_ok(d, t1, -_ES[a, 0], tol_in * dist)
                         ok = ok and _kkt_ok(d, t2, -_ES[a, 1], tol_in * dist)
                         for p in range(3):
@@ -312,14 +178,12 @@ def _blind_spot(
             ne = nbr_edge[f, e]
             tn = -t if faces[nb, ne] == faces[f, (e + 1) % 4] else t
             for side in range(2):
-                ff = f if side == 0 else nb
-                ee = e if side == 0 else ne
-                tt = t if side == 0 else tn
-                _gather(x, faces, ff, xyz)
+                ff, ee, tt = (f, e, t) if side == 0 else (nb, ne, tn)
+                gather_facet(x, faces, ff, xyz)
                 xi1 = _ES[ee, 0] + (tt + 1.0) * _ED[ee, 0]
                 xi2 = _ES[ee, 1] + (tt + 1.0) * _ED[ee, 1]
-                _frame(xyz, xi1, xi2, rho, t1, t2, nrm)
-                # edges 1, 3 fix xi1 = +1, -1; edges 0, 2 fix xi2 = -1, +1
+                facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm)
+                # edges 1, 3 fix xi1 = +1, -1 (inward -xi1 rho_1); edges 0, 2 fix xi2 = -1, +1
                 if ee % 2 == 1:
                     ok = ok and _kkt_ok(d, t1, -xi1, tol_in * dist)
                 else:
@@ -338,196 +202,105 @@ def _blind_spot(
             continue
         best_d2 = d2
         best_kind = kind
+        best_sign = sign
         bf = f
         xi_out[0] = _ES[e, 0] + (t + 1.0) * _ED[e, 0]
         xi_out[1] = _ES[e, 1] + (t + 1.0) * _ED[e, 1]
-        scale = 0.0
-        for p in range(3):
-            scale = max(scale, abs(xs[p]), abs(c[p]))
+        scale = max(abs(xs[0]), abs(xs[1]), abs(xs[2]), abs(c[0]), abs(c[1]), abs(c[2]))
         for p in range(3):
             n_out[p] = sign * d[p] / dist if dist > 1e-14 * scale and dist > 0.0 else nsum[p]
-        cb[0] = sign  # remember the sign of the best
     if bf < 0:
         return NO_CONTACT, -1, 0.0
-    return best_kind, bf, cb[0] * np.sqrt(best_d2)
+    return best_kind, bf, best_sign * np.sqrt(best_d2)
+
+
+@njit(cache=True)
+def _project_one(xs, x, topo, lo, hi, nat, cands, pf, pxi_in, prm, scr, wrk, vis, edges, xi_out, n_out):
+    """Contact point of one slave; returns (kind, facet, g) and writes xi_out (2,), n_out (3,)."""
+    faces = topo[0]
+    hyst, min_cos = prm[2], prm[3]
+    xyz, rho, t1, t2, _ = scr
+    xi, pxi, ndir, c = wrk
+    nen = faces.shape[1]
+    nvis = 0
+    nedge = 0
+    best_f = -1
+    best_g = 0.0
+    prev_g = 0.0
+    prev_ok = False
+    use_dir = False
+    if pf >= 0:
+        xi[0] = pxi_in[0] if np.isfinite(pxi_in[0]) else 0.0
+        xi[1] = pxi_in[1] if np.isfinite(pxi_in[1]) else 0.0
+        gather_facet(x, faces, pf, xyz)
+        facet_frame(xyz, min(max(xi[0], -1.0), 1.0), min(max(xi[1], -1.0), 1.0), rho, t1, t2, ndir)
+        use_dir = min_cos > -1.0
+        f, g, nvis, nedge = _walk(pf, xi, xs, x, topo, prm, use_dir, ndir, scr, vis, nvis, edges, nedge)
+        if f >= 0:
+            best_f, best_g = f, g
+            xi_out[:] = xi
+            if f == pf:
+                prev_ok, prev_g = True, g
+                pxi[:] = xi
+    for f0 in cands:
+        # boxes bound the facets: one farther than the best |g| cannot do better
+        if best_f >= 0 and _box_dist2(xs, lo[f0], hi[f0]) > best_g * best_g:
+            break
+        dmin = np.inf  # start from the facet node nearest to the slave
+        for a in range(nen):
+            d2 = 0.0
+            for p in range(3):
+                d2 += (x[faces[f0, a], p] - xs[p]) ** 2
+            if d2 < dmin:
+                dmin = d2
+                xi[0] = nat[a, 0]
+                xi[1] = nat[a, 1]
+        f, g, nvis, nedge = _walk(f0, xi, xs, x, topo, prm, use_dir, ndir, scr, vis, nvis, edges, nedge)
+        if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
+            best_f, best_g = f, g
+            xi_out[:] = xi
+    if prev_ok and not (abs(best_g) < (1.0 - hyst) * abs(prev_g)):
+        best_f, best_g = pf, prev_g
+        xi_out[:] = pxi
+    if best_f >= 0:
+        gather_facet(x, faces, best_f, xyz)
+        facet_frame(xyz, xi_out[0], xi_out[1], rho, t1, t2, n_out)
+        return FACET, best_f, best_g
+    return _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out)
 
 
 @njit(cache=True, parallel=True)
-def project_slaves_kernel(
-    xs_all,
-    x,
-    faces,
-    nat,
-    nbr_facet,
-    nbr_edge,
-    on_bnd,
-    n2f_ptr,
-    n2f_fac,
-    lo,
-    hi,
-    cand_ptr,
-    cand_fac,
-    prev_facet,
-    prev_xi,
-    gmax,
-    tol_in,
-    hyst,
-    min_cos,
-    max_hops,
-    nchunk,
-    out_facet,
-    out_xi,
-    out_g,
-    out_kind,
-    out_n,
-):
-    """Contact point of every slave (see the module docstring); writes the out arrays (ns, ...)."""
-    ns = xs_all.shape[0]
-    nen = faces.shape[1]
+def project_slaves_kernel(xs, x, topo, lo, hi, nat, cand_ptr, cand_fac, prev_facet, prev_xi, prm, nchunk,
+                          out_facet, out_xi, out_g, out_kind, out_n):  # fmt: skip
+    """Contact point of every slave (see the module docstring); writes the out arrays.
+
+    Args:
+        xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
+            node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. nat: (nen, 2) element
+            coordinates of the facet nodes. cand_ptr, cand_fac: candidate CSR. prev_facet (ns,),
+            prev_xi (ns, 2): last converged contact point, facet -1 for none.
+        prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops).
+        nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
+    """
+    ns = xs.shape[0]
+    nen = topo[0].shape[1]
     for ch in prange(nchunk):
-        xyz = np.empty((nen, 3))
-        xi = np.empty(2)
-        bxi = np.empty(2)
-        pxi = np.empty(2)
-        rho = np.empty(3)
-        nrm = np.empty(3)
-        ndir = np.zeros(3)
-        c = np.empty(3)
-        n_out = np.empty(3)
+        scr = (np.empty((nen, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3))
+        wrk = (np.empty(2), np.empty(2), np.zeros(3), np.empty(3))
         vis = np.empty(_MAX_VISITED, dtype=np.int64)
         edges = np.empty((_MAX_EDGES, 2), dtype=np.int64)
         for s in range(ch * ns // nchunk, (ch + 1) * ns // nchunk):
-            xs = xs_all[s]
-            nvis = 0
-            nedge = 0
-            best_f = -1
-            best_g = 0.0
-            prev_g = 0.0
-            prev_ok = False
-            pf = prev_facet[s]
-            use_dir = False
-            if pf >= 0:
-                xi[0] = prev_xi[s, 0]
-                xi[1] = prev_xi[s, 1]
-                if not (np.isfinite(xi[0]) and np.isfinite(xi[1])):
-                    xi[0] = 0.0
-                    xi[1] = 0.0
-                _gather(x, faces, pf, xyz)
-                _point_normal(xyz, min(max(xi[0], -1.0), 1.0), min(max(xi[1], -1.0), 1.0), rho, ndir)
-                use_dir = min_cos > -1.0
-                f, g, nvis, nedge = _walk(
-                    pf,
-                    xi,
-                    xs,
-                    x,
-                    faces,
-                    nbr_facet,
-                    nbr_edge,
-                    gmax,
-                    tol_in,
-                    max_hops,
-                    use_dir,
-                    ndir,
-                    min_cos,
-                    xyz,
-                    rho,
-                    nrm,
-                    vis,
-                    nvis,
-                    edges,
-                    nedge,
-                )
-                if f >= 0:
-                    best_f, best_g = f, g
-                    bxi[:] = xi
-                    if f == pf:
-                        prev_ok = True
-                        prev_g = g
-                        pxi[:] = xi
-            for m in range(cand_ptr[s], cand_ptr[s + 1]):
-                f0 = cand_fac[m]
-                if best_f >= 0 and _box_dist2(xs, lo[f0], hi[f0]) > best_g * best_g:
-                    break
-                # start from the facet node nearest to the slave
-                dmin = np.inf
-                for a in range(nen):
-                    d2 = 0.0
-                    for p in range(3):
-                        d2 += (x[faces[f0, a], p] - xs[p]) ** 2
-                    if d2 < dmin:
-                        dmin = d2
-                        xi[0] = nat[a, 0]
-                        xi[1] = nat[a, 1]
-                f, g, nvis, nedge = _walk(
-                    f0,
-                    xi,
-                    xs,
-                    x,
-                    faces,
-                    nbr_facet,
-                    nbr_edge,
-                    gmax,
-                    tol_in,
-                    max_hops,
-                    use_dir,
-                    ndir,
-                    min_cos,
-                    xyz,
-                    rho,
-                    nrm,
-                    vis,
-                    nvis,
-                    edges,
-                    nedge,
-                )
-                if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
-                    best_f, best_g = f, g
-                    bxi[:] = xi
-            if prev_ok and not (abs(best_g) < (1.0 - hyst) * abs(prev_g)):
-                best_f, best_g = pf, prev_g
-                bxi[:] = pxi
-            if best_f >= 0:
-                out_kind[s] = FACET
-                out_facet[s] = best_f
-                out_g[s] = best_g
-                out_xi[s, 0] = bxi[0]
-                out_xi[s, 1] = bxi[1]
-                _gather(x, faces, best_f, xyz)
-                _point_normal(xyz, bxi[0], bxi[1], rho, nrm)
-                out_n[s, :] = nrm
-                continue
-            kind, f, g = _blind_spot(
-                xs,
-                x,
-                faces,
-                nbr_facet,
-                nbr_edge,
-                on_bnd,
-                n2f_ptr,
-                n2f_fac,
-                gmax,
-                tol_in,
-                edges,
-                nedge,
-                xyz,
-                c,
-                bxi,
-                n_out,
-            )
+            cands = cand_fac[cand_ptr[s] : cand_ptr[s + 1]]
+            kind, f, g = _project_one(xs[s], x, topo, lo, hi, nat, cands, prev_facet[s], prev_xi[s], prm, scr,
+                                      wrk, vis, edges, out_xi[s], out_n[s])  # fmt: skip
+            out_kind[s] = kind
+            out_facet[s] = f
             if kind == NO_CONTACT:
-                out_kind[s] = NO_CONTACT
-                out_facet[s] = -1
                 out_g[s] = np.inf
-                out_xi[s, 0] = 0.0
-                out_xi[s, 1] = 0.0
+                out_xi[s, :] = 0.0
                 out_n[s, :] = 0.0
             else:
-                out_kind[s] = kind
-                out_facet[s] = f
                 out_g[s] = g
-                out_xi[s, 0] = bxi[0]
-                out_xi[s, 1] = bxi[1]
-                out_n[s, :] = n_out
 
 
 @dataclass
@@ -607,33 +380,22 @@ def project_slaves(
     if ns == 0:
         return out
     nchunk = min(ns, 16 * numba.get_num_threads())
-    project_slaves_kernel(
-        xs,
-        x,
+    topo = (
         surface.faces,
-        np.ascontiguousarray(NODES[surface.cell_type]),
         surface.nbr_facet,
         surface.nbr_edge,
         surface.node_on_boundary,
         surface.node_ptr,
         surface.node_facets,
-        np.ascontiguousarray(lo),
-        np.ascontiguousarray(hi),
-        np.ascontiguousarray(cand_ptr, np.int64),
-        np.ascontiguousarray(cand_facets, np.int64),
-        pf,
-        pxi,
-        gm,
-        float(tol_inside),
-        float(hysteresis),
-        float(min_cos),
-        int(max_hops),
-        nchunk,
-        out.facet,
-        out.xi,
-        out.g,
-        out.kind,
-        out.normal,
+    )
+    prm = (gm, float(tol_inside), float(hysteresis), float(min_cos), int(max_hops))
+    nat = np.ascontiguousarray(NODES[surface.cell_type])
+    cp = np.ascontiguousarray(cand_ptr, np.int64)
+    cf = np.ascontiguousarray(cand_facets, np.int64)
+    lo, hi = np.ascontiguousarray(lo), np.ascontiguousarray(hi)
+    o = out
+    project_slaves_kernel(
+        xs, x, topo, lo, hi, nat, cp, cf, pf, pxi, prm, nchunk, o.facet, o.xi, o.g, o.kind, o.normal
     )
     return out
 

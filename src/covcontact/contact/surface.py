@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..fem.quadrature import gauss_quad
-from ..fem.shapes import IDX, NODES, shape_functions
+from ..fem.shapes import IDX, NODES, lagrange1d, shape_functions
 
 #: element coordinates of the start of local edge e and its direction (edge parameter t in [-1, 1])
 EDGE_START = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
@@ -228,3 +228,114 @@ def facet_sizes(x_nodes: np.ndarray, faces: np.ndarray) -> np.ndarray:
     d1 = np.linalg.norm(x[faces[:, 2]] - x[faces[:, 0]], axis=1)
     d2 = np.linalg.norm(x[faces[:, 3]] - x[faces[:, 1]], axis=1)
     return np.maximum(d1, d2)
+
+
+# ---------------------------------------------------------------------------------------------
+# compiled point helpers on one facet (used by the projection driver)
+
+_IDX4 = IDX["quad4"]
+_IDX9 = IDX["quad9"]
+
+
+@njit(cache=True, inline="always")
+def gather_facet(x, faces, f, xyz):
+    """Copy the node positions of facet f into xyz (nen, 3)."""
+    for a in range(faces.shape[1]):
+        for p in range(3):
+            xyz[a, p] = x[faces[f, a], p]
+
+
+@njit(cache=True)
+def facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm):
+    """rho(xi), rho_1, rho_2 and the unit normal there (zero normal at a degenerate point)."""
+    nen = xyz.shape[0]
+    order = 1 if nen == 4 else 2
+    for p in range(3):
+        rho[p] = 0.0
+        t1[p] = 0.0
+        t2[p] = 0.0
+    for a in range(nen):
+        i = _IDX4[a, 0] if nen == 4 else _IDX9[a, 0]
+        j = _IDX4[a, 1] if nen == 4 else _IDX9[a, 1]
+        v1, d1, _ = lagrange1d(order, i, xi1)
+        v2, d2, _ = lagrange1d(order, j, xi2)
+        for p in range(3):
+            rho[p] += v1 * v2 * xyz[a, p]
+            t1[p] += d1 * v2 * xyz[a, p]
+            t2[p] += v1 * d2 * xyz[a, p]
+    nrm[0] = t1[1] * t2[2] - t1[2] * t2[1]
+    nrm[1] = t1[2] * t2[0] - t1[0] * t2[2]
+    nrm[2] = t1[0] * t2[1] - t1[1] * t2[0]
+    ln = np.sqrt(nrm[0] ** 2 + nrm[1] ** 2 + nrm[2] ** 2)
+    for p in range(3):
+        nrm[p] = nrm[p] / ln if ln > 0.0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def _edge_eval(xyz, e, t, r, r1, r2):
+    """Point, first and second derivative of the curve of local edge e at parameter t."""
+    a0 = e
+    a1 = (e + 1) % 4
+    if xyz.shape[0] == 4:
+        for p in range(3):
+            r[p] = 0.5 * (1.0 - t) * xyz[a0, p] + 0.5 * (1.0 + t) * xyz[a1, p]
+            r1[p] = 0.5 * (xyz[a1, p] - xyz[a0, p])
+            r2[p] = 0.0
+    else:
+        for p in range(3):
+            x0 = xyz[a0, p]
+            x1 = xyz[a1, p]
+            xm = xyz[4 + e, p]
+            r[p] = 0.5 * t * (t - 1.0) * x0 + 0.5 * t * (t + 1.0) * x1 + (1.0 - t * t) * xm
+            r1[p] = (t - 0.5) * x0 + (t + 0.5) * x1 - 2.0 * t * xm
+            r2[p] = x0 + x1 - 2.0 * xm
+
+
+@njit(cache=True)
+def edge_closest_point(xyz, e, xs, c):
+    """Closest point c on the curve of local edge e of a facet, edge parameter t in [-1, 1].
+
+    Local edge e runs from corner e (t = -1) to corner (e + 1) % 4 (t = +1), through mid-node 4 + e
+    on a quad9. 1D Newton on (x_s - r(t)) . r'(t) = 0 from t = 0 (Gauss-Newton where the second
+    derivative is not positive), clamped to [-1, 1], then compared with both ends.
+
+    Returns:
+        (t, squared distance); c (3,) out.
+    """
+    r = np.empty(3)
+    r1 = np.empty(3)
+    r2 = np.empty(3)
+    t = 0.0
+    for _ in range(30):
+        _edge_eval(xyz, e, t, r, r1, r2)
+        fp = 0.0
+        aa = 0.0
+        bb = 0.0
+        for p in range(3):
+            d = xs[p] - r[p]
+            fp -= d * r1[p]
+            aa += r1[p] * r1[p]
+            bb += d * r2[p]
+        if not (aa > 0.0):
+            break
+        fpp = aa - bb
+        dt = -fp / fpp if fpp > 1e-12 * aa else -fp / aa
+        if not np.isfinite(dt):
+            break
+        tn = min(max(t + min(max(dt, -1.0), 1.0), -1.0), 1.0)
+        done = abs(tn - t) < 1e-13
+        t = tn
+        if done:
+            break
+    best_t = 0.0
+    best_d2 = np.inf
+    for k in range(3):
+        tk = t if k == 0 else (-1.0 if k == 1 else 1.0)
+        _edge_eval(xyz, e, tk, r, r1, r2)
+        d2 = (xs[0] - r[0]) ** 2 + (xs[1] - r[1]) ** 2 + (xs[2] - r[2]) ** 2
+        if d2 < best_d2:
+            best_d2 = d2
+            best_t = tk
+            for p in range(3):
+                c[p] = r[p]
+    return best_t, best_d2

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import get_num_threads, njit, prange, set_parallel_chunksize
 
 from ..assembly.pattern import Pattern, scatter_matrices, scatter_vectors
 from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
@@ -23,6 +23,8 @@ from ..materials.hyperelastic import VOIGT, Material, material_energy, material_
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
 
 SOLID_CELLS = ("hex8", "hex18", "hex27")
+#: parallel blocks per thread and chunk (handed out dynamically, for load balance on shared cores)
+BLOCKS_PER_THREAD = 8
 
 
 @njit(cache=True, inline="always")
@@ -144,11 +146,15 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D,
 
 
 @njit(parallel=True, cache=True)
-def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, nthreads):
-    """Element buffers Ke (nc, nd, nd), fe (nc, nd) and flags (nc,) of elements e0 .. e0 + nc - 1."""
+def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, nblocks):
+    """Element buffers Ke (nc, nd, nd), fe (nc, nd) and flags (nc,) of elements e0 .. e0 + nc - 1.
+
+    The chunk is split into ``nblocks`` contiguous blocks (the parallel iterations), each with its
+    own scratch arrays.
+    """
     nc = fe.shape[0]
     nen = conn.shape[1]
-    nblk = min(nthreads, nc)
+    nblk = max(1, min(nblocks, nc))
     for t in prange(nblk):
         lo = t * nc // nblk
         hi = (t + 1) * nc // nblk
@@ -373,14 +379,25 @@ class SolidBody:
                 raise ValueError(f"data must be float64 of shape ({pattern.nnz},)")
             ranks = self.ranks(pattern, node_offset)
             node_ptr = pattern.node_ptr
+        else:
+            ranks = self._ranks
+            node_ptr = np.zeros(1, dtype=np.int64)
         if self._fe.shape[0] != self.chunk:
             self._fe = np.empty((self.chunk, nd))
             self._flags = np.empty(self.chunk, dtype=np.int64)
         if want_K and self._Ke.shape[0] != self.chunk:
             self._Ke = np.empty((self.chunk, nd, nd))
-        kind, params = self.material.kind, self.material.params
         off = np.int64(node_offset)
-        nthreads = get_num_threads()
+        nblocks = BLOCKS_PER_THREAD * get_num_threads()
+        old_chunksize = set_parallel_chunksize(1)  # blocks handed out dynamically (shared cores)
+        try:
+            first_bad = self._assemble_chunks(u, data, rhs, node_ptr, ranks, off, nblocks, want_K)
+        finally:
+            set_parallel_chunksize(old_chunksize)
+        return first_bad
+
+    def _assemble_chunks(self, u, data, rhs, node_ptr, ranks, off, nblocks, want_K) -> int:
+        kind, params = self.material.kind, self.material.params
         first_bad = -1
         for e0 in range(0, self.n_elements, self.chunk):
             nc = min(self.chunk, self.n_elements - e0)
@@ -388,7 +405,7 @@ class SolidBody:
             fe = self._fe[:nc]
             flags = self._flags[:nc]
             solid_chunk(kind, params, self.X, u, self.cells, e0, self.dNdxi, self.weights, want_K, Ke, fe,
-                        flags, nthreads)
+                        flags, nblocks)
             scatter_vectors(rhs, self.cells, off, fe, e0)
             if want_K:
                 scatter_matrices(data, node_ptr, self.cells, off, ranks, Ke, e0)

@@ -87,7 +87,7 @@ class NeoHooke(_Isotropic):
 
 Material = SaintVenantKirchhoff | NeoHooke
 
-_NAMES: dict[str, type[SaintVenantKirchhoff] | type[NeoHooke]] = {
+_NAMES: dict[str, type[SaintVenantKirchhoff | NeoHooke]] = {
     "svk": SaintVenantKirchhoff,
     "saint-venant-kirchhoff": SaintVenantKirchhoff,
     "st-venant-kirchhoff": SaintVenantKirchhoff,

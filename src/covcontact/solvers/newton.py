@@ -126,6 +126,7 @@ class Newton:
             out.iterations = it
             R, K = self._evaluate(u, lam_b)
             t0 = time.perf_counter()
+            reactions = float(np.linalg.norm(R[~free]))
             rhs = -R
             rhs[~free] = 0.0
             K = m.eliminate(K)
@@ -133,13 +134,18 @@ class Newton:
             rn = float(np.linalg.norm(rhs))
             out.residual_norms.append(rn)
             out.records.append(IterationRecord(it, rn, energy, m.active_count()))
-            if not np.isfinite(rn) or rn > opt.divergence_factor * max(r0, opt.atol * scale):
+            if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
                 return out
-            if rn <= max(opt.rtol * r0, opt.atol * scale) and energy <= opt.etol * e0 + 1e-300 \
-                    and m.active_set_settled():
-                out.converged = True
-                return out
+            scale_k = max(scale, reactions)
+            conv_energy = energy <= opt.etol * e0
+            conv_res = rn <= max(opt.rtol * r0, opt.atol * scale_k)
+            # round-off floor: the energy criterion holds and the residual stopped falling
+            floor = conv_energy and it >= 2 and rn >= 0.5 * out.residual_norms[-2] and rn <= 1e-6 * r0
+            if (conv_res and conv_energy) or floor:
+                if m.active_set_settled():
+                    out.converged = True
+                    return out
         out.reason = f"no convergence in {opt.max_iterations} iterations"
         return out
 

@@ -30,7 +30,10 @@ def _reactions(model: Model, u: np.ndarray, lam: float) -> dict:
     out = {}
     for bc in model.problem.dirichlet:
         nodes = model.system.global_nodes(bc.body, bc.set)
-        out[f"{bc.body}.{bc.set}"] = R.reshape(-1, 3)[nodes].sum(axis=0).tolist()
+        total = R.reshape(-1, 3)[nodes].sum(axis=0)
+        comp = np.zeros(3, dtype=bool)
+        comp[list(bc.components)] = True
+        out[f"{bc.body}.{bc.set}"] = np.where(comp, total, 0.0).tolist()
     return out
 
 

@@ -1,0 +1,641 @@
+"""Linear solver registry: sparse direct and iterative backends behind one small interface.
+
+Backends, in order of preference (``available()`` lists those usable on this machine):
+
+- ``pardiso``: MKL PARDISO through the ``pypardiso`` package (x86-64). Symmetric matrices are
+  factorised as LDL^T with Bunch-Kaufman pivoting (mtype -2, upper triangle), which also covers the
+  indefinite tangents of buckling and contact; non-symmetric ones as LU (mtype 11).
+- ``cholmod``: CHOLMOD supernodal Cholesky (scikit-sparse); symmetric only. An indefinite matrix
+  falls back to the next LDL^T/LU backend for that factorisation.
+- ``mumps``: MUMPS LDL^T / LU (python-mumps).
+- ``superlu``: SciPy's SuperLU, always present; for symmetric matrices with the symmetric-mode
+  options (MMD on A^T + A, diagonal pivots preferred), about 2.4x faster than ``spsolve``.
+- ``cg-amg``: smoothed-aggregation AMG (pyamg) as preconditioner of CG (symmetric) or GMRES, with
+  the rigid-body modes as near-null space once ``set_geometry`` has been called.
+
+Every solver keeps its symbolic analysis while the sparsity pattern (indptr, indices) is unchanged,
+records the time of its last analysis, factorisation and solve, checks the residual of each solve
+and raises ``SingularMatrixError`` for a singular matrix or a non-finite solution.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import platform
+import time
+import warnings
+from functools import lru_cache
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+#: all backends, in order of preference
+BACKENDS = ("pardiso", "cholmod", "mumps", "superlu", "cg-amg")
+_DIRECT = ("pardiso", "cholmod", "mumps", "superlu")
+
+
+class LinearSolverError(RuntimeError):
+    """A linear solve failed (bad input, backend error, or no convergence)."""
+
+
+class SingularMatrixError(LinearSolverError):
+    """The matrix is singular (or numerically so) or the solution is not finite."""
+
+
+# ----------------------------------------------------------------------------- availability
+
+
+@lru_cache(maxsize=None)
+def _probe(name: str) -> tuple[bool, str, str]:
+    """(available, version, note) of one backend; imports it if possible."""
+    try:
+        if name == "pardiso":
+            if platform.machine().lower() not in ("x86_64", "amd64"):
+                return False, "", "MKL PARDISO needs x86-64"
+            import pypardiso
+
+            _pardiso_function()
+            return True, getattr(pypardiso, "__version__", ""), "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
+        if name == "cholmod":
+            import sksparse
+            import sksparse.cholmod  # noqa: F401
+
+            return True, getattr(sksparse, "__version__", ""), "CHOLMOD Cholesky, symmetric only"
+        if name == "mumps":
+            import mumps
+
+            if not hasattr(mumps, "Context"):
+                return False, "", "the installed 'mumps' module is not python-mumps"
+            return True, getattr(mumps, "__version__", ""), "MUMPS LDL^T / LU"
+        if name == "superlu":
+            import scipy
+
+            return True, scipy.__version__, "SciPy SuperLU (symmetric mode for symmetric matrices)"
+        if name == "cg-amg":
+            import pyamg
+
+            return True, pyamg.__version__, "iterative: CG/GMRES + smoothed-aggregation AMG"
+    except (ImportError, OSError) as exc:
+        return False, "", f"not installed ({exc.__class__.__name__}: {exc})"
+    raise ValueError(name)
+
+
+def available() -> list[str]:
+    """Backends usable here, in order of preference."""
+    return [name for name in BACKENDS if _probe(name)[0]]
+
+
+def describe() -> list[dict]:
+    """One dict per backend (name, available, version, note), for ``covcontact info``."""
+    out = []
+    for name in BACKENDS:
+        ok, version, note = _probe(name)
+        out.append({"name": name, "available": ok, "version": version, "note": note})
+    return out
+
+
+def make_solver(name: str = "auto", symmetric: bool = True, **options) -> LinearSolver:
+    """Create a linear solver.
+
+    Args:
+        name: a backend from ``BACKENDS`` or ``"auto"`` (the first direct backend available that
+            handles the symmetry).
+        symmetric: whether the matrices will be symmetric (they may still be indefinite).
+        **options: backend options (``check_tol`` for all; ``spd``/``matching`` for pardiso;
+            ``ordering`` for mumps; ``rtol``/``maxiter`` for cg-amg).
+    """
+    here = available()
+    key = name.lower().strip()
+    if key == "auto":
+        for cand in here:
+            if cand in _DIRECT and (symmetric or cand != "cholmod"):
+                key = cand
+                break
+    if key not in BACKENDS:
+        raise ValueError(f"unknown linear solver {name!r}; available here: {', '.join(here)}")
+    if key not in here:
+        raise ValueError(
+            f"linear solver {name!r} is not available here ({_probe(key)[2]}); "
+            f"available: {', '.join(here)}"
+        )
+    if key == "cholmod" and not symmetric:
+        raise ValueError("cholmod factorises symmetric matrices only; use pardiso, mumps or superlu")
+    cls = {
+        "pardiso": PardisoSolver,
+        "cholmod": CholmodSolver,
+        "mumps": MumpsSolver,
+        "superlu": SuperLUSolver,
+        "cg-amg": AMGSolver,
+    }[key]
+    return cls(symmetric=symmetric, **options)
+
+
+def rigid_body_modes(points: np.ndarray, dofs: np.ndarray | None = None) -> np.ndarray:
+    """The six rigid-body modes (ndof, 6) of nodes ``points`` restricted to global ``dofs``."""
+    X = np.asarray(points, dtype=np.float64)
+    if dofs is None:
+        dofs = np.arange(3 * X.shape[0])
+    dofs = np.asarray(dofs, dtype=np.int64)
+    node, i = dofs // 3, dofs % 3
+    x = X[node] - X.mean(axis=0)
+    B = np.zeros((dofs.size, 6))
+    B[np.arange(dofs.size), i] = 1.0
+    # rotation about axis k: u = e_k x x
+    for k in range(3):
+        rot = np.zeros((dofs.size, 3))
+        rot[:, (k + 2) % 3] = x[:, (k + 1) % 3]
+        rot[:, (k + 1) % 3] = -x[:, (k + 2) % 3]
+        B[:, 3 + k] = rot[np.arange(dofs.size), i]
+    return B
+
+
+# ----------------------------------------------------------------------------- common layer
+
+
+def _as_csr(K) -> sp.csr_matrix:
+    """Canonical float64 CSR view (or copy) of K, checked for shape, finiteness and empty rows."""
+    if not sp.issparse(K):
+        raise TypeError(f"the matrix must be a scipy sparse matrix, got {type(K).__name__}")
+    if K.format != "csr" or K.dtype != np.float64:
+        K = sp.csr_matrix(K, dtype=np.float64)
+    if K.shape[0] != K.shape[1]:
+        raise ValueError(f"the matrix must be square, got shape {K.shape}")
+    if not K.has_canonical_format:
+        K = K.copy()
+        K.sum_duplicates()
+    empty = np.flatnonzero(np.diff(K.indptr) == 0)
+    if empty.size:
+        raise SingularMatrixError(
+            f"the matrix is singular: {empty.size} empty row(s), first {empty[:5].tolist()} "
+            "(unconstrained or unconnected dofs?)"
+        )
+    if not np.isfinite(K.data).all():
+        raise LinearSolverError("the matrix has non-finite entries")
+    return K
+
+
+class LinearSolver:
+    """Interface shared by all backends.
+
+    Attributes:
+        name: backend name.
+        direct: True for a factorisation, False for an iterative method.
+        t_analyze, t_factor, t_solve: seconds of the last symbolic analysis (0 when reused), the
+            last ``factorize`` call (analysis included) and the last ``solve_factorized`` call.
+        n_analyses, n_factorizations: counters.
+        residual: relative residual ||K x - b|| / ||b|| of the last solve.
+    """
+
+    name = "base"
+    direct = True
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6):
+        self.symmetric = symmetric
+        self.check_tol = check_tol
+        self.t_analyze = self.t_factor = self.t_solve = 0.0
+        self.n_analyses = self.n_factorizations = 0
+        self.residual = float("nan")
+        self._K: sp.csr_matrix | None = None
+        self._indptr: np.ndarray | None = None
+        self._indices: np.ndarray | None = None
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name} symmetric={self.symmetric}>"
+
+    def same_pattern(self, K: sp.csr_matrix) -> bool:
+        """Whether K has the sparsity pattern of the last analysis."""
+        if self._indptr is None or K.shape[0] + 1 != self._indptr.size:
+            return False
+        return np.array_equal(K.indptr, self._indptr) and np.array_equal(K.indices, self._indices)
+
+    def factorize(self, K) -> None:
+        """Factorise K (CSR), reusing the symbolic analysis when the pattern is unchanged."""
+        K = _as_csr(K)
+        t0 = time.perf_counter()
+        self.t_analyze = 0.0
+        if not self.same_pattern(K):
+            self._analyze(K)
+            self._indptr, self._indices = K.indptr.copy(), K.indices.copy()
+            self.n_analyses += 1
+            self.t_analyze = time.perf_counter() - t0
+        self._K = None
+        self._factor(K)
+        self._K = K
+        self.n_factorizations += 1
+        self.t_factor = time.perf_counter() - t0
+
+    def solve_factorized(self, b: np.ndarray) -> np.ndarray:
+        """Solve with the last factorisation; b is (n,) or (n, nrhs)."""
+        if self._K is None:
+            raise LinearSolverError("factorize() must succeed before solve_factorized()")
+        b = np.asarray(b, dtype=np.float64)
+        if b.shape[0] != self._K.shape[0] or b.ndim > 2:
+            raise ValueError(f"right-hand side of shape {b.shape} for a matrix of size {self._K.shape[0]}")
+        t0 = time.perf_counter()
+        x = self._solve(b)
+        res = self._check(b, x)
+        if self.direct and res > self.check_tol and np.isfinite(res):
+            x = x + self._solve(b - self._K @ x)  # one step of iterative refinement
+            res = self._check(b, x)
+        self.t_solve = time.perf_counter() - t0
+        if res > self.check_tol:
+            raise SingularMatrixError(
+                f"{self.name}: relative residual {res:.2e} > {self.check_tol:.0e} after the solve; "
+                f"the matrix is singular or too ill-conditioned{self._diagnosis()}"
+            )
+        return x
+
+    def solve(self, K, b: np.ndarray) -> np.ndarray:
+        """Factorise K and solve K x = b."""
+        self.factorize(K)
+        return self.solve_factorized(b)
+
+    def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
+        """Node coordinates (nnode, 3) and the global dofs of the unknowns (used by cg-amg)."""
+
+    def close(self) -> None:
+        """Release the factorisation and the analysis (the next ``factorize`` analyses afresh)."""
+        self._release()
+        self._K = None
+        self._indptr = self._indices = None
+
+    def _check(self, b: np.ndarray, x: np.ndarray) -> float:
+        if not np.isfinite(x).all():
+            raise SingularMatrixError(
+                f"{self.name}: the solution has non-finite entries; the matrix is singular"
+                f"{self._diagnosis()}"
+            )
+        assert self._K is not None
+        nb = np.linalg.norm(b, axis=0)
+        r = np.linalg.norm(self._K @ x - b, axis=0)
+        self.residual = float(np.max(np.where(nb > 0, r / np.where(nb > 0, nb, 1.0), r)))
+        return self.residual
+
+    def _diagnosis(self) -> str:
+        return ""
+
+    # backend hooks
+    def _release(self) -> None:
+        pass
+
+    def _analyze(self, K: sp.csr_matrix) -> None:
+        pass
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        raise NotImplementedError
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+
+# ----------------------------------------------------------------------------- PARDISO
+
+_PARDISO_ERRORS = {
+    -1: "input inconsistent",
+    -2: "not enough memory",
+    -3: "reordering problem",
+    -4: "zero pivot (numerical factorisation or iterative refinement problem)",
+    -5: "unclassified internal error",
+    -6: "reordering failed",
+    -7: "diagonal matrix is singular",
+    -8: "32-bit integer overflow",
+    -9: "not enough memory for out-of-core",
+}
+
+
+@lru_cache(maxsize=1)
+def _pardiso_function():
+    """The ``pardiso`` entry point of the MKL runtime located by pypardiso."""
+    import pypardiso
+
+    lib = pypardiso.PyPardisoSolver().libmkl
+    fn = lib["pardiso"]  # a fresh function pointer: our own argtypes
+    i32p = ctypes.POINTER(ctypes.c_int32)
+    fn.argtypes = [ctypes.c_void_p] + [i32p] * 5 + [ctypes.c_void_p] + [i32p] * 6 + [ctypes.c_void_p] * 2 + [i32p]
+    fn.restype = None
+    return fn
+
+
+def _upper_structure(K: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """CSR structure (ia, ja int32) of the upper triangle of K with every diagonal entry present,
+    and for each entry its position in K.data (K.nnz for a structural zero on the diagonal)."""
+    n = K.shape[0]
+    rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(K.indptr))
+    keep = np.flatnonzero(K.indices >= rows)
+    r, c, pos = rows[keep], K.indices[keep].astype(np.int64), keep
+    has_diag = np.zeros(n, dtype=bool)
+    has_diag[r[c == r]] = True
+    missing = np.flatnonzero(~has_diag)
+    if missing.size:  # PARDISO needs the diagonal in the structure of symmetric matrices
+        r = np.concatenate([r, missing])
+        c = np.concatenate([c, missing])
+        pos = np.concatenate([pos, np.full(missing.size, K.nnz)])
+        order = np.lexsort((c, r))
+        r, c, pos = r[order], c[order], pos[order]
+    ia = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(np.bincount(r, minlength=n), out=ia[1:])
+    return ia, c.astype(np.int32), pos
+
+
+class PardisoSolver(LinearSolver):
+    """MKL PARDISO with the analysis (phase 11) redone only when the pattern changes.
+
+    Options: ``spd=True`` uses Cholesky (mtype 2; falls back to -2 if the matrix is not positive
+    definite); ``matching=True`` adds weighted matching and scaling to LDL^T (saddle-point
+    matrices with zero diagonal blocks).
+    """
+
+    name = "pardiso"
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, spd: bool = False,
+                 matching: bool = False):
+        super().__init__(symmetric, check_tol)
+        self._fn = _pardiso_function()
+        self.mtype = (2 if spd else -2) if symmetric else 11
+        self.matching = matching
+        self.pt = np.zeros(64, dtype=np.int64)
+        self.iparm = np.zeros(64, dtype=np.int32)
+        self._n = 0
+        self._a = np.zeros(1)
+        self._ia = self._ja = np.zeros(1, dtype=np.int32)
+        self._pos: np.ndarray | None = None
+        self._pad = False
+        self.n_perturbed = 0
+        self.inertia: tuple[int, int] | None = None
+
+    def _set_iparm(self) -> None:
+        ip = self.iparm
+        ip[:] = 0
+        ip[0] = 1  # user-supplied parameters
+        ip[1] = 2  # METIS nested dissection
+        ip[7] = 0  # iterative refinement: automatic (2 steps after perturbed pivots)
+        ip[34] = 1  # zero-based indexing
+        if self.mtype == 11:
+            ip[9], ip[10], ip[12] = 13, 1, 1  # pivot perturbation 1e-13, scaling, matching
+        else:
+            ip[9] = 8  # pivot perturbation 1e-8
+            ip[20] = 1  # Bunch-Kaufman 1x1 and 2x2 pivots
+            if self.matching:
+                ip[10], ip[12] = 1, 1
+
+    def _call(self, phase: int, b: np.ndarray | None = None, x: np.ndarray | None = None) -> int:
+        err = ctypes.c_int32(0)
+        nrhs = 1 if b is None or b.ndim == 1 else b.shape[1]
+        dummy = np.zeros(1)
+        c = ctypes.c_int32
+
+        def ref(v):
+            return ctypes.byref(c(v))
+
+        i32p = ctypes.POINTER(ctypes.c_int32)
+        self._fn(self.pt.ctypes.data, ref(1), ref(1), ref(self.mtype), ref(phase), ref(self._n),
+                 self._a.ctypes.data, self._ia.ctypes.data_as(i32p), self._ja.ctypes.data_as(i32p),
+                 None, ref(nrhs), self.iparm.ctypes.data_as(i32p), ref(0),
+                 (dummy if b is None else b).ctypes.data, (dummy if x is None else x).ctypes.data,
+                 ctypes.byref(err))
+        return err.value
+
+    def _values(self, K: sp.csr_matrix) -> np.ndarray:
+        """Values in PARDISO's structure; kept alive, PARDISO refines with them in phase 33."""
+        if self._pos is None:
+            return K.data.copy()
+        if self._pad:
+            return np.append(K.data, 0.0)[self._pos]
+        return K.data[self._pos]
+
+    def _analyze(self, K: sp.csr_matrix) -> None:
+        self._release()
+        self._n = K.shape[0]
+        if self.mtype == 11:
+            self._ia, self._ja, self._pos = K.indptr.astype(np.int32), K.indices.astype(np.int32), None
+        else:
+            self._ia, self._ja, self._pos = _upper_structure(K)
+            self._pad = bool((self._pos == K.nnz).any())
+        self._set_iparm()
+        self._a = self._values(K)
+        err = self._call(11)
+        if err:
+            self._release()
+            raise LinearSolverError(f"pardiso analysis failed: {_PARDISO_ERRORS.get(err, err)}")
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        self._a = self._values(K)
+        err = self._call(22)
+        if err == -4 and self.mtype == 2:  # not positive definite: continue with LDL^T
+            self.mtype = -2
+            self._analyze(K)
+            err = self._call(22)
+        if err:
+            cls = SingularMatrixError if err in (-4, -7) else LinearSolverError
+            raise cls(f"pardiso factorisation failed: {_PARDISO_ERRORS.get(err, err)}")
+        self.n_perturbed = int(self.iparm[13])
+        self.inertia = (int(self.iparm[21]), int(self.iparm[22])) if self.mtype == -2 else None
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        bf = np.array(b, dtype=np.float64, order="F")
+        x = np.zeros_like(bf, order="F")
+        err = self._call(33, bf, x)
+        if err:
+            raise LinearSolverError(f"pardiso solve failed: {_PARDISO_ERRORS.get(err, err)}")
+        return np.ascontiguousarray(x)
+
+    def _diagnosis(self) -> str:
+        return f" ({self.n_perturbed} perturbed pivots)" if self.n_perturbed else ""
+
+    def _release(self) -> None:
+        if self._n and self.pt.any():
+            self._call(-1)
+        self.pt[:] = 0
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+
+# ----------------------------------------------------------------------------- SuperLU
+
+
+class SuperLUSolver(LinearSolver):
+    """SciPy SuperLU. SuperLU offers no reuse of the analysis: every factorisation is complete.
+
+    K^T is handed over as CSC (a free view of the CSR arrays) and solved transposed.
+    """
+
+    name = "superlu"
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, diag_pivot_thresh: float = 1e-3):
+        super().__init__(symmetric, check_tol)
+        self.diag_pivot_thresh = diag_pivot_thresh
+        self._lu = None
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        Kt = sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape)
+        self._lu = None
+        try:
+            if self.symmetric:
+                self._lu = sla.splu(Kt, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=self.diag_pivot_thresh,
+                                    options={"SymmetricMode": True})
+            else:
+                self._lu = sla.splu(Kt)
+        except RuntimeError as exc:
+            raise SingularMatrixError(f"superlu: {exc}") from exc
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        return self._lu.solve(np.ascontiguousarray(b), trans="T")
+
+    def _release(self) -> None:
+        self._lu = None
+
+
+# ----------------------------------------------------------------------------- CHOLMOD
+
+
+class CholmodSolver(LinearSolver):
+    """CHOLMOD supernodal Cholesky with the symbolic analysis kept per pattern.
+
+    A matrix that is not positive definite is factorised by the ``fallback`` backend instead
+    (``last_backend`` tells which one solved).
+    """
+
+    name = "cholmod"
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6):
+        if not symmetric:
+            raise ValueError("cholmod factorises symmetric matrices only")
+        super().__init__(symmetric, check_tol)
+        self._factor_obj = None
+        self._fallback: LinearSolver | None = None
+        self.last_backend = self.name
+
+    def _analyze(self, K: sp.csr_matrix) -> None:
+        from sksparse.cholmod import analyze
+
+        self._factor_obj = analyze(sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape))
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        from sksparse.cholmod import CholmodNotPositiveDefiniteError
+
+        self.last_backend = self.name
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                self._factor_obj.cholesky_inplace(sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape))
+            return
+        except (CholmodNotPositiveDefiniteError, Warning):
+            pass
+        if self._fallback is None:
+            nxt = "mumps" if "mumps" in available() else "superlu"
+            self._fallback = make_solver(nxt, symmetric=True, check_tol=self.check_tol)
+        self._fallback.factorize(K)
+        self.last_backend = self._fallback.name
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        if self.last_backend != self.name:
+            assert self._fallback is not None
+            return self._fallback._solve(b)
+        return self._factor_obj(b)
+
+
+# ----------------------------------------------------------------------------- MUMPS
+
+
+class MumpsSolver(LinearSolver):
+    """MUMPS (python-mumps): LDL^T with pivoting for symmetric matrices, LU otherwise."""
+
+    name = "mumps"
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, ordering: str = "auto"):
+        super().__init__(symmetric, check_tol)
+        import mumps
+
+        self._mumps = mumps
+        self.ordering = ordering
+        self._ctx = mumps.Context()
+        self._fresh = False
+
+    def _set(self, K: sp.csr_matrix) -> None:
+        self._ctx.set_matrix(K, symmetric=self.symmetric)
+
+    def _analyze(self, K: sp.csr_matrix) -> None:
+        self._set(K)
+        try:
+            self._ctx.analyze(ordering=self.ordering)
+        except self._mumps.MUMPSError as exc:
+            raise LinearSolverError(f"mumps analysis: {exc}") from exc
+        self._fresh = True
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        if not self._fresh:
+            self._set(K)
+        self._fresh = False
+        try:
+            self._ctx.factor(reuse_analysis=True)
+        except self._mumps.MUMPSError as exc:
+            cls = SingularMatrixError if exc.error in (-6, -10) else LinearSolverError
+            raise cls(f"mumps factorisation: {exc}") from exc
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(self._ctx.solve(b))
+
+
+# ----------------------------------------------------------------------------- AMG
+
+
+class AMGSolver(LinearSolver):
+    """pyamg smoothed aggregation as a preconditioner; CG for symmetric matrices (GMRES if CG does
+    not converge, e.g. indefinite ones) and GMRES for non-symmetric ones. ``factorize`` builds the
+    hierarchy; ``rtol`` is the relative residual reached by each solve."""
+
+    name = "cg-amg"
+    direct = False
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, rtol: float = 1e-10,
+                 maxiter: int = 2000):
+        super().__init__(symmetric, max(check_tol, 10 * rtol))
+        self.rtol, self.maxiter = rtol, maxiter
+        self._B: np.ndarray | None = None
+        self._geometry: tuple[np.ndarray, np.ndarray | None] | None = None
+        self._ml = None
+        self.iterations = 0
+
+    def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
+        self._geometry = (np.asarray(points, dtype=np.float64), dofs)
+        self._indptr = None  # rebuild the hierarchy with the new near-null space
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        import pyamg
+
+        B = None
+        if self._geometry is not None:
+            B = rigid_body_modes(*self._geometry)
+            if B.shape[0] != K.shape[0]:
+                raise ValueError(f"geometry gives {B.shape[0]} dofs, the matrix has {K.shape[0]}")
+        self._ml = pyamg.smoothed_aggregation_solver(
+            K, B=B, symmetry="symmetric" if self.symmetric else "nonsymmetric", max_coarse=500
+        )
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        if b.ndim == 2:
+            return np.stack([self._solve(b[:, j]) for j in range(b.shape[1])], axis=1)
+        assert self._K is not None
+        nb = np.linalg.norm(b)
+        self.iterations = 0
+        for accel in ["cg", "gmres"] if self.symmetric else ["gmres"]:
+            x = np.zeros_like(b)
+            for k in range(3):  # the Krylov methods stop on a preconditioned residual: tighten
+                res: list[float] = []
+                tol = self.rtol * 0.1**k
+                x = self._ml.solve(b, x0=x, tol=tol, maxiter=self.maxiter, accel=accel, residuals=res)
+                self.iterations += len(res)
+                if not np.isfinite(x).all():
+                    break
+                r = np.linalg.norm(self._K @ x - b)
+                if r <= self.rtol * nb:
+                    return x
+        raise LinearSolverError(
+            f"cg-amg: no convergence to {self.rtol:.0e} within {self.iterations} iterations "
+            "(singular, strongly indefinite or badly scaled matrix?)"
+        )

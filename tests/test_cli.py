@@ -1,0 +1,180 @@
+"""The command line: a run of an example, and every bad-input case giving exit code 2 and one line."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from covcontact.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+GOOD = """
+[problem]
+name = "tiny"
+
+[[bodies]]
+name = "cube"
+element = "hex8"
+material = { model = "svk", E = 100.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2 }
+
+[[dirichlet]]
+set = "cube.zmin"
+components = "xyz"
+
+[[pressure]]
+set = "cube.zmax"
+value = 1.0
+
+[steps]
+count = 2
+"""
+
+
+def write(tmp_path: Path, text: str, name: str = "p.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def run_cli(args, capsys):
+    code = main([str(a) for a in args])
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+def test_run_good_problem(tmp_path, capsys):
+    path = write(tmp_path, GOOD)
+    code, _, err = run_cli(["run", path, "--out", tmp_path / "out"], capsys)
+    assert code == 0, err
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["converged"] and len(summary["steps"]) == 2
+    assert (tmp_path / "out" / "result.pvd").exists()
+    assert (tmp_path / "out" / "step_0002.vtu").exists()
+    lines = (tmp_path / "out" / "convergence.csv").read_text().splitlines()
+    assert lines[0] == "step,iteration,residual_norm,energy_norm,active_contacts"
+    assert "step    1/2" in err and "time:" in err
+    # pressure 1 pushes the unit top face down; the support pushes the body up by 1
+    react = summary["steps"][-1]["reactions"]["cube.zmin"]
+    assert react[2] == pytest.approx(1.0, rel=1e-8)
+
+
+def test_quiet_prints_nothing(tmp_path, capsys):
+    path = write(tmp_path, GOOD)
+    code, out, err = run_cli(["run", path, "--out", tmp_path / "o", "--quiet"], capsys)
+    assert code == 0 and err == "" and out == ""
+
+
+BAD_CASES = {
+    "missing-key": (GOOD.replace('name = "tiny"', ""), "problem.name: missing required key"),
+    "unknown-key": (GOOD.replace("count = 2", "count = 2\ncuont = 3"), "steps.cuont: unknown key"),
+    "misspelled-material-key": (GOOD.replace("E = 100.0", "EE = 100.0"), "bodies[0].material"),
+    "wrong-type": (GOOD.replace("count = 2", 'count = "two"'), "steps.count: must be an integer"),
+    "zero-modulus": (GOOD.replace("E = 100.0", "E = 0.0"), "bodies[0].material.E: must be > 0"),
+    "bad-poisson": (GOOD.replace("nu = 0.3", "nu = 0.5"), "bodies[0].material.nu"),
+    "negative-thickness": (GOOD.replace('generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2',
+                                        'generator = "plate", lx = 1.0, ly = 1.0, t = -0.1, nx = 2, ny = 2'),
+                           "bodies[0].mesh"),
+    "unknown-element": (GOOD.replace('element = "hex8"', 'element = "hex20"'), "bodies[0].element"),
+    "unknown-set": (GOOD.replace('set = "cube.zmin"', 'set = "cube.bottom"'), "has no node set 'bottom'"),
+    "unknown-body": (GOOD.replace('set = "cube.zmin"', 'set = "ball.zmin"'), "no body named 'ball'"),
+    "unknown-generator": (GOOD.replace('generator = "block"', 'generator = "brick"'), "generator"),
+    "generator-arg": (GOOD.replace("nz = 2 }", "nz = 2, nw = 3 }"), "nw: unknown key for generator"),
+    "bad-components": (GOOD.replace('components = "xyz"', 'components = "xq"'), "components"),
+    "bad-steps": (GOOD.replace("count = 2", "factors = [0.5, 0.2]"), "steps.factors"),
+    "missing-mesh-file": (GOOD.replace('mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, '
+                                       'ny = 2, nz = 2 }', 'mesh = { file = "nowhere.msh" }'),
+                          "does not exist"),
+    "bad-tangent": (GOOD + '\n[[rigid]]\nname = "floor"\nshape = "plane"\npoint = [0.0, 0.0, 0.0]\n'
+                           'normal = [0.0, 0.0, 1.0]\n\n[[contact]]\nslave = "cube.zmin"\nmaster = "floor"\n'
+                           'penalty = 1.0\ntangent = "e"\n', "contact[0].tangent"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_CASES))
+def test_bad_input_one_line_exit_2(tmp_path, capsys, case):
+    text, expect = BAD_CASES[case]
+    path = write(tmp_path, text)
+    code, out, err = run_cli(["run", path, "--out", tmp_path / "o"], capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert str(path) in lines[0]
+    assert expect in lines[0], lines[0]
+    assert "Traceback" not in err
+
+
+def test_missing_file_and_syntax_error(tmp_path, capsys):
+    code, _, err = run_cli(["run", tmp_path / "none.toml"], capsys)
+    assert code == 2 and "does not exist" in err and len(err.strip().splitlines()) == 1
+    path = write(tmp_path, GOOD.replace("count = 2", "count = = 2"))
+    code, _, err = run_cli(["run", path], capsys)
+    assert code == 2 and "TOML syntax error" in err and "line" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_mesh_file_that_does_not_parse(tmp_path, capsys):
+    (tmp_path / "junk.msh").write_text("this is not a mesh\n")
+    text = GOOD.replace('mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2 }',
+                        'mesh = { file = "junk.msh" }')
+    path = write(tmp_path, text)
+    code, _, err = run_cli(["run", path], capsys)
+    assert code == 2 and "junk.msh" in err and len(err.strip().splitlines()) == 1
+
+
+def test_empty_node_set(tmp_path, capsys):
+    inp = ["*NODE"]
+    k = 1
+    for z in (0, 1):
+        for y in (0, 1):
+            for x in (0, 1):
+                inp.append(f"{k}, {x}.0, {y}.0, {z}.0")
+                k += 1
+    inp += ["*ELEMENT, TYPE=C3D8, ELSET=ALL", "1, 1, 2, 4, 3, 5, 6, 8, 7",
+            "*NSET, NSET=BASE", "1, 2, 3, 4", "*NSET, NSET=NOTHING"]
+    (tmp_path / "cube.inp").write_text("\n".join(inp) + "\n")
+    text = GOOD.replace('mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2 }',
+                        'mesh = { file = "cube.inp" }')
+    text = text.replace('set = "cube.zmin"', 'set = "cube.NOTHING"')
+    path = write(tmp_path, text)
+    code, _, err = run_cli(["run", path], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "NOTHING" in err
+
+
+def test_unknown_solver_and_case(tmp_path, capsys):
+    path = write(tmp_path, GOOD)
+    code, _, err = run_cli(["run", path, "--solver", "nonesuch"], capsys)
+    assert code == 2 and "nonesuch" in err
+    code, _, err = run_cli(["study", path, "--cases", "a,q"], capsys)
+    assert code == 2 and "'q'" in err
+
+
+def test_nonconverging_step_exit_1(tmp_path, capsys):
+    # a load far beyond what the tiny budget of iterations and cutbacks can carry
+    text = GOOD.replace("value = 1.0", "value = 80.0").replace(
+        "count = 2", "count = 2\n\n[solver]\nmax_iterations = 2\nmax_cutbacks = 1")
+    path = write(tmp_path, text)
+    code, _, err = run_cli(["run", path, "--out", tmp_path / "o"], capsys)
+    assert code == 1
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["converged"] is False
+    assert summary["steps"][-1]["converged"] is False
+    assert "FAILED" in err
+
+
+def test_info(capsys):
+    code, out, _ = run_cli(["info"], capsys)
+    assert code == 0 and "covcontact" in out and "superlu" in out and "threads" in out
+
+
+def test_console_script_runs(tmp_path):
+    """The installed entry point, as a user calls it."""
+    path = write(tmp_path, GOOD)
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(path), "--out",
+                           str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "o" / "summary.json").exists()
