@@ -27,6 +27,7 @@ class Body:
     mesh: Mesh
     material: Any
     formulation: str = "solid"
+    options: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -72,6 +73,15 @@ class Pressure:
     body: str
     set: str
     value: float
+
+
+@dataclass
+class Traction:
+    """Dead traction ``lam * value`` (force per reference area) on a face set."""
+
+    body: str
+    set: str
+    value: tuple[float, float, float]
 
 
 @dataclass
@@ -136,6 +146,7 @@ class Problem:
     dirichlet: list[Dirichlet] = field(default_factory=list)
     forces: list[NodalForce] = field(default_factory=list)
     pressures: list[Pressure] = field(default_factory=list)
+    tractions: list[Traction] = field(default_factory=list)
     rigid: list[RigidBody] = field(default_factory=list)
     contacts: list[ContactPair] = field(default_factory=list)
     steps: Steps = field(default_factory=lambda: Steps.equal(1))

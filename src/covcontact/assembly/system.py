@@ -36,10 +36,11 @@ class BodyBlock:
     solid: SolidBody
 
 
-def face_load_vector(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
+def face_load_vector(X: np.ndarray, faces: np.ndarray, area_only: bool = False) -> np.ndarray:
     """Integral of N_a (rho_1 x rho_2) dxi over reference faces: (nnode, 3) nodal vectors.
 
-    A dead pressure p gives nodal forces -p times this (positive pressure pushes into the body).
+    A dead pressure p gives nodal forces -p times this (positive pressure pushes into the body). With
+    ``area_only`` the integral of N_a |rho_1 x rho_2| dxi (nodal areas, repeated in the 3 columns).
     """
     nfn = faces.shape[1]
     cell = "quad4" if nfn == 4 else "quad9"
@@ -49,6 +50,8 @@ def face_load_vector(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
     r1 = np.einsum("pa,fai->fpi", dN[:, :, 0], xf)
     r2 = np.einsum("pa,fai->fpi", dN[:, :, 1], xf)
     nda = np.cross(r1, r2) * w[None, :, None]  # (nf, np, 3)
+    if area_only:
+        nda = np.repeat(np.linalg.norm(nda, axis=2, keepdims=True), 3, axis=2)
     fa = np.einsum("pa,fpi->fai", N, nda)
     out = np.zeros_like(X)
     np.add.at(out, faces.ravel(), fa.reshape(-1, 3))
@@ -63,7 +66,13 @@ class System:
         self.blocks: list[BodyBlock] = []
         offset = 0
         for body in problem.bodies:
-            solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material)
+            if body.formulation == "solid-shell":
+                from ..elements.solidshell import SolidShellBody
+
+                solid = SolidShellBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
+                                       **body.options)
+            else:
+                solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material)
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
             offset += body.mesh.n_nodes
         self.n_nodes = offset
@@ -101,6 +110,12 @@ class System:
             faces = mesh.face_sets[pr.set]
             off = self.offset(pr.body)
             f[off: off + mesh.n_nodes] -= pr.value * face_load_vector(mesh.points, faces)
+        for tr in self.problem.tractions:
+            mesh = self.problem.body(tr.body).mesh
+            faces = mesh.face_sets[tr.set]
+            off = self.offset(tr.body)
+            f[off: off + mesh.n_nodes] += face_load_vector(mesh.points, faces, area_only=True) \
+                * np.asarray(tr.value, dtype=float)[None, :]
         self.f_ext = f.ravel()
 
     # -- Dirichlet ------------------------------------------------------------------------------
@@ -138,6 +153,21 @@ class System:
                 raise InvertedElementError(blk.name, int(bad))
         K = self.pattern.csr(data) if want_K else None
         return r, K
+
+    def save_state(self) -> None:
+        for blk in self.blocks:
+            if hasattr(blk.solid, "save_state"):
+                blk.solid.save_state()
+
+    def restore_state(self) -> None:
+        for blk in self.blocks:
+            if hasattr(blk.solid, "restore_state"):
+                blk.solid.restore_state()
+
+    def commit(self) -> None:
+        for blk in self.blocks:
+            if hasattr(blk.solid, "commit"):
+                blk.solid.commit()
 
     def energy(self, u: np.ndarray) -> float:
         U = u.reshape(-1, 3)

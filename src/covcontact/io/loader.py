@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..problem import (COMPONENTS, TANGENT_CASES, Body, ContactPair, Dirichlet, NodalForce, OutputOptions,
-                       Pressure, Problem, RigidBody, RigidMotion, SolverOptions, Steps)
+                       Pressure, Problem, RigidBody, RigidMotion, SolverOptions, Steps, Traction)
 from .validate import InputError, Section
 
 CELLS = ("hex8", "hex18", "hex27")
@@ -132,11 +132,22 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         if any(x.name == bname for x in bodies):
             b.fail(f"duplicate body name {bname!r}", "name")
         element = b.get("element", "str", None, choices=CELLS)
-        formulation = b.get("formulation", "str", "solid", choices=("solid",))
+        formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell"))
+        options = b.get("options", "table", None)
+        options = options.rest() if options is not None else {}
         material = _material(b.get("material", "table"))
         mesh = build_mesh(b.get("mesh", "table"), base, element)
         b.done()
-        bodies.append(Body(bname, mesh, material, formulation))
+        if formulation == "solid-shell":
+            from ..elements.solidshell import check_options
+
+            try:
+                options = check_options(mesh, options)
+            except ValueError as exc:
+                b.fail(str(exc), "options")
+        elif options:
+            b.fail("options are only known for formulation = \"solid-shell\"", "options")
+        bodies.append(Body(bname, mesh, material, formulation, options))
     if not bodies:
         top.fail("at least one [[bodies]] entry is needed")
 
@@ -219,6 +230,14 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         p.done()
         pressures.append(Pressure(bname, sname, value))
 
+    tractions = []
+    for t in top.get("traction", "array", []):
+        bname, sname = body_set(t, "set", "face")
+        deformable(t, "set", bname)
+        value = t.get("value", "vector")
+        t.done()
+        tractions.append(Traction(bname, sname, value))
+
     contacts = []
     for i, c in enumerate(top.get("contact", "array", [])):
         cname = c.get("name", "str", f"contact{i + 1}")
@@ -279,5 +298,5 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         o.done()
     top.done()
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
-                   pressures=pressures, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
+                   pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path)

@@ -620,22 +620,33 @@ class AMGSolver(LinearSolver):
     def _solve(self, b: np.ndarray) -> np.ndarray:
         if b.ndim == 2:
             return np.stack([self._solve(b[:, j]) for j in range(b.shape[1])], axis=1)
-        assert self._K is not None
+        K = self._K
+        assert K is not None
+        M = self._ml.aspreconditioner(cycle="V")
         nb = np.linalg.norm(b)
-        self.iterations = 0
+        count = [0]
+
+        def tick(_):
+            count[0] += 1
+
         for accel in ["cg", "gmres"] if self.symmetric else ["gmres"]:
             x = np.zeros_like(b)
-            for k in range(3):  # the Krylov methods stop on a preconditioned residual: tighten
-                res: list[float] = []
+            for k in range(3):  # restart with a tighter tolerance if the true residual lags behind
                 tol = self.rtol * 0.1**k
-                x = self._ml.solve(b, x0=x, tol=tol, maxiter=self.maxiter, accel=accel, residuals=res)
-                self.iterations += len(res)
+                if accel == "cg":
+                    x, info = sla.cg(K, b, x0=x, rtol=tol, atol=0.0, maxiter=self.maxiter, M=M, callback=tick)
+                else:
+                    x, info = sla.gmres(K, b, x0=x, rtol=tol, atol=0.0, restart=50, M=M, callback=tick,
+                                     maxiter=max(1, self.maxiter // 50), callback_type="pr_norm")
                 if not np.isfinite(x).all():
                     break
-                r = np.linalg.norm(self._K @ x - b)
-                if r <= self.rtol * nb:
+                if np.linalg.norm(K @ x - b) <= self.rtol * nb:
+                    self.iterations = count[0]
                     return x
+                if info != 0:  # no convergence (or breakdown): try the next method
+                    break
+        self.iterations = count[0]
         raise LinearSolverError(
-            f"cg-amg: no convergence to {self.rtol:.0e} within {self.iterations} iterations "
+            f"cg-amg: no convergence to {self.rtol:.0e} within {count[0]} iterations "
             "(singular, strongly indefinite or badly scaled matrix?)"
         )

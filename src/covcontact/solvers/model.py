@@ -97,12 +97,15 @@ class Model:
         self.contact.begin_step(self.positions(u), lam)
 
     def save_state(self) -> None:
+        self.system.save_state()
         self.contact.save_state()
 
     def restore_state(self) -> None:
+        self.system.restore_state()
         self.contact.restore_state()
 
     def commit(self) -> None:
+        self.system.commit()
         self.contact.commit()
 
     def active_count(self) -> int:
