@@ -109,6 +109,8 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
             if conv else [],
             "cutbacks": cutbacks,
         }
+        if cutbacks:
+            entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
         if success:
             entry.update(model.contact.step_report(model.positions(u), lam))
             entry["reactions"] = _reactions(model, u, lam)

@@ -1,0 +1,22 @@
+"""Every example problem runs with `covcontact run` and converges."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from covcontact.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = sorted(p for sub in ("solid", "contact", "verification")
+                  for p in (ROOT / "examples" / sub).glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: f"{p.parent.name}/{p.stem}")
+def test_example_runs(tmp_path, path):
+    code = main(["run", str(path), "--out", str(tmp_path), "--quiet"])
+    assert code == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["converged"]
+    assert all(s["converged"] for s in summary["steps"])
+    assert (tmp_path / "result.pvd").exists()
