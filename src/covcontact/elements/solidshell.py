@@ -1,0 +1,387 @@
+"""Solid-shell elements (Hauptmann & Schweizerhof 1998; Hauptmann, Schweizerhof & Doll 2000).
+
+Displacement-only hexahedra with one element through the thickness; the thickness direction is the
+third natural coordinate t (bottom node layer t = -1, then top layer t = +1, as in
+:mod:`covcontact.fem.shapes`). Total Lagrangian, with three locking cures on the covariant
+Green-Lagrange strain:
+
+- ANS transverse shear. hex8: Dvorkin-Bathe, E_rt tied at (0, -+1, t), E_st at (-+1, 0, t).
+  hex18: MITC9-like, E_rt at (r, s) = (-+a, {-b, 0, b}) interpolated linearly in r and
+  quadratically in s (E_st transposed), a = 1/sqrt(3), b = sqrt(3/5).
+- ANS thickness strain (curvature-thickness locking): E_tt tied at the in-plane node positions,
+  t = 0 (hex8 the four corners (-+1, -+1, 0), bilinear; hex18 the nine quad9 nodes, biquadratic).
+- EAS (Poisson thickness locking, in-plane bending): enhanced natural strain modes M(xi) alpha mapped
+  with the centre Jacobian (Simo-Rifai), alpha condensed per element after a local Newton solve.
+- hex18 only, optional: MITC9-like membrane tying (E_rr like E_rt, E_ss like E_st, E_rs at (-+a, -+a)).
+
+Kernels: :mod:`covcontact.elements.solidshell_kernels`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import get_num_threads, set_parallel_chunksize
+
+from ..assembly.pattern import Pattern, scatter_matrices, scatter_vectors
+from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
+from ..fem.shapes import NNODES, NODES, shape_functions
+from ..materials.hyperelastic import Material
+from .solid import BLOCKS_PER_THREAD, SolidStress
+from .solidshell_kernels import solidshell_chunk, solidshell_fields
+
+SHELL_CELLS = ("hex8", "hex18")
+
+_A = 1.0 / math.sqrt(3.0)
+_B = math.sqrt(0.6)
+
+
+def _p2(x: float) -> float:
+    return 0.5 * (3.0 * x * x - 1.0)
+
+
+#: EAS modes in the order they are switched on by ``eas = n``: (Voigt component of the natural strain
+#: (rr, ss, tt, rs, st, rt) = 0..5, the mode function of (r, s, t)); every mode has zero mean.
+EAS_MODES: dict[str, list[tuple[int, Any]]] = {
+    "hex8": [
+        (2, lambda r, s, t: t), (0, lambda r, s, t: r), (1, lambda r, s, t: s),
+        (3, lambda r, s, t: r), (3, lambda r, s, t: s),
+        (2, lambda r, s, t: r * t), (2, lambda r, s, t: s * t),
+    ],
+    "hex18": [
+        (2, lambda r, s, t: t), (2, lambda r, s, t: r * t), (2, lambda r, s, t: s * t),
+        (2, lambda r, s, t: r * s * t), (2, lambda r, s, t: _p2(r) * t), (2, lambda r, s, t: _p2(s) * t),
+        (2, lambda r, s, t: _p2(r) * s * t), (2, lambda r, s, t: r * _p2(s) * t),
+        (2, lambda r, s, t: _p2(r) * _p2(s) * t),
+    ],
+}
+
+#: default options per cell type (see docs/verification.md "Shells" for the benchmarks behind them)
+DEFAULTS: dict[str, dict[str, Any]] = {
+    "hex8": {"eas": 7, "ans_shear": True, "ans_thickness": True, "ans_membrane": False},
+    "hex18": {"eas": 1, "ans_shear": True, "ans_thickness": True, "ans_membrane": True},
+}
+OPTION_KEYS = ("eas", "ans_shear", "ans_thickness", "ans_membrane")
+
+
+def normalize_options(cell_type: str, options: dict | None) -> dict:
+    """Validated options with defaults filled in; ValueError with a one-line message otherwise."""
+    if cell_type not in SHELL_CELLS:
+        raise ValueError(f"solid-shell elements need cell type hex8 or hex18, got {cell_type!r}")
+    options = dict(options or {})
+    unknown = sorted(set(options) - set(OPTION_KEYS))
+    if unknown:
+        raise ValueError(f"unknown solid-shell option(s) {', '.join(unknown)}; known: {', '.join(OPTION_KEYS)}")
+    out = dict(DEFAULTS[cell_type])
+    nmax = len(EAS_MODES[cell_type])
+    if "eas" in options:
+        n = options["eas"]
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or not 0 <= n <= nmax:
+            raise ValueError(f"solid-shell option eas must be an integer 0..{nmax} for {cell_type}, got {n!r}")
+        out["eas"] = int(n)
+    for key in OPTION_KEYS[1:]:
+        if key in options:
+            v = options[key]
+            if not isinstance(v, (bool, np.bool_)):
+                raise ValueError(f"solid-shell option {key} must be true or false, got {v!r}")
+            out[key] = bool(v)
+    if cell_type == "hex8" and out["ans_membrane"]:
+        raise ValueError("solid-shell option ans_membrane applies to hex18 only")
+    return out
+
+
+def mesh_problem(cell_type: str, X: np.ndarray, cells: np.ndarray) -> str | None:
+    """One-line description of the first badly oriented element, or None.
+
+    Checks det J0 > 0 at the centre, the Gauss points and the corners of every element, and that no
+    thickness fibre (bottom node a -> top node a + nen/2) runs opposite to a neighbour's.
+    """
+    cells = np.asarray(cells, dtype=np.int64)
+    if cells.shape[0] == 0:
+        return None
+    corners = NODES["hex8"]
+    pts = np.vstack([np.zeros((1, 3)), gauss_tensor(DEFAULT_RULE[cell_type])[0], corners])
+    dN = shape_functions(cell_type, pts)[1]
+    J = np.einsum("eai,paj->epij", X[cells], dN)
+    det = np.linalg.det(J).min(axis=1)
+    scale = np.abs(np.linalg.det(J[:, 0])) + 1e-300
+    bad = np.flatnonzero(~(det > 1e-12 * scale))
+    if bad.size:
+        return f"solid-shell element {int(bad[0])} has det J <= 0 (inverted or degenerate cell, check node order)"
+    half = cells.shape[1] // 2
+    n = int(X.shape[0])
+    keys = (cells[:, :half] * n + cells[:, half:]).ravel()
+    rev = (cells[:, half:] * n + cells[:, :half]).ravel()
+    clash = np.isin(rev, keys)
+    if clash.any():
+        e = int(np.flatnonzero(clash)[0] // half)
+        return (f"solid-shell element {e} has its thickness direction opposite to a neighbour "
+                f"(bottom nodes 0..{half - 1}, top nodes {half}..{2 * half - 1} must agree)")
+    return None
+
+
+def check_options(mesh, options: dict | None) -> dict:
+    """Validate solid-shell ``options`` and the mesh orientation; return the normalised options."""
+    out = normalize_options(mesh.cell_type, options)
+    msg = mesh_problem(mesh.cell_type, mesh.points, mesh.cells)
+    if msg is not None:
+        raise ValueError(msg)
+    return out
+
+
+class _Points:
+    """Evaluation points with de-duplication."""
+
+    def __init__(self, first: np.ndarray) -> None:
+        self.pts: list[tuple[float, float, float]] = []
+        self.index: dict[tuple[float, float, float], int] = {}
+        for p in first:
+            self.add(p, unique=False)
+
+    def add(self, p, unique: bool = True) -> int:
+        key = tuple(round(float(x), 12) for x in p)
+        if unique and key in self.index:
+            return self.index[key]
+        self.index.setdefault(key, len(self.pts))
+        self.pts.append((float(p[0]), float(p[1]), float(p[2])))
+        return len(self.pts) - 1
+
+
+def _lagrange(nodes: tuple[float, ...], x: float) -> list[float]:
+    out = []
+    for k, xk in enumerate(nodes):
+        v = 1.0
+        for m, xm in enumerate(nodes):
+            if m != k:
+                v *= (x - xm) / (xk - xm)
+        out.append(v)
+    return out
+
+
+def tying_tables(cell_type: str, ans_shear: bool, ans_thickness: bool, ans_membrane: bool):
+    """Gauss rule and ANS interpolation of one cell type.
+
+    Returns points (npt, 3) (the ng Gauss points first), weights (ng,), and the CSR tying table
+    tie_ptr (6 ng + 1,), tie_pt, tie_w: component I of the natural strain at Gauss point g is
+    sum_q tie_w[q] E_I(points[tie_pt[q]]) over q in tie_ptr[6 g + I] .. tie_ptr[6 g + I + 1].
+    """
+    gp, w = gauss_tensor(DEFAULT_RULE[cell_type])
+    P = _Points(gp)
+    rows: list[list[tuple[int, float]]] = []
+    for g, (r, s, t) in enumerate(gp):
+        comp: list[list[tuple[int, float]]] = [[(g, 1.0)] for _ in range(6)]
+        if cell_type == "hex8":
+            if ans_shear:
+                comp[5] = [(P.add((0.0, -1.0, t)), 0.5 * (1 - s)), (P.add((0.0, 1.0, t)), 0.5 * (1 + s))]
+                comp[4] = [(P.add((-1.0, 0.0, t)), 0.5 * (1 - r)), (P.add((1.0, 0.0, t)), 0.5 * (1 + r))]
+            if ans_thickness:
+                lr, ls = _lagrange((-1.0, 1.0), r), _lagrange((-1.0, 1.0), s)
+                comp[2] = [(P.add((x, y, 0.0)), lr[i] * ls[j])
+                           for j, y in enumerate((-1.0, 1.0)) for i, x in enumerate((-1.0, 1.0))]
+        else:
+            lin, quad = (-_A, _A), (-_B, 0.0, _B)
+            la_r, la_s = _lagrange(lin, r), _lagrange(lin, s)
+            lq_r, lq_s = _lagrange(quad, r), _lagrange(quad, s)
+            rows_r = [(P.add((x, y, t)), la_r[i] * lq_s[j]) for j, y in enumerate(quad) for i, x in enumerate(lin)]
+            rows_s = [(P.add((x, y, t)), lq_r[i] * la_s[j]) for j, y in enumerate(lin) for i, x in enumerate(quad)]
+            if ans_shear:
+                comp[5] = rows_r
+                comp[4] = rows_s
+            if ans_membrane:
+                comp[0] = rows_r
+                comp[1] = rows_s
+                comp[3] = [(P.add((x, y, t)), la_r[i] * la_s[j]) for j, y in enumerate(lin) for i, x in enumerate(lin)]
+            if ans_thickness:
+                nodes = (-1.0, 0.0, 1.0)
+                l3r, l3s = _lagrange(nodes, r), _lagrange(nodes, s)
+                comp[2] = [(P.add((x, y, 0.0)), l3r[i] * l3s[j]) for j, y in enumerate(nodes) for i, x in enumerate(nodes)]
+        rows.extend(comp)
+    tie_ptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    tie_ptr[1:] = np.cumsum([len(c) for c in rows])
+    tie_pt = np.array([p for c in rows for p, _ in c], dtype=np.int64)
+    tie_w = np.array([v for c in rows for _, v in c], dtype=np.float64)
+    return np.array(P.pts), w, tie_ptr, tie_pt, tie_w
+
+
+def eas_tables(cell_type: str, neas: int, gauss_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Natural component (neas,) and values (ng, neas) of the first ``neas`` EAS modes."""
+    modes = EAS_MODES[cell_type][:neas]
+    comp = np.array([c for c, _ in modes], dtype=np.int64)
+    val = np.array([[f(*p) for _, f in modes] for p in gauss_points], dtype=np.float64).reshape(-1, neas)
+    return comp, np.ascontiguousarray(val)
+
+
+class SolidShellBody:
+    """A solid-shell body (hex8 or hex18), the :class:`SolidBody` interface plus EAS history.
+
+    Args:
+        cell_type: "hex8" (quad4 faces) or "hex18" (quad9 faces).
+        X: (nnode, 3) reference coordinates.
+        cells: (nelem, nen) connectivity, thickness = third natural direction.
+        material: a :mod:`covcontact.materials` material.
+        **options: eas (number of EAS modes), ans_shear, ans_thickness, ans_membrane (hex18); see
+            :func:`normalize_options` and :data:`DEFAULTS`.
+    """
+
+    def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
+                 chunk_bytes: int = 32 * 2**20, **options: Any) -> None:
+        self.options = normalize_options(cell_type, options)
+        self.cell_type = cell_type
+        self.X = np.ascontiguousarray(X, dtype=np.float64)
+        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
+        nen = NNODES[cell_type]
+        if self.X.ndim != 2 or self.X.shape[1] != 3:
+            raise ValueError(f"X must have shape (nnode, 3), got {self.X.shape}")
+        if self.cells.ndim != 2 or self.cells.shape[1] != nen:
+            raise ValueError(f"{cell_type} cells must have shape (nelem, {nen}), got {self.cells.shape}")
+        if self.cells.size and (self.cells.min() < 0 or self.cells.max() >= self.X.shape[0]):
+            raise ValueError(f"cells refer to nodes outside [0, {self.X.shape[0]})")
+        msg = mesh_problem(cell_type, self.X, self.cells)
+        if msg is not None:
+            raise ValueError(msg)
+        self.material = material
+        o = self.options
+        pts, self.weights, self.tie_ptr, self.tie_pt, self.tie_w = tying_tables(
+            cell_type, o["ans_shear"], o["ans_thickness"], o["ans_membrane"])
+        self.points = pts
+        self.dNp = np.ascontiguousarray(shape_functions(cell_type, pts)[1])
+        self.dNc = np.ascontiguousarray(shape_functions(cell_type, np.zeros((1, 3)))[1][0])
+        self.neas = o["eas"]
+        self.eas_comp, self.eas_val = eas_tables(cell_type, self.neas, pts[: self.weights.size])
+        self.alpha = np.zeros((self.n_elements, self.neas))
+        self._alpha_saved = self.alpha.copy()
+        self._alpha_committed = self.alpha.copy()
+        nd = 3 * nen
+        self.chunk = int(max(1, min(self.n_elements, chunk_bytes // (8 * nd * nd))))
+        self._Ke = np.empty((0, nd, nd))
+        self._fe = np.empty((0, nd))
+        self._flags = np.empty(0, dtype=np.int64)
+        self._ranks_key: tuple[Pattern, int] | None = None
+        self._ranks = np.empty((0, nen, nen), dtype=np.int32)
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.X.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.cells.shape[0])
+
+    @property
+    def nen(self) -> int:
+        return int(self.cells.shape[1])
+
+    def _u(self, u: np.ndarray) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        return u if u.shape == self.X.shape else u.reshape(self.X.shape)
+
+    def _tables(self) -> tuple:
+        return (self.dNp, self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp,
+                self.eas_val)
+
+    def _fields(self, u: np.ndarray, mode: int, ncol: int) -> np.ndarray:
+        out = np.empty((self.n_elements, ncol))
+        if self.n_elements:
+            solidshell_fields(self.material.kind, self.material.params, self.X, self._u(u), self.cells,
+                              self.alpha, *self._tables(), mode, out, get_num_threads())
+        return out
+
+    # -- history --------------------------------------------------------------------------------
+    def save_state(self) -> None:
+        """Remember the EAS parameters at the start of a load step."""
+        self._alpha_saved = self.alpha.copy()
+
+    def restore_state(self) -> None:
+        """Back to the parameters of :meth:`save_state` (cutback)."""
+        self.alpha[...] = self._alpha_saved
+
+    def commit(self) -> None:
+        """The step converged: its parameters become the committed history."""
+        self._alpha_committed = self.alpha.copy()
+        self._alpha_saved = self.alpha.copy()
+
+    # -- evaluation -----------------------------------------------------------------------------
+    def check_reference(self) -> list[int]:
+        """Elements with det J0 <= 0 at the centre or an evaluation point (the caller raises)."""
+        det = self._fields(np.zeros_like(self.X), 1, 1)[:, 0]
+        return [int(e) for e in np.flatnonzero(~(det > 0.0))]
+
+    def ranks(self, pattern: Pattern, node_offset: int = 0) -> np.ndarray:
+        """Node-pair ranks of this body's cells in ``pattern`` (cached for the last pattern)."""
+        if self._ranks_key is None or self._ranks_key[0] is not pattern or self._ranks_key[1] != node_offset:
+            self._ranks = pattern.ranks(self.cells, node_offset)
+            self._ranks_key = (pattern, int(node_offset))
+        return self._ranks
+
+    def assemble(self, u: np.ndarray, data: np.ndarray, rhs: np.ndarray, pattern: Pattern | None,
+                 node_offset: int = 0, want_K: bool = True) -> int:
+        """Add internal forces to ``rhs`` and (if want_K) condensed element tangents to ``data``.
+
+        The EAS parameters are solved for ``u`` (local Newton from their last values), so the result
+        depends on u only. Returns -1, or the first element with an inadmissible strain, det J0 <= 0
+        or a failed local solve; the outputs then stay finite.
+        """
+        u = self._u(u)
+        nd = 3 * self.nen
+        if rhs.dtype != np.float64 or rhs.ndim != 1 or rhs.size < 3 * (node_offset + self.n_nodes):
+            raise ValueError("rhs must be float64 (ndofs,) covering this body's dofs")
+        if want_K:
+            if pattern is None:
+                raise ValueError("want_K needs the pattern")
+            if data.shape != (pattern.nnz,) or data.dtype != np.float64:
+                raise ValueError(f"data must be float64 of shape ({pattern.nnz},)")
+            ranks = self.ranks(pattern, node_offset)
+            node_ptr = pattern.node_ptr
+        else:
+            ranks = self._ranks
+            node_ptr = np.zeros(1, dtype=np.int64)
+        if self._fe.shape[0] != self.chunk:
+            self._fe = np.empty((self.chunk, nd))
+            self._flags = np.empty(self.chunk, dtype=np.int64)
+        if want_K and self._Ke.shape[0] != self.chunk:
+            self._Ke = np.empty((self.chunk, nd, nd))
+        off = np.int64(node_offset)
+        nblocks = BLOCKS_PER_THREAD * get_num_threads()
+        old = set_parallel_chunksize(1)
+        try:
+            first_bad = -1
+            kind, params = self.material.kind, self.material.params
+            for e0 in range(0, self.n_elements, self.chunk):
+                nc = min(self.chunk, self.n_elements - e0)
+                Ke = self._Ke[:nc] if want_K else self._Ke
+                fe = self._fe[:nc]
+                flags = self._flags[:nc]
+                solidshell_chunk(kind, params, self.X, u, self.cells, e0, self.alpha, *self._tables(), want_K,
+                                 Ke, fe, flags, nblocks)
+                scatter_vectors(rhs, self.cells, off, fe, e0)
+                if want_K:
+                    scatter_matrices(data, node_ptr, self.cells, off, ranks, Ke, e0)
+                if first_bad < 0:
+                    bad = np.flatnonzero(flags)
+                    if bad.size:
+                        first_bad = e0 + int(bad[0])
+        finally:
+            set_parallel_chunksize(old)
+        return first_bad
+
+    def energy(self, u: np.ndarray) -> float:
+        """Strain energy int W(E) dV at the solved EAS parameters (inf if a strain is inadmissible)."""
+        return float(self._fields(u, 0, 1).sum())
+
+    def stress(self, u: np.ndarray) -> SolidStress:
+        """Element averages of Cauchy stress (compatible F), S and the assumed strain; nodal Cauchy."""
+        f = self._fields(u, 2, 18)
+        cauchy = np.ascontiguousarray(f[:, :6])
+        count = np.bincount(self.cells.ravel(), minlength=self.n_nodes).astype(np.float64)
+        nodal = np.empty((self.n_nodes, 6))
+        for I in range(6):
+            nodal[:, I] = np.bincount(self.cells.ravel(), weights=np.repeat(cauchy[:, I], self.nen),
+                                      minlength=self.n_nodes)
+        nodal /= np.maximum(count, 1.0)[:, None]
+        s = cauchy
+        vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)
+                     + 3.0 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
+        return SolidStress(cauchy=cauchy, pk2=np.ascontiguousarray(f[:, 6:12]),
+                           green_lagrange=np.ascontiguousarray(f[:, 12:]), cauchy_nodal=nodal, von_mises=vm)

@@ -1,0 +1,598 @@
+"""Compiled kernels of the solid-shell elements (formulation in :mod:`covcontact.elements.solidshell`).
+
+Per element: the covariant base vectors G_i (reference) and g_i (current) are evaluated at a list of
+points (the Gauss points first, then the ANS tying points); there the compatible covariant strains
+E_ij = 1/2 (g_i . g_j - G_i . G_j) are formed. At Gauss point g every covariant component c is an
+interpolation sum_k w_gck E_c(p_k) over its tying points (just the Gauss point itself for an untied
+component), turned into Cartesian Voigt strain by the local Jacobian, E_cart = T_g E_nat. The enhanced
+strain Gamma_g alpha (EAS, natural modes mapped with the centre Jacobian and scaled by det J_c / det J_g)
+is added, the EAS parameters alpha are solved per element by a local Newton, and the tangent is
+condensed: K = K_uu - K_ua H^-1 K_au.
+
+Voigt order of natural and Cartesian strain: (rr, ss, tt, rs, st, rt) and (11, 22, 33, 12, 23, 13),
+engineering shear (2 E_ij), the order of :mod:`covcontact.materials`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ..materials.hyperelastic import SVK, VOIGT_PAIRS, material_energy, material_response
+from .solid import _jacobian
+
+#: element flags: 0 ok, 1 strain not admissible (det F <= 0 / C not positive definite),
+#: 2 det J0 <= 0, 3 local EAS Newton failed
+FLAG_INVERTED = 1
+FLAG_REFERENCE = 2
+FLAG_EAS = 3
+#: local EAS Newton (Neo-Hooke): relative strain-increment tolerance and iteration limit
+EAS_TOL = 1e-11
+EAS_MAXIT = 30
+
+
+@njit(cache=True, inline="always")
+def _strain_transform(Ji, T):
+    """T (6, 6): Cartesian Voigt strain = T @ covariant Voigt strain (Ji[i, k] = dxi_i / dX_k)."""
+    for K in range(6):
+        k = VOIGT_PAIRS[K, 0]
+        l = VOIGT_PAIRS[K, 1]
+        fK = 1.0 if k == l else 2.0
+        for I in range(6):
+            i = VOIGT_PAIRS[I, 0]
+            j = VOIGT_PAIRS[I, 1]
+            if i == j:
+                c = Ji[i, k] * Ji[i, l]
+            else:
+                c = 0.5 * (Ji[i, k] * Ji[j, l] + Ji[j, k] * Ji[i, l])
+            T[K, I] = fK * c
+
+
+@njit(cache=True, inline="always")
+def _stretch(E, F):
+    """An F with F^T F = C = I + 2 E (upper Cholesky factor); False if C is not positive definite."""
+    c00 = 1.0 + 2.0 * E[0]
+    c11 = 1.0 + 2.0 * E[1]
+    c22 = 1.0 + 2.0 * E[2]
+    if not (c00 > 0.0):
+        return False
+    l00 = math.sqrt(c00)
+    l10 = E[3] / l00
+    l20 = E[5] / l00
+    d = c11 - l10 * l10
+    if not (d > 0.0):
+        return False
+    l11 = math.sqrt(d)
+    l21 = (E[4] - l20 * l10) / l11
+    d = c22 - l20 * l20 - l21 * l21
+    if not (d > 0.0):
+        return False
+    F[0, 0] = l00
+    F[0, 1] = l10
+    F[0, 2] = l20
+    F[1, 0] = 0.0
+    F[1, 1] = l11
+    F[1, 2] = l21
+    F[2, 0] = 0.0
+    F[2, 1] = 0.0
+    F[2, 2] = math.sqrt(d)
+    return True
+
+
+@njit(cache=True, inline="always")
+def _response(kind, params, E, F, S, D):
+    """S and D at Cartesian Green-Lagrange strain E; 1 if E is not admissible (S = 0, D = Hooke)."""
+    if _stretch(E, F):
+        return material_response(kind, params, F, S, D)
+    lam = params[2]
+    mu = params[3]
+    for I in range(6):
+        S[I] = 0.0
+        for K in range(6):
+            D[I, K] = 0.0
+    for I in range(3):
+        for K in range(3):
+            D[I, K] = lam
+        D[I, I] += 2.0 * mu
+        D[I + 3, I + 3] = mu
+    return 1
+
+
+@njit(cache=True, inline="always")
+def _chol(A, n, L):
+    """Lower Cholesky factor L of the leading n x n block of A; False if not positive definite."""
+    for i in range(n):
+        for j in range(i + 1):
+            s = A[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            if i == j:
+                if not (s > 0.0):
+                    return False
+                L[i, i] = math.sqrt(s)
+            else:
+                L[i, j] = s / L[j, j]
+    return True
+
+
+@njit(cache=True, inline="always")
+def _chol_solve(L, n, b):
+    """b <- A^-1 b with A = L L^T (n x n)."""
+    for i in range(n):
+        s = b[i]
+        for k in range(i):
+            s -= L[i, k] * b[k]
+        b[i] = s / L[i, i]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * b[k]
+        b[i] = s / L[i, i]
+
+
+@njit(cache=True)
+def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
+             Gp, gp, Ep, Tg, Ec, Gam, detg, J0, Ji, T0, En):
+    """Geometry and assumed compatible strains of one element; returns 0 or FLAG_REFERENCE."""
+    nen = Xe.shape[0]
+    npt = dNp.shape[0]
+    ng = w.size
+    neas = eas_comp.size
+    detc = _jacobian(Xe, dNc, J0, Ji)
+    if not (detc > 0.0):
+        return FLAG_REFERENCE
+    _strain_transform(Ji, T0)
+    for p in range(npt):
+        for i in range(3):
+            for k in range(3):
+                sG = 0.0
+                su = 0.0
+                for a in range(nen):
+                    d = dNp[p, a, i]
+                    sG += d * Xe[a, k]
+                    su += d * ue[a, k]
+                Gp[p, i, k] = sG
+                gp[p, i, k] = sG + su
+        for I in range(6):
+            i = VOIGT_PAIRS[I, 0]
+            j = VOIGT_PAIRS[I, 1]
+            v = (gp[p, i, 0] * gp[p, j, 0] + gp[p, i, 1] * gp[p, j, 1] + gp[p, i, 2] * gp[p, j, 2]
+                 - Gp[p, i, 0] * Gp[p, j, 0] - Gp[p, i, 1] * Gp[p, j, 1] - Gp[p, i, 2] * Gp[p, j, 2])
+            Ep[p, I] = 0.5 * v if i == j else v
+    for g in range(ng):
+        det = _jacobian(Xe, dNp[g], J0, Ji)
+        if not (det > 0.0):
+            return FLAG_REFERENCE
+        detg[g] = det
+        _strain_transform(Ji, Tg[g])
+        for I in range(6):
+            s = 0.0
+            for q in range(tie_ptr[6 * g + I], tie_ptr[6 * g + I + 1]):
+                s += tie_w[q] * Ep[tie_pt[q], I]
+            En[I] = s
+        for K in range(6):
+            s = 0.0
+            for I in range(6):
+                s += Tg[g, K, I] * En[I]
+            Ec[g, K] = s
+        r = detc / det
+        for m in range(neas):
+            c = eas_comp[m]
+            f = r * eas_val[g, m]
+            for K in range(6):
+                Gam[g, K, m] = f * T0[K, c]
+    return 0
+
+
+@njit(cache=True)
+def _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F):
+    """S, D at every Gauss point for parameters alpha; EAS residual h and matrix H. Returns a flag."""
+    ng = w.size
+    neas = alpha.size
+    flag = 0
+    for m in range(neas):
+        h[m] = 0.0
+        for n in range(neas):
+            H[m, n] = 0.0
+    for g in range(ng):
+        for K in range(6):
+            s = Ec[g, K]
+            for m in range(neas):
+                s += Gam[g, K, m] * alpha[m]
+            Et[g, K] = s
+        if _response(kind, params, Et[g], F, S[g], D[g]) != 0:
+            flag = FLAG_INVERTED
+        wd = w[g] * detg[g]
+        for m in range(neas):
+            s = 0.0
+            for K in range(6):
+                s += Gam[g, K, m] * S[g, K]
+            h[m] += wd * s
+            for n in range(m, neas):
+                s = 0.0
+                for K in range(6):
+                    t = 0.0
+                    for L in range(6):
+                        t += D[g, K, L] * Gam[g, L, n]
+                    s += Gam[g, K, m] * t
+                H[m, n] += wd * s
+    for m in range(neas):
+        for n in range(m):
+            H[m, n] = H[n, m]
+    return flag
+
+
+@njit(cache=True)
+def _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F):
+    """Solve the EAS equations h(alpha) = 0 (alpha in place, from its current value).
+
+    On return S, D hold the response at the solution and H the (unfactored) EAS matrix. SVK: h is
+    linear in alpha, one solve is exact and S is updated linearly. Neo-Hooke: Newton until the
+    strain increment |Gamma dalpha| <= EAS_TOL |E|, then one more evaluation at the solution.
+    """
+    ng = w.size
+    neas = alpha.size
+    for m in range(neas):
+        if not np.isfinite(alpha[m]):
+            for n in range(neas):
+                alpha[n] = 0.0
+            break
+    done = False
+    for it in range(EAS_MAXIT):
+        flag = _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F)
+        if flag != 0 or neas == 0 or done:
+            return flag
+        if not _chol(H, neas, Hf):
+            return FLAG_EAS
+        for m in range(neas):
+            dal[m] = -h[m]
+        _chol_solve(Hf, neas, dal)
+        for m in range(neas):
+            alpha[m] += dal[m]
+        dmax = 0.0
+        emax = 0.0
+        for g in range(ng):
+            for K in range(6):
+                s = 0.0
+                for m in range(neas):
+                    s += Gam[g, K, m] * dal[m]
+                dmax = max(dmax, abs(s))
+                emax = max(emax, abs(Et[g, K] + s))
+                if kind == SVK:
+                    Et[g, K] += s
+            if kind == SVK:
+                for K in range(6):
+                    s = 0.0
+                    for m in range(neas):
+                        t = 0.0
+                        for L in range(6):
+                            t += D[g, K, L] * Gam[g, L, m]
+                        s += t * dal[m]
+                    S[g, K] += s
+        if kind == SVK:
+            return 0
+        if not np.isfinite(dmax):
+            return FLAG_EAS
+        done = dmax <= EAS_TOL * emax
+    return FLAG_EAS
+
+
+@njit(cache=True)
+def _forces(dNp, gp, w, tie_ptr, tie_pt, tie_w, Tg, detg, S, sig, fe, want_K, Ke):
+    """Internal forces fe and the geometric stiffness (added to Ke) from the Gauss-point stresses.
+
+    The weighted covariant stress of every Gauss point is distributed over the tying points of each
+    component: sig[p] (3, 3) is the stress acting on the covariant strain at point p.
+    """
+    npt = dNp.shape[0]
+    nen = dNp.shape[1]
+    ng = w.size
+    for p in range(npt):
+        for i in range(3):
+            for j in range(3):
+                sig[p, i, j] = 0.0
+    for g in range(ng):
+        wd = w[g] * detg[g]
+        for I in range(6):
+            s = 0.0
+            for K in range(6):
+                s += Tg[g, K, I] * S[g, K]
+            s *= wd
+            i = VOIGT_PAIRS[I, 0]
+            j = VOIGT_PAIRS[I, 1]
+            for q in range(tie_ptr[6 * g + I], tie_ptr[6 * g + I + 1]):
+                v = tie_w[q] * s
+                p = tie_pt[q]
+                sig[p, i, j] += v
+                if i != j:
+                    sig[p, j, i] += v
+    for r in range(3 * nen):
+        fe[r] = 0.0
+    for p in range(npt):
+        nz = False
+        for i in range(3):
+            for j in range(3):
+                if sig[p, i, j] != 0.0:
+                    nz = True
+        if not nz:
+            continue
+        for a in range(nen):
+            q0 = dNp[p, a, 0] * sig[p, 0, 0] + dNp[p, a, 1] * sig[p, 1, 0] + dNp[p, a, 2] * sig[p, 2, 0]
+            q1 = dNp[p, a, 0] * sig[p, 0, 1] + dNp[p, a, 1] * sig[p, 1, 1] + dNp[p, a, 2] * sig[p, 2, 1]
+            q2 = dNp[p, a, 0] * sig[p, 0, 2] + dNp[p, a, 1] * sig[p, 1, 2] + dNp[p, a, 2] * sig[p, 2, 2]
+            for k in range(3):
+                fe[3 * a + k] += q0 * gp[p, 0, k] + q1 * gp[p, 1, k] + q2 * gp[p, 2, k]
+            if want_K:
+                for b in range(a, nen):
+                    v = q0 * dNp[p, b, 0] + q1 * dNp[p, b, 1] + q2 * dNp[p, b, 2]
+                    for k in range(3):
+                        Ke[3 * a + k, 3 * b + k] += v
+
+
+@njit(cache=True)
+def _material_tangent(dNp, gp, w, tie_ptr, tie_pt, tie_w, Tg, detg, D, Gam, Bn, Bc, DB, DG, Kua, Ke):
+    """Ke += int Bc^T D Bc (upper triangle) and Kua = int Bc^T D Gamma, Bc = T_g B_nat."""
+    nen = dNp.shape[1]
+    nd = 3 * nen
+    ng = w.size
+    neas = Gam.shape[2]
+    for r in range(nd):
+        for m in range(neas):
+            Kua[r, m] = 0.0
+    for g in range(ng):
+        wd = w[g] * detg[g]
+        for I in range(6):
+            for r in range(nd):
+                Bn[I, r] = 0.0
+            i = VOIGT_PAIRS[I, 0]
+            j = VOIGT_PAIRS[I, 1]
+            for q in range(tie_ptr[6 * g + I], tie_ptr[6 * g + I + 1]):
+                p = tie_pt[q]
+                wt = tie_w[q]
+                for a in range(nen):
+                    di = wt * dNp[p, a, i]
+                    if i == j:
+                        for k in range(3):
+                            Bn[I, 3 * a + k] += di * gp[p, i, k]
+                    else:
+                        dj = wt * dNp[p, a, j]
+                        for k in range(3):
+                            Bn[I, 3 * a + k] += di * gp[p, j, k] + dj * gp[p, i, k]
+        for K in range(6):
+            for r in range(nd):
+                s = 0.0
+                for I in range(6):
+                    s += Tg[g, K, I] * Bn[I, r]
+                Bc[K, r] = s
+        for K in range(6):
+            for r in range(nd):
+                s = 0.0
+                for L in range(6):
+                    s += D[g, K, L] * Bc[L, r]
+                DB[K, r] = wd * s
+            for m in range(neas):
+                s = 0.0
+                for L in range(6):
+                    s += D[g, K, L] * Gam[g, L, m]
+                DG[K, m] = wd * s
+        for r in range(nd):
+            for c in range(r, nd):
+                s = 0.0
+                for K in range(6):
+                    s += Bc[K, r] * DB[K, c]
+                Ke[r, c] += s
+            for m in range(neas):
+                s = 0.0
+                for K in range(6):
+                    s += Bc[K, r] * DG[K, m]
+                Kua[r, m] += s
+
+
+@njit(cache=True)
+def _condense(Ke, Kua, Hf, neas, x):
+    """Ke -= Kua H^-1 Kua^T (upper triangle), H = Hf Hf^T."""
+    nd = Ke.shape[0]
+    if neas == 0:
+        return
+    for r in range(nd):
+        for m in range(neas):
+            x[m] = Kua[r, m]
+        _chol_solve(Hf, neas, x)
+        for c in range(r, nd):
+            s = 0.0
+            for m in range(neas):
+                s += Kua[c, m] * x[m]
+            Ke[r, c] -= s
+
+
+@njit(cache=True)
+def _element(kind, params, Xe, ue, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
+             want_K, Ke, fe, ws3, ws4, ws2, wsg, wv):
+    """Internal force fe and condensed tangent Ke of one element; alpha updated in place.
+
+    Scratch: ws3 = (Gp, gp, sig) (npt, 3, 3) each; ws4 = (Tg, D) (ng, 6, 6); ws2 = (Ep, S, Et, Ec);
+    wsg = (Gam, detg); wv = small vectors/matrices. Returns a flag (0 ok).
+    """
+    Gp, gp, sig = ws3
+    Tg, D = ws4
+    Ep, S, Et, Ec = ws2
+    Gam, detg = wsg
+    J0, Ji, T0, F, En, h, H, Hf, dal, a0, x, Bn, Bc, DB, DG, Kua = wv
+    nd = fe.size
+    neas = alpha.size
+    for m in range(neas):
+        a0[m] = alpha[m]
+    flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec, Gam,
+                    detg, J0, Ji, T0, En)
+    if flag == 0:
+        flag = _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F)
+    if flag != 0:
+        for m in range(neas):
+            alpha[m] = a0[m] if np.isfinite(a0[m]) else 0.0
+        for r in range(nd):
+            fe[r] = 0.0
+        if want_K:
+            for r in range(nd):
+                for c in range(nd):
+                    Ke[r, c] = 0.0
+        if flag == FLAG_REFERENCE:
+            return flag
+        # keep finite outputs at the admissible part (S = 0 where E is not admissible)
+        if flag == FLAG_EAS:
+            return flag
+    if want_K:
+        for r in range(nd):
+            for c in range(nd):
+                Ke[r, c] = 0.0
+    _forces(dNp, gp, w, tie_ptr, tie_pt, tie_w, Tg, detg, S, sig, fe, want_K, Ke)
+    if want_K:
+        _material_tangent(dNp, gp, w, tie_ptr, tie_pt, tie_w, Tg, detg, D, Gam, Bn, Bc, DB, DG, Kua, Ke)
+        if neas > 0 and flag == 0:
+            if _chol(H, neas, Hf):
+                _condense(Ke, Kua, Hf, neas, x)
+            else:
+                flag = FLAG_EAS
+        for r in range(nd):
+            for c in range(r + 1, nd):
+                Ke[c, r] = Ke[r, c]
+    return flag
+
+
+@njit(cache=True)
+def _scratch(nen, npt, ng, neas):
+    nd = 3 * nen
+    ne = max(neas, 1)
+    ws3 = (np.empty((npt, 3, 3)), np.empty((npt, 3, 3)), np.empty((npt, 3, 3)))
+    ws4 = (np.empty((ng, 6, 6)), np.empty((ng, 6, 6)))
+    ws2 = (np.empty((npt, 6)), np.empty((ng, 6)), np.empty((ng, 6)), np.empty((ng, 6)))
+    wsg = (np.empty((ng, 6, ne)), np.empty(ng))
+    wv = (np.empty((3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((3, 3)), np.empty(6), np.empty(ne),
+          np.empty((ne, ne)), np.empty((ne, ne)), np.empty(ne), np.empty(ne), np.empty(ne), np.empty((6, nd)),
+          np.empty((6, nd)), np.empty((6, nd)), np.empty((6, ne)), np.empty((nd, ne)))
+    return ws3, ws4, ws2, wsg, wv
+
+
+@njit(parallel=True, cache=True)
+def solidshell_chunk(kind, params, X, u, conn, e0, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
+                     eas_val, want_K, Ke, fe, flags, nblocks):
+    """Element buffers Ke (nc, nd, nd), fe (nc, nd), flags (nc,) of elements e0 .. e0 + nc - 1.
+
+    alpha (nelem, neas) holds the EAS parameters: read as the start of the local Newton, overwritten
+    with the solution.
+    """
+    nc = fe.shape[0]
+    nen = conn.shape[1]
+    npt = dNp.shape[0]
+    ng = w.size
+    neas = eas_comp.size
+    nblk = max(1, min(nblocks, nc))
+    for t in prange(nblk):
+        lo = t * nc // nblk
+        hi = (t + 1) * nc // nblk
+        Xe = np.empty((nen, 3))
+        ue = np.empty((nen, 3))
+        ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
+        Kdummy = np.empty((0, 0))
+        for c in range(lo, hi):
+            e = e0 + c
+            for a in range(nen):
+                n = conn[e, a]
+                for i in range(3):
+                    Xe[a, i] = X[n, i]
+                    ue[a, i] = u[n, i]
+            Kc = Ke[c] if want_K else Kdummy
+            flags[c] = _element(kind, params, Xe, ue, alpha[e], dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
+                                eas_val, want_K, Kc, fe[c], ws3, ws4, ws2, wsg, wv)
+
+
+@njit(parallel=True, cache=True)
+def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
+                      mode, out, nthreads):
+    """Per-element quantities at the solved EAS parameters.
+
+    mode 0: out (ne, 1) strain energy int W(E) dV (inf if E is not admissible); mode 1: out (ne, 1)
+    minimum det J0 over the centre and all evaluation points; mode 2: out (ne, 18) volume averages of
+    Cauchy stress (pushed forward with the compatible F), S and the assumed strain E (Voigt).
+    """
+    ne = conn.shape[0]
+    nen = conn.shape[1]
+    npt = dNp.shape[0]
+    ng = w.size
+    neas = eas_comp.size
+    nblk = max(1, min(nthreads, ne))
+    for t in prange(nblk):
+        lo = t * ne // nblk
+        hi = (t + 1) * ne // nblk
+        Xe = np.empty((nen, 3))
+        ue = np.empty((nen, 3))
+        Gx = np.empty((nen, 3))
+        Fc = np.empty((3, 3))
+        ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
+        Gp, gp, sig = ws3
+        Tg, D = ws4
+        Ep, S, Et, Ec = ws2
+        Gam, detg = wsg
+        J0, Ji, T0, F, En, h, H, Hf, dal, a0, x, Bn, Bc, DB, DG, Kua = wv
+        for e in range(lo, hi):
+            for a in range(nen):
+                n = conn[e, a]
+                for i in range(3):
+                    Xe[a, i] = X[n, i]
+                    ue[a, i] = u[n, i]
+            for r in range(out.shape[1]):
+                out[e, r] = 0.0
+            if mode == 1:
+                dmin = _jacobian(Xe, dNc, J0, Ji)
+                for p in range(npt):
+                    dmin = min(dmin, _jacobian(Xe, dNp[p], J0, Ji))
+                out[e, 0] = dmin
+                continue
+            flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
+                            Gam, detg, J0, Ji, T0, En)
+            if flag == 0:
+                flag = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F)
+            if flag != 0:
+                if mode == 0:
+                    out[e, 0] = np.inf
+                continue
+            vol = 0.0
+            for g in range(ng):
+                wd = w[g] * detg[g]
+                vol += wd
+                if mode == 0:
+                    if _stretch(Et[g], F):
+                        out[e, 0] += wd * material_energy(kind, params, F)
+                    else:
+                        out[e, 0] = np.inf
+                    continue
+                # compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
+                _jacobian(Xe, dNp[g], J0, Ji)
+                for a in range(nen):
+                    for j in range(3):
+                        Gx[a, j] = dNp[g, a, 0] * Ji[0, j] + dNp[g, a, 1] * Ji[1, j] + dNp[g, a, 2] * Ji[2, j]
+                for i in range(3):
+                    for j in range(3):
+                        s = 1.0 if i == j else 0.0
+                        for a in range(nen):
+                            s += ue[a, i] * Gx[a, j]
+                        Fc[i, j] = s
+                J = (Fc[0, 0] * (Fc[1, 1] * Fc[2, 2] - Fc[1, 2] * Fc[2, 1])
+                     - Fc[0, 1] * (Fc[1, 0] * Fc[2, 2] - Fc[1, 2] * Fc[2, 0])
+                     + Fc[0, 2] * (Fc[1, 0] * Fc[2, 1] - Fc[1, 1] * Fc[2, 0]))
+                rJ = wd / J if J > 0.0 else 0.0
+                for I in range(6):
+                    i = VOIGT_PAIRS[I, 0]
+                    j = VOIGT_PAIRS[I, 1]
+                    s = 0.0
+                    for k in range(3):
+                        for m in range(3):
+                            K = k if k == m else (3 if k + m == 1 else (4 if k + m == 3 else 5))
+                            s += Fc[i, k] * S[g, K] * Fc[j, m]
+                    out[e, I] += rJ * s
+                    out[e, 6 + I] += wd * S[g, I]
+                    out[e, 12 + I] += wd * (Et[g, I] if I < 3 else 0.5 * Et[g, I])
+            if mode == 2 and vol > 0.0:
+                for r in range(18):
+                    out[e, r] /= vol
