@@ -143,6 +143,12 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
     summary["timing"] = {k: round(v, 4) for k, v in timing.items()}
     summary["wall_time_s"] = timing["total"]
     writer.write_summary(summary)
+    if problem.output.pictures and problem.output.vtu:
+        from ..io.pictures import render_pictures
+
+        for path in render_pictures(out):
+            if not quiet:
+                print(f"picture {path}", file=sys.stderr, flush=True)
     if not quiet:
         split = "  ".join(f"{k} {v:.2f}s" for k, v in summary["timing"].items())
         print(f"time: {split}", file=sys.stderr, flush=True)
