@@ -49,7 +49,8 @@ def test_block_on_plane_uniform_pressure(block_on_plane):
     assert last["min_gap"] == pytest.approx(-np.mean(p) / 1e7, rel=1e-6)
 
 
-@pytest.mark.parametrize("name", ["block_on_sphere", "block_on_cylinder", "two_blocks", "ball_into_plate"])
+@pytest.mark.parametrize("name", ["block_on_sphere", "block_on_cylinder", "two_blocks", "ball_into_plate",
+                                  "block_on_rigid_mesh"])
 def test_quadratic_convergence(tmp_path, name):
     """The exact tangent converges quadratically in every step; case a nearly so (it drops O(g^2) terms);
     case d (main part only) converges linearly. Measured (C = r_(k+1) / r_k^2): exact max 1.2 .. 64,
@@ -69,7 +70,7 @@ def test_quadratic_convergence(tmp_path, name):
     assert runs["d"]["total_iterations"] > runs["exact"]["total_iterations"]
 
 
-@pytest.mark.parametrize("name", ["block_on_sphere", "two_blocks", "ball_into_plate"])
+@pytest.mark.parametrize("name", ["block_on_sphere", "two_blocks", "ball_into_plate", "block_on_rigid_mesh"])
 def test_assembled_tangent_matches_finite_differences(name):
     prob = load_problem(EXAMPLES / f"{name}.toml")
     exact = check_tangent(prob, step=2, tangent="exact", columns=40)
@@ -109,3 +110,22 @@ def test_deformable_pair_force_balance(tmp_path):
     assert top == pytest.approx(-base, rel=1e-8)
     # the force on the slave nodes balances the punch's reaction
     assert last["contact_force"][2] == pytest.approx(-top, rel=1e-8)
+
+
+def test_two_pass(tmp_path):
+    """Two-pass: each surface is slave and master in turn; both passes carry load and balance."""
+    prob = load_problem(EXAMPLES / "two_blocks.toml")
+    prob.contacts[0].two_pass = True
+    res = prob.run(out=tmp_path, tangent="exact")
+    assert res.exit_code == 0
+    last = res.summary["steps"][-1]
+    pairs = last["pairs"]
+    assert set(pairs) == {"contact1", "contact1/reverse"}
+    assert all(p["active_contacts"] > 0 for p in pairs.values())
+    # the forces of the two passes share the load: their sum balances the punch reaction
+    top = last["reactions"]["punch.zmax"][2]
+    f_slave = pairs["contact1"]["contact_force"][2]
+    f_reverse = pairs["contact1/reverse"]["contact_force"][2]
+    assert f_slave - f_reverse == pytest.approx(-top, rel=1e-8)
+    for s in res.summary["steps"]:
+        assert s["iterations"] <= 6

@@ -83,13 +83,18 @@ def _stretch(E, F):
 
 @njit(cache=True, inline="always")
 def _response(kind, params, E, F, S, D):
-    """S and D at Cartesian Green-Lagrange strain E; 1 if E is not admissible (S = 0, D = Hooke)."""
-    if _stretch(E, F):
+    """S and D at Cartesian Green-Lagrange strain E; 1 if E is not admissible (S = 0, D = Hooke).
+
+    St. Venant-Kirchhoff is evaluated from E directly (S = lambda tr E I + 2 mu E, the law of
+    material_response without forming C = I + 2 E, whose round-off would dominate the small strains
+    of thin shells); other materials through material_response at an F with F^T F = C.
+    """
+    ok = _stretch(E, F)
+    if ok and kind != SVK:
         return material_response(kind, params, F, S, D)
     lam = params[2]
     mu = params[3]
     for I in range(6):
-        S[I] = 0.0
         for K in range(6):
             D[I, K] = 0.0
     for I in range(3):
@@ -97,7 +102,15 @@ def _response(kind, params, E, F, S, D):
             D[I, K] = lam
         D[I, I] += 2.0 * mu
         D[I + 3, I + 3] = mu
-    return 1
+    if not ok:
+        for I in range(6):
+            S[I] = 0.0
+        return 1
+    tr = E[0] + E[1] + E[2]
+    for I in range(3):
+        S[I] = lam * tr + 2.0 * mu * E[I]
+        S[I + 3] = mu * E[I + 3]
+    return 0
 
 
 @njit(cache=True, inline="always")
@@ -134,7 +147,7 @@ def _chol_solve(L, n, b):
 
 @njit(cache=True)
 def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
-             Gp, gp, Ep, Tg, Ec, Gam, detg, J0, Ji, T0, En):
+             Gp, gp, Ep, Tg, Ec, Gam, detg, J0, Ji, T0, En, dU):
     """Geometry and assumed compatible strains of one element; returns 0 or FLAG_REFERENCE."""
     nen = Xe.shape[0]
     npt = dNp.shape[0]
@@ -155,11 +168,14 @@ def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
                     su += d * ue[a, k]
                 Gp[p, i, k] = sG
                 gp[p, i, k] = sG + su
+                dU[i, k] = su
+        # E_ij = 1/2 (G_i . u_j + G_j . u_i + u_i . u_j), u_i = d u / d xi_i (no cancellation)
         for I in range(6):
             i = VOIGT_PAIRS[I, 0]
             j = VOIGT_PAIRS[I, 1]
-            v = (gp[p, i, 0] * gp[p, j, 0] + gp[p, i, 1] * gp[p, j, 1] + gp[p, i, 2] * gp[p, j, 2]
-                 - Gp[p, i, 0] * Gp[p, j, 0] - Gp[p, i, 1] * Gp[p, j, 1] - Gp[p, i, 2] * Gp[p, j, 2])
+            v = 0.0
+            for k in range(3):
+                v += Gp[p, i, k] * dU[j, k] + Gp[p, j, k] * dU[i, k] + dU[i, k] * dU[j, k]
             Ep[p, I] = 0.5 * v if i == j else v
     for g in range(ng):
         det = _jacobian(Xe, dNp[g], J0, Ji)
@@ -425,7 +441,7 @@ def _element(kind, params, Xe, ue, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, e
     for m in range(neas):
         a0[m] = alpha[m]
     flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec, Gam,
-                    detg, J0, Ji, T0, En)
+                    detg, J0, Ji, T0, En, F)
     if flag == 0:
         flag = _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F)
     if flag != 0:
@@ -550,7 +566,7 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
                 out[e, 0] = dmin
                 continue
             flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
-                            Gam, detg, J0, Ji, T0, En)
+                            Gam, detg, J0, Ji, T0, En, F)
             if flag == 0:
                 flag = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F)
             if flag != 0:
