@@ -7,6 +7,7 @@ contributes to the residual and tangent only through the deformable dofs of its 
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -91,6 +92,7 @@ class ContactManager:
                 self.passes.append(self._make_pass(pair.name + "/reverse", rev_slave, rev_master, pair))
         self.lam = 0.0
         self._x_rigid_lam = self.X_rigid.copy()
+        self.timing = {"search": 0.0, "projection": 0.0}
 
     # -- set-up ---------------------------------------------------------------------------------
     def _mesh_of(self, body: str):
@@ -149,15 +151,19 @@ class ContactManager:
             float(np.abs(xe - p.x_search).max())
         if p.cand is not None and moved < 0.25 * p.margin:
             return
+        t0 = time.perf_counter()
         sizes = facet_sizes(xe, p.surface.faces)
         p.margin = float(sizes.max()) if len(sizes) else 0.0
         p.cand = candidates(xe, p.surface, xe[p.slaves], p.margin)
         p.x_search = xe.copy()
+        self.timing["search"] += time.perf_counter() - t0
 
     def _pair_arrays(self, p: Pass, xe: np.ndarray):
         """Project the slaves; returns the projection result and the active mask."""
         self._search(p, xe)
+        t0 = time.perf_counter()
         res = project_slaves(xe, p.surface, xe[p.slaves], p.cand[0], p.cand[1], p.prev_facet, p.prev_xi)
+        self.timing["projection"] += time.perf_counter() - t0
         ok = res.kind != 0
         p.prev_facet = np.where(ok, res.facet, -1)
         p.prev_xi = np.where(ok[:, None], res.xi, 0.0)

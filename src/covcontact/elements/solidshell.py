@@ -209,7 +209,8 @@ def eas_tables(cell_type: str, neas: int, gauss_points: np.ndarray) -> tuple[np.
     """Natural component (neas,) and values (ng, neas) of the first ``neas`` EAS modes."""
     modes = EAS_MODES[cell_type][:neas]
     comp = np.array([c for c, _ in modes], dtype=np.int64)
-    val = np.array([[f(*p) for _, f in modes] for p in gauss_points], dtype=np.float64).reshape(-1, neas)
+    val = np.array([[f(*p) for _, f in modes] for p in gauss_points], dtype=np.float64)
+    val = val.reshape(len(gauss_points), neas)
     return comp, np.ascontiguousarray(val)
 
 

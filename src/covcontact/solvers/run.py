@@ -138,6 +138,11 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
         writer.write_summary(summary)
     summary["converged"] = ok
     timing = dict(newton.timing)
+    split = getattr(model.contact, "timing", None)
+    if split:
+        timing["contact_search"] = split["search"]
+        timing["contact_projection"] = split["projection"]
+        timing["contact_assembly"] = max(timing["contact"] - split["search"] - split["projection"], 0.0)
     timing["output"] = t_out
     timing["total"] = time.perf_counter() - t_start
     summary["timing"] = {k: round(v, 4) for k, v in timing.items()}

@@ -1,0 +1,178 @@
+"""Pictures of a result folder: the initial and the final state, like the figures of a paper.
+
+``render_pictures(out)`` reads ``step_0000.vtu`` and the last ``step_NNNN.vtu`` of a result folder and writes
+``initial.png`` and ``final.png``: the deformable bodies coloured by the displacement magnitude, the rigid
+bodies in translucent grey, drawn at the current position (points + displacement) with equal axis scaling
+and a colour bar. Only matplotlib (off-screen, Agg) and meshio are needed.
+
+Rigid bodies are recognised by their cells: the result files give them no stress (NaN), and they carry the
+largest ``body_id`` values.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+# the six faces of a linear hexahedron (VTK order), each ordered outward
+_HEX_FACES = np.array([
+    [0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7],
+])
+_LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
+_STRESS_KEYS = ("von_mises", "cauchy", "pk2", "green_lagrange")
+
+
+def _step_files(out: Path) -> list[Path]:
+    files = [p for p in out.glob("step_*.vtu") if re.fullmatch(r"step_\d+\.vtu", p.name)]
+    return sorted(files, key=lambda p: int(p.stem.split("_")[1]))
+
+
+def _load_factor(out: Path, name: str) -> float | None:
+    """Load factor of a step file from result.pvd (None if unknown)."""
+    try:
+        text = (out / "result.pvd").read_text()
+    except OSError:
+        return None
+    m = re.search(r'timestep="([^"]+)"[^>]*file="' + re.escape(name) + '"', text)
+    return float(m.group(1)) if m else None
+
+
+def _rigid_mask(mesh, block: int, n: int) -> np.ndarray:
+    """True for the cells of cell block ``block`` that belong to rigid bodies."""
+    for key in _STRESS_KEYS:
+        if key in mesh.cell_data:
+            arr = np.asarray(mesh.cell_data[key][block], dtype=float).reshape(n, -1)
+            return np.all(np.isnan(arr), axis=1)
+    if "body_id" in mesh.cell_data:
+        ids = np.concatenate([np.asarray(b, dtype=float).ravel() for b in mesh.cell_data["body_id"]])
+        bid = np.asarray(mesh.cell_data["body_id"][block], dtype=float).ravel()
+        return bid == ids.max() if len(np.unique(ids)) > 1 else np.zeros(n, dtype=bool)
+    return np.zeros(n, dtype=bool)
+
+
+def _boundary_quads(hexes: np.ndarray) -> np.ndarray:
+    """Faces of linear hexahedra that belong to one cell only."""
+    if len(hexes) == 0:
+        return np.zeros((0, 4), dtype=np.int64)
+    faces = hexes[:, _HEX_FACES].reshape(-1, 4)
+    key = np.sort(faces, axis=1)
+    _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    return faces[count[inv.ravel()] == 1]
+
+
+def surface_quads(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """(quads (m, 4), rigid (m,) bool) of the drawable surface of a meshio mesh of covcontact results."""
+    quads, rigid = [], []
+    for b, block in enumerate(mesh.cells):
+        conn = np.asarray(block.data, dtype=np.int64)
+        mask = _rigid_mask(mesh, b, len(conn))
+        if block.type.startswith("hexahedron"):
+            for flag in (False, True):
+                q = _boundary_quads(conn[mask == flag, :8])
+                quads.append(q)
+                rigid.append(np.full(len(q), flag))
+        elif block.type.startswith("quad"):
+            quads.append(conn[:, :4])
+            rigid.append(mask)
+    if not quads:
+        return np.zeros((0, 4), dtype=np.int64), np.zeros(0, dtype=bool)
+    return np.vstack(quads), np.concatenate(rigid)
+
+
+def _state(path: Path):
+    import meshio
+
+    mesh = meshio.read(path)
+    x = np.asarray(mesh.points, dtype=float)
+    disp = np.asarray(mesh.point_data.get("displacement", np.zeros_like(x)), dtype=float)
+    disp = np.nan_to_num(disp)
+    quads, rigid = surface_quads(mesh)
+    return x + disp, np.linalg.norm(disp, axis=1), quads, rigid
+
+
+def _shade(polys: np.ndarray) -> np.ndarray:
+    n = np.cross(polys[:, 2] - polys[:, 0], polys[:, 3] - polys[:, 1])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    return 0.55 + 0.45 * np.abs(n @ _LIGHT)
+
+
+def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title: str,
+          view: tuple[float, float]) -> None:
+    import matplotlib
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import MaxNLocator
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    x, mag, quads, rigid = state
+    polys = x[quads]
+    cmap = matplotlib.colormaps["viridis"]
+    norm = matplotlib.colors.Normalize(0.0, vmax)
+    colors = np.empty((len(quads), 4))
+    colors[~rigid] = cmap(norm(mag[quads[~rigid]].mean(axis=1)))
+    colors[rigid] = (0.72, 0.72, 0.75, 0.55)
+    colors[:, :3] *= _shade(polys)[:, None]
+    edge = np.where(rigid[:, None], (0.35, 0.35, 0.4, 0.35), (0.1, 0.1, 0.1, 0.5))
+
+    fig = Figure(figsize=(8.0, 5.6), dpi=130)
+    ax = fig.add_subplot(projection="3d", computed_zorder=False)
+    coll = Poly3DCollection(polys, facecolors=colors, edgecolors=edge, linewidths=0.25)
+    ax.add_collection3d(coll)
+    span = hi - lo
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(tuple(np.maximum(span, 1e-3 * span.max())))
+    ax.view_init(elev=view[0], azim=view[1])
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_zlabel("z")
+    ax.tick_params(labelsize=7, pad=0)
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(5))
+    sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=ax, shrink=0.55, pad=0.12, label="displacement magnitude")
+    ax.set_title(title)
+    tmp = path.with_name("." + path.name + ".tmp.png")
+    fig.savefig(tmp, bbox_inches="tight", pad_inches=0.15)
+    tmp.replace(path)
+
+
+def render_pictures(out_dir: Path, view: tuple[float, float] = (22.0, -58.0)) -> list[Path]:
+    """Write ``initial.png`` and ``final.png`` of the result folder ``out_dir``; return their paths.
+
+    ``view`` is the camera (elevation, azimuth) in degrees. Nothing is written (empty list) when the
+    folder holds no step files.
+    """
+    out_dir = Path(out_dir)
+    files = _step_files(out_dir)
+    if not files:
+        return []
+    first, last = files[0], files[-1]
+    s0, s1 = _state(first), _state(last)
+    # one frame for both pictures: the deformable bodies in both states, plus the rigid parts near them
+    pts = [s[0][np.unique(s[2][~s[3]])] for s in (s0, s1) if (~s[3]).any()]
+    allp = np.vstack(pts) if pts else np.vstack([s0[0], s1[0]])
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    pad = 0.15 * (hi - lo).max()
+    lo, hi = lo - pad, hi + pad
+    for s in (s0, s1):
+        rp = s[0][np.unique(s[2][s[3]])] if s[3].any() else np.zeros((0, 3))
+        if len(rp):
+            near = np.all((rp > lo - pad) & (rp < hi + pad), axis=1)
+            if near.any():
+                lo = np.minimum(lo, rp[near].min(axis=0))
+                hi = np.maximum(hi, rp[near].max(axis=0))
+    deform = ~s1[3]
+    vmax = float(s1[1][np.unique(s1[2][deform])].max()) if deform.any() else 1.0
+    vmax = vmax if vmax > 0 else 1.0
+    written = []
+    lam = _load_factor(out_dir, last.name)
+    step = int(last.stem.split("_")[1])
+    final = f"final state: step {step}" + (f", load factor {lam:.3g}" if lam is not None else "")
+    for state, name, label in ((s0, "initial.png", "initial state"), (s1, "final.png", final)):
+        path = out_dir / name
+        _draw(path, state, lo, hi, vmax, label, view)
+        written.append(path)
+    return written
