@@ -116,7 +116,7 @@ def test_auto_picks_first_direct():
     s = make_solver("auto")
     assert s.name == DIRECT[0] and s.direct
     s = make_solver("auto", symmetric=False)
-    assert s.name == [n for n in DIRECT if n != "cholmod"][0]
+    assert s.name == next(n for n in DIRECT if n != "cholmod")
 
 
 def test_unknown_name_lists_available():

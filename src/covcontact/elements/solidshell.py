@@ -114,9 +114,9 @@ def mesh_problem(cell_type: str, X: np.ndarray, cells: np.ndarray) -> str | None
     n = int(X.shape[0])
     keys = (cells[:, :half] * n + cells[:, half:]).ravel()
     rev = (cells[:, half:] * n + cells[:, :half]).ravel()
-    clash = np.isin(rev, keys)
+    clash = np.isin(rev, keys).reshape(-1, half).sum(axis=1)
     if clash.any():
-        e = int(np.flatnonzero(clash)[0] // half)
+        e = int(np.argmax(clash))  # the element with the most reversed fibres (a flipped one)
         return (f"solid-shell element {e} has its thickness direction opposite to a neighbour "
                 f"(bottom nodes 0..{half - 1}, top nodes {half}..{2 * half - 1} must agree)")
     return None

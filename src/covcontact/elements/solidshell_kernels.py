@@ -28,8 +28,9 @@ from .solid import _jacobian
 FLAG_INVERTED = 1
 FLAG_REFERENCE = 2
 FLAG_EAS = 3
-#: local EAS Newton (Neo-Hooke): relative strain-increment tolerance and iteration limit
+#: local EAS Newton (Neo-Hooke): relative and absolute strain-increment tolerances, iteration limit
 EAS_TOL = 1e-11
+EAS_ATOL = 1e-15
 EAS_MAXIT = 30
 
 
@@ -148,7 +149,11 @@ def _chol_solve(L, n, b):
 @njit(cache=True)
 def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
              Gp, gp, Ep, Tg, Ec, Gam, detg, J0, Ji, T0, En, dU):
-    """Geometry and assumed compatible strains of one element; returns 0 or FLAG_REFERENCE."""
+    """Geometry and assumed strains of one element.
+
+    Returns FLAG_REFERENCE (det J0 <= 0, outputs incomplete), FLAG_INVERTED (the compatible det F <= 0
+    at a Gauss point, outputs complete) or 0.
+    """
     nen = Xe.shape[0]
     npt = dNp.shape[0]
     ng = w.size
@@ -177,11 +182,18 @@ def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
             for k in range(3):
                 v += Gp[p, i, k] * dU[j, k] + Gp[p, j, k] * dU[i, k] + dU[i, k] * dU[j, k]
             Ep[p, I] = 0.5 * v if i == j else v
+    flag = 0
     for g in range(ng):
         det = _jacobian(Xe, dNp[g], J0, Ji)
         if not (det > 0.0):
             return FLAG_REFERENCE
         detg[g] = det
+        # det F of the compatible deformation = det[g_1, g_2, g_3] / det[G_1, G_2, G_3]
+        detx = (gp[g, 0, 0] * (gp[g, 1, 1] * gp[g, 2, 2] - gp[g, 1, 2] * gp[g, 2, 1])
+                - gp[g, 0, 1] * (gp[g, 1, 0] * gp[g, 2, 2] - gp[g, 1, 2] * gp[g, 2, 0])
+                + gp[g, 0, 2] * (gp[g, 1, 0] * gp[g, 2, 1] - gp[g, 1, 1] * gp[g, 2, 0]))
+        if not (detx > 0.0):
+            flag = FLAG_INVERTED
         _strain_transform(Ji, Tg[g])
         for I in range(6):
             s = 0.0
@@ -199,7 +211,7 @@ def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
             f = r * eas_val[g, m]
             for K in range(6):
                 Gam[g, K, m] = f * T0[K, c]
-    return 0
+    return flag
 
 
 @njit(cache=True)
@@ -291,7 +303,7 @@ def _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et,
             return 0
         if not np.isfinite(dmax):
             return FLAG_EAS
-        done = dmax <= EAS_TOL * emax
+        done = dmax <= EAS_TOL * emax or dmax <= EAS_ATOL
     return FLAG_EAS
 
 
@@ -442,8 +454,10 @@ def _element(kind, params, Xe, ue, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, e
         a0[m] = alpha[m]
     flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec, Gam,
                     detg, J0, Ji, T0, En, F)
-    if flag == 0:
-        flag = _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F)
+    if flag != FLAG_REFERENCE:
+        f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F)
+        if f2 != 0:
+            flag = f2
     if flag != 0:
         for m in range(neas):
             alpha[m] = a0[m] if np.isfinite(a0[m]) else 0.0
@@ -567,9 +581,11 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
                 continue
             flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
                             Gam, detg, J0, Ji, T0, En, F)
-            if flag == 0:
-                flag = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F)
-            if flag != 0:
+            if flag != FLAG_REFERENCE:
+                f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F)
+                if f2 != 0:
+                    flag = f2
+            if flag != 0 and (mode == 0 or flag != FLAG_INVERTED):
                 if mode == 0:
                     out[e, 0] = np.inf
                 continue

@@ -20,11 +20,13 @@ and raises ``SingularMatrixError`` for a singular matrix or a non-finite solutio
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import platform
 import time
 import warnings
-from functools import lru_cache
+from functools import cache, lru_cache
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -46,7 +48,7 @@ class SingularMatrixError(LinearSolverError):
 # ----------------------------------------------------------------------------- availability
 
 
-@lru_cache(maxsize=None)
+@cache
 def _probe(name: str) -> tuple[bool, str, str]:
     """(available, version, note) of one backend; imports it if possible."""
     try:
@@ -59,7 +61,7 @@ def _probe(name: str) -> tuple[bool, str, str]:
             return True, getattr(pypardiso, "__version__", ""), "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
         if name == "cholmod":
             import sksparse
-            import sksparse.cholmod  # noqa: F401
+            import sksparse.cholmod
 
             return True, getattr(sksparse, "__version__", ""), "CHOLMOD Cholesky, symmetric only"
         if name == "mumps":
@@ -205,7 +207,7 @@ class LinearSolver:
 
     def same_pattern(self, K: sp.csr_matrix) -> bool:
         """Whether K has the sparsity pattern of the last analysis."""
-        if self._indptr is None or K.shape[0] + 1 != self._indptr.size:
+        if self._indptr is None or self._indices is None or K.shape[0] + 1 != self._indptr.size:
             return False
         return np.array_equal(K.indptr, self._indptr) and np.array_equal(K.indices, self._indices)
 
@@ -449,10 +451,8 @@ class PardisoSolver(LinearSolver):
         self.pt[:] = 0
 
     def __del__(self):
-        try:
+        with contextlib.suppress(Exception):  # interpreter shutdown
             self.close()
-        except Exception:  # noqa: BLE001 - interpreter shutdown
-            pass
 
 
 # ----------------------------------------------------------------------------- SuperLU
@@ -469,7 +469,7 @@ class SuperLUSolver(LinearSolver):
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, diag_pivot_thresh: float = 1e-3):
         super().__init__(symmetric, check_tol)
         self.diag_pivot_thresh = diag_pivot_thresh
-        self._lu = None
+        self._lu: Any = None
 
     def _factor(self, K: sp.csr_matrix) -> None:
         Kt = sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape)
@@ -506,7 +506,7 @@ class CholmodSolver(LinearSolver):
         if not symmetric:
             raise ValueError("cholmod factorises symmetric matrices only")
         super().__init__(symmetric, check_tol)
-        self._factor_obj = None
+        self._factor_obj: Any = None
         self._fallback: LinearSolver | None = None
         self.last_backend = self.name
 
@@ -598,7 +598,7 @@ class AMGSolver(LinearSolver):
         self.rtol, self.maxiter = rtol, maxiter
         self._B: np.ndarray | None = None
         self._geometry: tuple[np.ndarray, np.ndarray | None] | None = None
-        self._ml = None
+        self._ml: Any = None
         self.iterations = 0
 
     def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
@@ -614,7 +614,8 @@ class AMGSolver(LinearSolver):
             if B.shape[0] != K.shape[0]:
                 raise ValueError(f"geometry gives {B.shape[0]} dofs, the matrix has {K.shape[0]}")
         self._ml = pyamg.smoothed_aggregation_solver(
-            K, B=B, symmetry="symmetric" if self.symmetric else "nonsymmetric", max_coarse=500
+            K, B=B, symmetry="symmetric" if self.symmetric else "nonsymmetric", max_coarse=500,
+            coarse_solver="splu",  # the default dense pseudo-inverse costs minutes on a stalled 2500-dof level
         )
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
