@@ -32,14 +32,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
-from test_hertz import (  # noqa: E402
+from test_hertz import (
     hertz_measures,
     hertz_mesh,
     hertz_problem,
     quarter,
 )
 
-from covcontact.mesh import hemisphere_solid  # noqa: E402
+from covcontact.mesh import hemisphere_solid
 
 FACTORS = (0.1, 0.2, 0.4, 0.6, 0.8, 1.0)
 FULL = [("hex8", 16, ("svk", "neo-hooke")), ("hex8", 24, ("svk", "neo-hooke")), ("hex8", 32, ("neo-hooke",)),
@@ -76,9 +76,10 @@ def table(records: list[dict]) -> str:
     for r in records:
         mesh = (f"{r['cell']} n={r['n']}" + (" graded" if r["graded"] else f" focus={r['focus']}")
                 + (" clamped" if r["clamp"] else ""))
-        rows.append(f"| {mesh} | {r['material']} | {r['dofs']} | " + " ".join(f"{v:.3f}" for v in r["ratio"])
-                    + f" | {r['C1']:.3f} | {r['C2']:.3f} | {r['a_error_max']:.3f} | {r['p_center_error_max']:.3f}"
-                    f" | {r['iterations']} | {r['wall_s']} |")
+        ratios = " ".join(f"{v:.3f}" for v in r["ratio"])
+        rows.append(f"| {mesh} | {r['material']} | {r['dofs']} | {ratios} | {r['C1']:.3f} | {r['C2']:.3f}"
+                    f" | {r['a_error_max']:.3f} | {r['p_center_error_max']:.3f} | {r['iterations']}"
+                    f" | {r['wall_s']} |")
     return "\n".join(rows)
 
 
@@ -92,11 +93,13 @@ def main(argv: list[str] | None = None) -> int:
     records = []
     if not args.no_baseline:
         mesh = quarter(hemisphere_solid(1.0, n=12, cell="hex8", focus=0.12))
-        records.append(one(mesh, "neo-hooke", dict(cell="hex8", n=12, nr=6, graded=False, focus=0.12), clamp=True))
+        base = {"cell": "hex8", "n": 12, "nr": 6, "graded": False, "focus": 0.12}
+        records.append(one(mesh, "neo-hooke", base, clamp=True))
     for cell, n, materials in QUICK if args.quick else FULL:
         mesh = hertz_mesh(n=n, nr=n // 2, cell=cell)
         for material in materials:
-            records.append(one(mesh, material, dict(cell=cell, n=n, nr=n // 2, graded=True, focus=1.0)))
+            label = {"cell": cell, "n": n, "nr": n // 2, "graded": True, "focus": 1.0}
+            records.append(one(mesh, material, label))
     result = {"benchmark": "hertz", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "total_s": round(time.perf_counter() - t0, 1),
               "d_over_R": [0.01 * f for f in FACTORS], "records": records}
