@@ -101,6 +101,8 @@ class ContactPair:
     tangent: str = "a"
     two_pass: bool = False
     max_penetration: float | None = None
+    friction: float = 0.0
+    tangential_penalty: float | None = None
 
 
 @dataclass

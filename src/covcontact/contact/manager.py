@@ -17,6 +17,7 @@ from ..fem.shapes import shape_functions
 from .analytic import Cylinder, Plane, Sphere
 from .driver import EDGE, FACET, VERTEX, project_slaves
 from .element import CASES
+from .friction import HIST_SIZE, SLIP, STICK, analytic_friction_batch, friction_batch, transfer_history
 from .kernels import contact_batch
 from .search import candidates
 from .surface import MeshSurface, facet_sizes, tributary_area
@@ -38,9 +39,12 @@ class Pass:
     cand: tuple | None = None
     x_search: np.ndarray | None = None
     margin: float = 0.0
+    mu: float = 0.0                    # Coulomb coefficient (0: frictionless)
+    eps_t: np.ndarray = field(default=None)  # (ns,) tangential penalty per slave
     # last evaluation
     g: np.ndarray = field(default=None)
     force: np.ndarray = field(default=None)  # (ns, 3) force on each slave node
+    state: np.ndarray = field(default=None)  # (ns,) friction state (0 open, 1 stick, 2 slip, 3 new)
 
     def __post_init__(self):
         ns = len(self.slaves)
@@ -48,7 +52,13 @@ class Pass:
         self.prev_xi = np.zeros((ns, 2))
         self.g = np.full(ns, np.inf)
         self.force = np.zeros((ns, 3))
+        self.state = np.zeros(ns, dtype=np.int64)
         self.committed = (self.prev_facet.copy(), self.prev_xi.copy())
+        # friction history: committed at converged steps, trial from the last evaluation
+        self.hist = np.zeros((ns, HIST_SIZE))
+        self.hist_trial = np.zeros((ns, HIST_SIZE))
+        self.hist_facet = np.full(ns, -1, dtype=np.int64)
+        self.x_conv: np.ndarray | None = None
 
 
 def _analytic_surface(rb):
@@ -90,9 +100,11 @@ class ContactManager:
                 rev_slave = (pair.master[0], pair.master[1])
                 rev_master = (pair.slave[0], pair.slave[1])
                 self.passes.append(self._make_pass(pair.name + "/reverse", rev_slave, rev_master, pair))
+        self.symmetric = not any(p.mu > 0.0 for p in self.passes)
         self.lam = 0.0
         self._x_rigid_lam = self.X_rigid.copy()
         self.timing = {"search": 0.0, "projection": 0.0}
+        self._x_last: np.ndarray | None = None
 
     # -- set-up ---------------------------------------------------------------------------------
     def _mesh_of(self, body: str):
@@ -122,12 +134,15 @@ class ContactManager:
             eps = pair.penalty * area
         else:
             eps = np.full(len(slaves), pair.penalty)
+        mu = float(getattr(pair, "friction", 0.0) or 0.0)
+        ratio = (pair.tangential_penalty / pair.penalty) if getattr(pair, "tangential_penalty", None) else 1.0
+        eps_t = eps * ratio
         mmesh, moff = self._mesh_of(master[0])
         if mmesh is None:
             rb = next(r for r in self.problem.rigid if r.name == master[0])
-            return Pass(name, slaves, eps, area, analytic=_analytic_surface(rb))
+            return Pass(name, slaves, eps, area, analytic=_analytic_surface(rb), mu=mu, eps_t=eps_t)
         faces = mmesh.face_sets[master[1]] + moff
-        return Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=self.n_ext))
+        return Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=self.n_ext), mu=mu, eps_t=eps_t)
 
     # -- positions ------------------------------------------------------------------------------
     def rigid_positions(self, lam: float) -> np.ndarray:
@@ -207,6 +222,8 @@ class ContactManager:
             P = np.zeros((idx.size, 4, nd, nd)) if want_parts else np.zeros((1, 4, 1, 1))
             g = np.zeros(idx.size)
             contact_batch(xe, conn, sl, xi, eps, case, want_parts, R, K, P, g)
+            if p.mu > 0.0 and not want_parts:
+                R, K, g = self._facet_friction(p, xe, idx, conn, sl, xi, eps)
             p.g[idx] = g
             p.force[idx] = -R[:, -3:]
             dofs = self._dofs(np.hstack([conn, sl[:, None]]))
@@ -237,10 +254,57 @@ class ContactManager:
             if want_parts:
                 self._scatter(dofs, np.zeros_like(R), K, np.zeros_like(r), *parts_acc[0])
 
+    def _facet_history(self, p: Pass, idx: np.ndarray, facets: np.ndarray, xi: np.ndarray) -> np.ndarray:
+        """Committed friction history of slaves ``idx`` moved onto their current facets."""
+        hist = p.hist[idx].copy()
+        moved = np.flatnonzero((hist[:, -1] > 0.0) & (p.hist_facet[idx] != facets))
+        for j in moved:
+            xyz = p.x_conv[p.surface.faces[facets[j]]] if p.x_conv is not None else None
+            if xyz is None:
+                hist[j] = 0.0
+                continue
+            try:
+                hist[j] = transfer_history(hist[j], xyz, xi[j])
+            except ValueError:
+                hist[j] = 0.0
+        return hist
+
+    def _facet_friction(self, p: Pass, xe, idx, conn, sl, xi, eps):
+        """Frictional residual and (non-symmetric) tangent of the active facet pairs ``idx``."""
+        facets = p.prev_facet[idx]
+        hist = self._facet_history(p, idx, facets, xi)
+        nd = 3 * (p.surface.nen + 1)
+        R = np.zeros((idx.size, nd))
+        K = np.zeros((idx.size, nd, nd))
+        hist_out = np.zeros_like(hist)
+        g = np.zeros(idx.size)
+        state = np.zeros(idx.size, dtype=np.int64)
+        friction_batch(xe, conn, sl, xi, np.ascontiguousarray(eps), np.ascontiguousarray(p.eps_t[idx]),
+                       np.full(idx.size, p.mu), hist, R, K, hist_out, g, state)
+        p.hist_trial[idx] = hist_out
+        p.state[idx] = state
+        return R, K, g
+
     def _analytic_pass(self, p: Pass, xe, case, want_K, want_parts, r, rows, cols, vals, parts_acc):
         xs = np.ascontiguousarray(xe[p.slaves])
         parts = {v: k for k, v in CASES.items()}[case]
         out = p.analytic.evaluate(xs, p.eps, parts=parts, lam=self.lam)
+        if p.mu > 0.0 and not want_parts:
+            ns = len(xs)
+            origin, frame = p.analytic.placement(self.lam)
+            R3 = np.zeros((ns, 3))
+            K3 = np.zeros((ns, 3, 3))
+            hist_out = np.zeros((ns, HIST_SIZE))
+            g = np.zeros(ns)
+            xi = np.zeros((ns, 2))
+            state = np.zeros(ns, dtype=np.int64)
+            analytic_friction_batch(p.analytic.kind, origin, frame, float(p.analytic.radius),
+                                    float(p.analytic.sigma), xs, np.ascontiguousarray(p.eps),
+                                    np.ascontiguousarray(p.eps_t), np.full(ns, p.mu), p.hist.copy(), R3, K3,
+                                    hist_out, g, xi, state)
+            out.residual, out.tangent, out.gap = R3, K3, g
+            p.hist_trial[:] = hist_out
+            p.state[:] = state
         p.g = out.gap
         active = out.gap <= 0.0
         p.force = -out.residual
@@ -263,6 +327,7 @@ class ContactManager:
         """Contact residual (n_dofs,) and tangent (CSR or None) at deformable positions x (N, 3)."""
         case = self.case if case is None else case
         xe = self.extended(x)
+        self._x_last = xe
         r = np.zeros(3 * self.N)
         rows: list = []
         cols: list = []
@@ -297,6 +362,12 @@ class ContactManager:
     def commit(self) -> None:
         for p in self.passes:
             p.committed = (p.prev_facet.copy(), p.prev_xi.copy())
+            if p.mu > 0.0:
+                open_ = p.g > 0.0
+                p.hist = p.hist_trial.copy()
+                p.hist[open_] = 0.0  # a node that lost contact starts again without history
+                p.hist_facet = p.prev_facet.copy()
+                p.x_conv = self._x_last.copy() if self._x_last is not None else None
 
     def active_count(self) -> int:
         return int(sum(np.count_nonzero(p.g <= 0.0) for p in self.passes))
@@ -316,16 +387,21 @@ class ContactManager:
     # -- reports --------------------------------------------------------------------------------
     def step_report(self, x: np.ndarray, lam: float) -> dict:
         """Per pair: active contacts, minimum gap, force resultant; the contribution norms of the parts."""
+        saved = [(p.g.copy(), p.force.copy(), p.state.copy()) for p in self.passes]
         r, K, parts = self.evaluate(x, lam, want_K=True, case=CASES["a"], want_parts=True)
         main, rot, curv, _ = parts
         full = main + rot + curv
         nf = sp.linalg.norm(full) if full.nnz else 0.0
         contrib = {"rotational": float(sp.linalg.norm(rot) / nf * 100) if nf > 0 and rot.nnz else 0.0,
                    "curvature": float(sp.linalg.norm(curv) / nf * 100) if nf > 0 and curv.nnz else 0.0}
+        for p, kept in zip(self.passes, saved):  # forces and friction states of the converged iterate
+            p.g, p.force, p.state = kept
         pairs = {}
         for p in self.passes:
             act = p.g <= 0.0
             pairs[p.name] = {"active_contacts": int(act.sum()),
+                             **({"stick": int(np.count_nonzero(act & (p.state == STICK))),
+                                 "slip": int(np.count_nonzero(act & (p.state == SLIP)))} if p.mu > 0 else {}),
                              "min_gap": float(p.g.min()) if len(p.g) and np.isfinite(p.g.min()) else None,
                              "contact_force": p.force[act].sum(axis=0).tolist()}
         total_force = np.sum([v["contact_force"] for v in pairs.values()], axis=0).tolist()

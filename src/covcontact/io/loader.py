@@ -258,8 +258,11 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area"))
         tangent = c.get("tangent", "str", "a", choices=TANGENT_CASES)
         two_pass = c.get("two_pass", "bool", False)
+        mu = c.get("friction", "float", 0.0, nonnegative=True)
+        eps_t = c.get("tangential_penalty", "float", None, positive=True)
         c.done()
-        contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass))
+        contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass,
+                                    friction=mu, tangential_penalty=eps_t))
 
     steps_sec = top.get("steps", "table", None)
     if steps_sec is None:

@@ -1,0 +1,60 @@
+"""Coulomb friction in problems: sliding at mu N, sticking below it, assembled non-symmetric tangents."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from covcontact.io.loader import load_problem
+from covcontact.tangent_check import check_tangent
+
+ROOT = Path(__file__).resolve().parents[2]
+SLIDING = ROOT / "examples" / "friction" / "block_sliding.toml"
+
+
+def test_full_sliding_gives_mu_times_normal_force(tmp_path):
+    res = load_problem(SLIDING).run(out=tmp_path)
+    assert res.exit_code == 0 and res.model.symmetric is False
+    last = res.summary["steps"][-1]["pairs"]["contact1"]
+    assert last["slip"] == last["active_contacts"] == 25
+    fx, fy, fz = last["contact_force"]
+    # friction opposes the +x motion of the block; every node is on the cone (|t| = mu N), and the small
+    # radial (Poisson) part of each node's slip turns a little of its traction away from x
+    assert 0.2995 < -fx / fz <= 0.3 * (1 + 1e-9)
+    assert abs(fy) < 1e-9 * fz
+    # force balance with the dragging support
+    react = res.summary["steps"][-1]["reactions"]["block.zmax"]
+    assert np.allclose(react, [-fx, -fy, -fz], rtol=1e-8, atol=1e-9 * fz)
+
+
+def test_small_drag_sticks(tmp_path):
+    prob = load_problem(SLIDING)
+    prob.dirichlet[0].values = (0.0005, 0.0, -0.01)
+    res = prob.run(out=tmp_path)
+    last = res.summary["steps"][-1]["pairs"]["contact1"]
+    assert res.exit_code == 0
+    assert last["stick"] > 0
+    fx, _, fz = last["contact_force"]
+    assert abs(fx) < 0.3 * fz
+
+
+@pytest.mark.parametrize("step", [1, 4])
+def test_assembled_friction_tangent(step):
+    """Stick in step 1 (new contacts) and slip later: the assembled tangent matches finite differences."""
+    rep = check_tangent(load_problem(SLIDING), step=step, tangent="exact", columns=40)
+    assert rep["converged"] and rep["relative_error"] < 1e-6, rep
+
+
+def test_friction_between_deformable_bodies(tmp_path):
+    prob = load_problem(ROOT / "examples" / "contact" / "two_blocks.toml")
+    prob.contacts[0].friction = 0.2
+    prob.dirichlet[1].values = (0.05, 0.0, -0.02)  # the punch is pressed and dragged
+    res = prob.run(out=tmp_path, tangent="exact")
+    assert res.exit_code == 0
+    last = res.summary["steps"][-1]
+    pair = last["pairs"]["contact1"]
+    assert pair["slip"] + pair["stick"] == pair["active_contacts"] > 0
+    fx, _, fz = pair["contact_force"]
+    assert abs(fx) <= 0.2 * fz * (1 + 1e-9)
+    rep = check_tangent(prob, step=2, tangent="exact", columns=40)
+    assert rep["relative_error"] < 1e-6, rep
