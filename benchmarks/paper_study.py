@@ -12,6 +12,7 @@ the mixed case c.
     python benchmarks/paper_study.py --out results/paper --json paper_study.json
     python benchmarks/paper_study.py --only sphere_q9 --cases a,d
     python benchmarks/paper_study.py --variants-only --json paper_variants.json
+    python benchmarks/paper_study.py --report paper_study.json   # markdown tables of a JSON record
 """
 
 from __future__ import annotations
@@ -107,6 +108,60 @@ def run_one(name: str, cases: list[str], out: Path, mods: dict | None = None, la
     return rec
 
 
+def _ranges(iterations: list[int], eps: list[float]) -> list[tuple[str, int, int, float]]:
+    """(load-step range, iterations, cumulative, largest eps in the range): the paper's Table 1 rows."""
+    from covcontact.study import step_ranges
+
+    steps = [{"step": k + 1, "iterations": n, "converged": True, "contribution_percent": {"rotational": e}}
+             for k, (n, e) in enumerate(zip(iterations, eps))]
+    return [(str(r["first"]) if r["first"] == r["last"] else f"{r['first']}-{r['last']}", r["iterations"],
+             r["cumulative"], r["eps_rot_max"]) for r in step_ranges(steps)]
+
+
+def table1(rec: dict, cases: tuple[str, ...] = ("a", "b", "d")) -> str:
+    """One study in the layout of the paper's Table 1: per case the step ranges, iterations, cumulative;
+    for case a also the largest eps of the rotational part in the range (percent)."""
+    cols = {c: _ranges(rec["cases"][c]["iterations"], rec["cases"][c]["eps_rotational"])
+            for c in cases if c in rec["cases"]}
+    head, rule = [], []
+    for c in cols:
+        head += [f"{c}: steps", "No.", "Cum."] + (["eps rot. %"] if c == "a" else [])
+        rule += ["---"] * (4 if c == "a" else 3)
+    lines = ["| " + " | ".join(head) + " |", "|" + "|".join(rule) + "|"]
+    for i in range(max(len(v) for v in cols.values())):
+        row = []
+        for c, v in cols.items():
+            if i < len(v):
+                row += [v[i][0], str(v[i][1]), str(v[i][2])] + ([f"{v[i][3]:.3g}"] if c == "a" else [])
+            else:
+                row += [""] * (4 if c == "a" else 3)
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def summary_table(record: dict) -> str:
+    """Totals per study and case, the largest eps, and the wall time per case."""
+    lines = ["| study | variant | dofs | a | b | c | d | exact | eps rot. max % | eps curv. max % | "
+             "wall time per case, s (a / b / c / d / exact) |", "|" + "---|" * 11]
+    for rec in record["studies"]:
+        cs = rec["cases"]
+        tot = [str(cs[c]["total_iterations"]) + ("" if cs[c]["converged"] else " (failed)") if c in cs else "-"
+               for c in CASES]
+        a = cs.get("a") or next(iter(cs.values()))
+        walls = " / ".join(f"{cs[c]['wall_time_s']:.0f}" if c in cs else "-" for c in CASES)
+        lines.append(f"| {rec['study']} | {rec['variant']} | {a['dofs']} | " + " | ".join(tot) +
+                     f" | {a['eps_rotational_max']:.3g} | {a['eps_curvature_max']:.3g} | {walls} |")
+    return "\n".join(lines)
+
+
+def report(record: dict) -> str:
+    parts = ["## Totals", "", summary_table(record), ""]
+    for rec in record["studies"]:
+        if rec["variant"] == "main":
+            parts += [f"## {rec['study']} ({rec['problem']})", "", table1(rec), ""]
+    return "\n".join(parts)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", help="comma separated studies, from " + ", ".join(STUDIES))
@@ -115,7 +170,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--variants-only", action="store_true", help="only the robustness variants")
     ap.add_argument("--out", default="results/paper", help="result folders")
     ap.add_argument("--json", help="write the JSON record here (default: OUT/paper_study.json)")
+    ap.add_argument("--report", nargs="+", metavar="JSON", help="print markdown tables of JSON records")
     args = ap.parse_args(argv)
+    if args.report:
+        merged = {"studies": [rec for path in args.report for rec in json.loads(Path(path).read_text())["studies"]]}
+        print(report(merged))
+        return 0
     from covcontact import __version__
     from numba import get_num_threads
 

@@ -12,6 +12,9 @@ from covcontact.contact.element import (
     ContactResult,
     node_to_surface,
 )
+from covcontact.contact.friction import (HIST_SIZE, NEW, OPEN, SLIP, STICK, FrictionResult,
+                                         analytic_friction_batch, friction_batch, make_history, new_history,
+                                         node_to_surface_friction, surface_friction, transfer_history)
 from covcontact.contact.kernels import contact_batch
 from covcontact.contact.projection import project_on_facet
 from covcontact.contact.rigid import RigidMotion
@@ -21,6 +24,19 @@ from covcontact.contact.driver import (EDGE, FACET, NO_CONTACT, VERTEX, Projecti
                                        project_slaves)
 
 __all__ = [
+    "HIST_SIZE",
+    "NEW",
+    "OPEN",
+    "SLIP",
+    "STICK",
+    "FrictionResult",
+    "analytic_friction_batch",
+    "friction_batch",
+    "make_history",
+    "new_history",
+    "node_to_surface_friction",
+    "surface_friction",
+    "transfer_history",
     "EDGE",
     "FACET",
     "NO_CONTACT",

@@ -61,7 +61,7 @@ EAS_MODES: dict[str, list[tuple[int, Any]]] = {
 #: default options per cell type (see docs/verification.md "Shells" for the benchmarks behind them)
 DEFAULTS: dict[str, dict[str, Any]] = {
     "hex8": {"eas": 7, "ans_shear": True, "ans_thickness": True, "ans_membrane": False},
-    "hex18": {"eas": 1, "ans_shear": True, "ans_thickness": True, "ans_membrane": True},
+    "hex18": {"eas": 4, "ans_shear": True, "ans_thickness": True, "ans_membrane": True},
 }
 OPTION_KEYS = ("eas", "ans_shear", "ans_thickness", "ans_membrane")
 
@@ -141,7 +141,7 @@ class _Points:
             self.add(p, unique=False)
 
     def add(self, p, unique: bool = True) -> int:
-        key = tuple(round(float(x), 12) for x in p)
+        key = (round(float(p[0]), 12), round(float(p[1]), 12), round(float(p[2]), 12))
         if unique and key in self.index:
             return self.index[key]
         self.index.setdefault(key, len(self.pts))
@@ -278,15 +278,12 @@ class SolidShellBody:
         u = np.ascontiguousarray(u, dtype=np.float64)
         return u if u.shape == self.X.shape else u.reshape(self.X.shape)
 
-    def _tables(self) -> tuple:
-        return (self.dNp, self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp,
-                self.eas_val)
-
     def _fields(self, u: np.ndarray, mode: int, ncol: int) -> np.ndarray:
         out = np.empty((self.n_elements, ncol))
         if self.n_elements:
             solidshell_fields(self.material.kind, self.material.params, self.X, self._u(u), self.cells,
-                              self.alpha, *self._tables(), mode, out, get_num_threads())
+                              self.alpha, self.dNp, self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w,
+                              self.eas_comp, self.eas_val, mode, out, get_num_threads())
         return out
 
     # -- history --------------------------------------------------------------------------------
@@ -354,8 +351,9 @@ class SolidShellBody:
                 Ke = self._Ke[:nc] if want_K else self._Ke
                 fe = self._fe[:nc]
                 flags = self._flags[:nc]
-                solidshell_chunk(kind, params, self.X, u, self.cells, e0, self.alpha, *self._tables(), want_K,
-                                 Ke, fe, flags, nblocks)
+                solidshell_chunk(kind, params, self.X, u, self.cells, e0, self.alpha, self.dNp, self.dNc,
+                                 self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
+                                 want_K, Ke, fe, flags, nblocks)
                 scatter_vectors(rhs, self.cells, off, fe, e0)
                 if want_K:
                     scatter_matrices(data, node_ptr, self.cells, off, ranks, Ke, e0)

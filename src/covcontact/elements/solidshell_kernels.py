@@ -34,7 +34,7 @@ EAS_ATOL = 1e-15
 EAS_MAXIT = 30
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _strain_transform(Ji, T):
     """T (6, 6): Cartesian Voigt strain = T @ covariant Voigt strain (Ji[i, k] = dxi_i / dX_k)."""
     for K in range(6):
@@ -51,7 +51,7 @@ def _strain_transform(Ji, T):
             T[K, I] = fK * c
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _stretch(E, F):
     """An F with F^T F = C = I + 2 E (upper Cholesky factor); False if C is not positive definite."""
     c00 = 1.0 + 2.0 * E[0]
@@ -82,7 +82,7 @@ def _stretch(E, F):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _response(kind, params, E, F, S, D):
     """S and D at Cartesian Green-Lagrange strain E; 1 if E is not admissible (S = 0, D = Hooke).
 
@@ -114,7 +114,7 @@ def _response(kind, params, E, F, S, D):
     return 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _chol(A, n, L):
     """Lower Cholesky factor L of the leading n x n block of A; False if not positive definite."""
     for i in range(n):
@@ -131,7 +131,7 @@ def _chol(A, n, L):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _chol_solve(L, n, b):
     """b <- A^-1 b with A = L L^T (n x n)."""
     for i in range(n):
@@ -560,11 +560,11 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
         Gx = np.empty((nen, 3))
         Fc = np.empty((3, 3))
         ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
-        Gp, gp, sig = ws3
+        Gp, gp, _sig = ws3
         Tg, D = ws4
         Ep, S, Et, Ec = ws2
         Gam, detg = wsg
-        J0, Ji, T0, F, En, h, H, Hf, dal, a0, x, Bn, Bc, DB, DG, Kua = wv
+        J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua = wv
         for e in range(lo, hi):
             for a in range(nen):
                 n = conn[e, a]
