@@ -14,7 +14,8 @@ Green-Lagrange strain:
   with the centre Jacobian (Simo-Rifai), alpha condensed per element after a local Newton solve.
 - hex18 only, optional: MITC9-like membrane tying (E_rr like E_rt, E_ss like E_st, E_rs at (-+a, -+a)).
 
-Kernels: :mod:`covcontact.elements.solidshell_kernels`.
+Kernels: :mod:`covcontact.elements.solidshell_kernels` (element routines) and
+:mod:`covcontact.elements.solidshell_loops` (parallel loops over elements).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
 from ..fem.shapes import NNODES, NODES, shape_functions
 from ..materials.hyperelastic import Material
 from .solid import BLOCKS_PER_THREAD, SolidStress
-from .solidshell_kernels import solidshell_chunk, solidshell_fields
+from .solidshell_loops import solidshell_chunk, solidshell_fields
 
 SHELL_CELLS = ("hex8", "hex18")
 
