@@ -139,7 +139,7 @@ def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title:
     tmp.replace(path)
 
 
-def render_pictures(out_dir: Path, view: tuple[float, float] = (22.0, -58.0)) -> list[Path]:
+def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) -> list[Path]:
     """Write ``initial.png`` and ``final.png`` of the result folder ``out_dir``; return their paths.
 
     ``view`` is the camera (elevation, azimuth) in degrees. Nothing is written (empty list) when the

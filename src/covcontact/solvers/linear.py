@@ -187,6 +187,7 @@ class LinearSolver:
             last ``factorize`` call (analysis included) and the last ``solve_factorized`` call.
         n_analyses, n_factorizations: counters.
         residual: relative residual ||K x - b|| / ||b|| of the last solve.
+        backward_error: ||K x - b|| / (||K||_F ||x|| + ||b||) of the last solve (see ``_check``).
     """
 
     name = "base"
@@ -198,6 +199,8 @@ class LinearSolver:
         self.t_analyze = self.t_factor = self.t_solve = 0.0
         self.n_analyses = self.n_factorizations = 0
         self.residual = float("nan")
+        self.backward_error = float("nan")
+        self._K_norm: float | None = None
         self._K: sp.csr_matrix | None = None
         self._indptr: np.ndarray | None = None
         self._indices: np.ndarray | None = None
@@ -222,6 +225,7 @@ class LinearSolver:
             self.n_analyses += 1
             self.t_analyze = time.perf_counter() - t0
         self._K = None
+        self._K_norm = None
         self._factor(K)
         self._K = K
         self.n_factorizations += 1
@@ -263,6 +267,15 @@ class LinearSolver:
         self._indptr = self._indices = None
 
     def _check(self, b: np.ndarray, x: np.ndarray) -> float:
+        """The error measure compared with ``check_tol``.
+
+        Normally the relative residual ||K x - b|| / ||b|| (also stored in ``residual``). On the very
+        ill-conditioned tangents of thin shells (cond ~ 1e12) a correct, backward-stable solve can leave a
+        relative residual of 1e-5; such a solve is accepted when its normwise backward error
+        ||K x - b|| / (||K||_F ||x|| + ||b||) is below 1e-11 and the relative residual below 1e-2. A
+        singular system with an inconsistent right-hand side keeps a relative residual of order one and
+        is still rejected.
+        """
         if not np.isfinite(x).all():
             raise SingularMatrixError(
                 f"{self.name}: the solution has non-finite entries; the matrix is singular"
@@ -272,6 +285,13 @@ class LinearSolver:
         nb = np.linalg.norm(b, axis=0)
         r = np.linalg.norm(self._K @ x - b, axis=0)
         self.residual = float(np.max(np.where(nb > 0, r / np.where(nb > 0, nb, 1.0), r)))
+        if self._K_norm is None:
+            self._K_norm = float(np.linalg.norm(self._K.data))
+        nx = np.linalg.norm(x, axis=0)
+        denom = self._K_norm * nx + nb
+        self.backward_error = float(np.max(np.where(denom > 0, r / np.where(denom > 0, denom, 1.0), r)))
+        if self.residual > self.check_tol and self.residual <= 1e-2 and self.backward_error <= 1e-11:
+            return self.backward_error
         return self.residual
 
     def _diagnosis(self) -> str:

@@ -1,0 +1,153 @@
+"""Parallel element loops of the solid-shell elements: assembly buffers and per-element fields.
+
+The element mathematics is in :mod:`covcontact.elements.solidshell_kernels`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ..materials.hyperelastic import VOIGT_PAIRS, material_energy
+from .solid import _jacobian
+from .solidshell_kernels import FLAG_INVERTED, FLAG_REFERENCE, _element, _local_solve, _prepare, _stretch
+
+
+@njit(cache=True)
+def _scratch(nen, npt, ng, neas):
+    nd = 3 * nen
+    ne = max(neas, 1)
+    ws3 = (np.empty((npt, 3, 3)), np.empty((npt, 3, 3)), np.empty((npt, 3, 3)))
+    ws4 = (np.empty((ng, 6, 6)), np.empty((ng, 6, 6)))
+    ws2 = (np.empty((npt, 6)), np.empty((ng, 6)), np.empty((ng, 6)), np.empty((ng, 6)))
+    wsg = (np.empty((ng, 6, ne)), np.empty(ng))
+    wv = (np.empty((3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((3, 3)), np.empty(6), np.empty(ne),
+          np.empty((ne, ne)), np.empty((ne, ne)), np.empty(ne), np.empty(ne), np.empty(ne), np.empty((6, nd)),
+          np.empty((6, nd)), np.empty((6, nd)), np.empty((6, ne)), np.empty((nd, ne)))
+    return ws3, ws4, ws2, wsg, wv
+
+
+@njit(parallel=True, cache=True)
+def solidshell_chunk(kind, params, X, u, conn, e0, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
+                     eas_val, want_K, Ke, fe, flags, nblocks):
+    """Element buffers Ke (nc, nd, nd), fe (nc, nd), flags (nc,) of elements e0 .. e0 + nc - 1.
+
+    alpha (nelem, neas) holds the EAS parameters: read as the start of the local Newton, overwritten
+    with the solution.
+    """
+    nc = fe.shape[0]
+    nen = conn.shape[1]
+    npt = dNp.shape[0]
+    ng = w.size
+    neas = eas_comp.size
+    nblk = max(1, min(nblocks, nc))
+    for t in prange(nblk):
+        lo = t * nc // nblk
+        hi = (t + 1) * nc // nblk
+        Xe = np.empty((nen, 3))
+        ue = np.empty((nen, 3))
+        ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
+        Kdummy = np.empty((0, 0))
+        for c in range(lo, hi):
+            e = e0 + c
+            for a in range(nen):
+                n = conn[e, a]
+                for i in range(3):
+                    Xe[a, i] = X[n, i]
+                    ue[a, i] = u[n, i]
+            Kc = Ke[c] if want_K else Kdummy
+            flags[c] = _element(kind, params, Xe, ue, alpha[e], dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
+                                eas_val, want_K, Kc, fe[c], ws3, ws4, ws2, wsg, wv)
+
+
+@njit(parallel=True, cache=True)
+def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
+                      mode, out, nthreads):
+    """Per-element quantities at the solved EAS parameters.
+
+    mode 0: out (ne, 1) strain energy int W(E) dV (inf if E is not admissible); mode 1: out (ne, 1)
+    minimum det J0 over the centre and all evaluation points; mode 2: out (ne, 18) volume averages of
+    Cauchy stress (pushed forward with the compatible F), S and the assumed strain E (Voigt).
+    """
+    ne = conn.shape[0]
+    nen = conn.shape[1]
+    npt = dNp.shape[0]
+    ng = w.size
+    neas = eas_comp.size
+    nblk = max(1, min(nthreads, ne))
+    for t in prange(nblk):
+        lo = t * ne // nblk
+        hi = (t + 1) * ne // nblk
+        Xe = np.empty((nen, 3))
+        ue = np.empty((nen, 3))
+        Gx = np.empty((nen, 3))
+        Fc = np.empty((3, 3))
+        ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
+        Gp, gp, _sig = ws3
+        Tg, D = ws4
+        Ep, S, Et, Ec = ws2
+        Gam, detg = wsg
+        J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua = wv
+        for e in range(lo, hi):
+            for a in range(nen):
+                n = conn[e, a]
+                for i in range(3):
+                    Xe[a, i] = X[n, i]
+                    ue[a, i] = u[n, i]
+            for r in range(out.shape[1]):
+                out[e, r] = 0.0
+            if mode == 1:
+                dmin = _jacobian(Xe, dNc, J0, Ji)
+                for p in range(npt):
+                    dmin = min(dmin, _jacobian(Xe, dNp[p], J0, Ji))
+                out[e, 0] = dmin
+                continue
+            flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
+                            Gam, detg, J0, Ji, T0, En, F)
+            if flag != FLAG_REFERENCE:
+                f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F)
+                if f2 != 0:
+                    flag = f2
+            if flag != 0 and (mode == 0 or flag != FLAG_INVERTED):
+                if mode == 0:
+                    out[e, 0] = np.inf
+                continue
+            vol = 0.0
+            for g in range(ng):
+                wd = w[g] * detg[g]
+                vol += wd
+                if mode == 0:
+                    if _stretch(Et[g], F):
+                        out[e, 0] += wd * material_energy(kind, params, F)
+                    else:
+                        out[e, 0] = np.inf
+                    continue
+                # compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
+                _jacobian(Xe, dNp[g], J0, Ji)
+                for a in range(nen):
+                    for j in range(3):
+                        Gx[a, j] = dNp[g, a, 0] * Ji[0, j] + dNp[g, a, 1] * Ji[1, j] + dNp[g, a, 2] * Ji[2, j]
+                for i in range(3):
+                    for j in range(3):
+                        s = 1.0 if i == j else 0.0
+                        for a in range(nen):
+                            s += ue[a, i] * Gx[a, j]
+                        Fc[i, j] = s
+                J = (Fc[0, 0] * (Fc[1, 1] * Fc[2, 2] - Fc[1, 2] * Fc[2, 1])
+                     - Fc[0, 1] * (Fc[1, 0] * Fc[2, 2] - Fc[1, 2] * Fc[2, 0])
+                     + Fc[0, 2] * (Fc[1, 0] * Fc[2, 1] - Fc[1, 1] * Fc[2, 0]))
+                rJ = wd / J if J > 0.0 else 0.0
+                for I in range(6):
+                    i = VOIGT_PAIRS[I, 0]
+                    j = VOIGT_PAIRS[I, 1]
+                    s = 0.0
+                    for k in range(3):
+                        for m in range(3):
+                            K = k if k == m else (3 if k + m == 1 else (4 if k + m == 3 else 5))
+                            s += Fc[i, k] * S[g, K] * Fc[j, m]
+                    out[e, I] += rJ * s
+                    out[e, 6 + I] += wd * S[g, I]
+                    out[e, 12 + I] += wd * (Et[g, I] if I < 3 else 0.5 * Et[g, I])
+            if mode == 2 and vol > 0.0:
+                for r in range(18):
+                    out[e, r] /= vol
