@@ -91,18 +91,28 @@ class ContactPair:
     slave: (body name, node set name); the body may be deformable or a rigid meshed body.
     master: (body name, face set name) of a deformable or rigid meshed body, or (rigid body name, "")
     for an analytic surface.
+    penalty: eps_N, or "auto" (``auto_factor`` times Young's modulus over the facet size of the master
+    body, or of the slave body against a rigid master; times the tributary area for "nodal" weighting).
+    method: "penalty", or "augmented" (Uzawa updates of per-node multipliers after each converged step
+    until the largest penetration is below ``gap_tolerance``, absolute, or ``gap_tolerance_relative``
+    times the mean master facet size; at most ``max_augmentations`` updates per step).
     """
 
     name: str
     slave: tuple[str, str]
     master: tuple[str, str]
-    penalty: float
+    penalty: float | str
     weighting: str = "nodal"
     tangent: str = "a"
     two_pass: bool = False
     max_penetration: float | None = None
     friction: float = 0.0
     tangential_penalty: float | None = None
+    method: str = "penalty"
+    gap_tolerance: float | None = None
+    gap_tolerance_relative: float | None = None
+    max_augmentations: int = 20
+    auto_factor: float = 10.0
 
 
 @dataclass

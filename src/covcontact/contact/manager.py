@@ -40,6 +40,9 @@ class Pass:
     x_search: np.ndarray | None = None
     margin: float = 0.0
     mu: float = 0.0                    # Coulomb coefficient (0: frictionless)
+    augmented: bool = False            # augmented Lagrangian (Uzawa) instead of pure penalty
+    gap_tol: float = 0.0               # largest accepted penetration of the augmented method
+    max_aug: int = 20
     eps_t: np.ndarray = field(default=None)  # (ns,) tangential penalty per slave
     # last evaluation
     g: np.ndarray = field(default=None)
@@ -59,6 +62,10 @@ class Pass:
         self.hist_trial = np.zeros((ns, HIST_SIZE))
         self.hist_facet = np.full(ns, -1, dtype=np.int64)
         self.x_conv: np.ndarray | None = None
+        # augmented Lagrangian multipliers (<= 0) per slave node: trial, saved at a step start, committed
+        self.lam_mult = np.zeros(ns)
+        self.lam_saved = np.zeros(ns)
+        self.n_aug = 0
 
 
 def _analytic_surface(rb):
@@ -119,6 +126,25 @@ class ContactManager:
     def _reference_positions(self) -> np.ndarray:
         return np.vstack([self.system.X, self.X_rigid])
 
+    def _material_E(self, body: str) -> float | None:
+        for b in self.problem.bodies:
+            if b.name == body:
+                return float(b.material.params[0])
+        return None
+
+    def _auto_penalty(self, pair, slave, master) -> float:
+        """eps_N per unit area: auto_factor * E / h of the master body (the slave body's if rigid)."""
+        X = self._reference_positions()
+        for body, sset in (master, slave):
+            E = self._material_E(body)
+            mesh, off = self._mesh_of(body)
+            if E is None or mesh is None or sset not in mesh.face_sets:
+                continue
+            h = float(np.mean(facet_sizes(X, mesh.face_sets[sset] + off))) / np.sqrt(2.0)
+            return pair.auto_factor * E / h
+        raise ValueError(f"contact {pair.name}: penalty = \"auto\" needs a deformable body with a face set "
+                         f"named like its contact set")
+
     def _make_pass(self, name, slave, master, pair) -> Pass:
         smesh, soff = self._mesh_of(slave[0])
         slaves = smesh.node_sets[slave[1]] + soff
@@ -128,21 +154,31 @@ class ContactManager:
             area = area_all[slaves]
         else:
             area = np.ones(len(slaves))
-        if pair.weighting == "area":
+        penalty = self._auto_penalty(pair, slave, master) if pair.penalty == "auto" else pair.penalty
+        if pair.weighting == "area" or pair.penalty == "auto":
             if slave[1] not in smesh.face_sets:
-                raise ValueError(f"contact {pair.name}: 'area' weighting needs a face set named {slave[1]!r}")
-            eps = pair.penalty * area
+                raise ValueError(f"contact {pair.name}: area weighting needs a face set named {slave[1]!r}")
+            eps = penalty * area
         else:
-            eps = np.full(len(slaves), pair.penalty)
+            eps = np.full(len(slaves), float(penalty))
         mu = float(getattr(pair, "friction", 0.0) or 0.0)
-        ratio = (pair.tangential_penalty / pair.penalty) if getattr(pair, "tangential_penalty", None) else 1.0
+        ratio = (pair.tangential_penalty / penalty) if getattr(pair, "tangential_penalty", None) else 1.0
         eps_t = eps * ratio
+        extra = {"mu": mu, "eps_t": eps_t, "augmented": pair.method == "augmented",
+                 "max_aug": pair.max_augmentations}
         mmesh, moff = self._mesh_of(master[0])
         if mmesh is None:
             rb = next(r for r in self.problem.rigid if r.name == master[0])
-            return Pass(name, slaves, eps, area, analytic=_analytic_surface(rb), mu=mu, eps_t=eps_t)
-        faces = mmesh.face_sets[master[1]] + moff
-        return Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=self.n_ext), mu=mu, eps_t=eps_t)
+            h = float(np.mean(facet_sizes(X, smesh.face_sets[slave[1]] + soff))) if slave[1] in smesh.face_sets \
+                else 1.0
+            p = Pass(name, slaves, eps, area, analytic=_analytic_surface(rb), **extra)
+        else:
+            faces = mmesh.face_sets[master[1]] + moff
+            h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)
+            p = Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=self.n_ext), **extra)
+        if p.augmented:
+            p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
+        return p
 
     # -- positions ------------------------------------------------------------------------------
     def rigid_positions(self, lam: float) -> np.ndarray:
@@ -352,11 +388,14 @@ class ContactManager:
     def save_state(self) -> None:
         for p in self.passes:
             p.saved = (p.prev_facet.copy(), p.prev_xi.copy())
+            p.lam_saved = p.lam_mult.copy()
+            p.n_aug = 0
 
     def restore_state(self) -> None:
         for p in self.passes:
             if p.saved is not None:
                 p.prev_facet, p.prev_xi = p.saved[0].copy(), p.saved[1].copy()
+            p.lam_mult = p.lam_saved.copy()
             p.cand = None
 
     def commit(self) -> None:
@@ -368,6 +407,22 @@ class ContactManager:
                 p.hist[open_] = 0.0  # a node that lost contact starts again without history
                 p.hist_facet = p.prev_facet.copy()
                 p.x_conv = self._x_last.copy() if self._x_last is not None else None
+
+    def augment(self) -> bool:
+        """Uzawa update lambda <- <lambda + eps_N g> of every augmented pass whose largest penetration
+        exceeds its tolerance (at most ``max_aug`` times per step); True when Newton must run again."""
+        again = False
+        for p in self.passes:
+            if not p.augmented or p.n_aug >= p.max_aug:
+                continue
+            pen = float(np.max(-p.g[np.isfinite(p.g)], initial=0.0))
+            if pen <= p.gap_tol:
+                continue
+            g = np.where(np.isfinite(p.g), p.g, 0.0)
+            p.lam_mult = np.minimum(p.lam_mult + p.eps * g, 0.0)
+            p.n_aug += 1
+            again = True
+        return again
 
     def active_count(self) -> int:
         return int(sum(np.count_nonzero(p.g <= 0.0) for p in self.passes))

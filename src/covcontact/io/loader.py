@@ -254,7 +254,19 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             master = body_set(c, "master", "face")
         if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
             c.fail("slave and master are the same rigid body")
-        penalty = c.get("penalty", "float", positive=True)
+        if isinstance(c.data.get("penalty"), str):
+            penalty = c.get("penalty", "str", choices=("auto",))
+        else:
+            penalty = c.get("penalty", "float", positive=True)
+        auto_factor = c.get("auto_factor", "float", 10.0, positive=True)
+        method = c.get("method", "str", "penalty", choices=("penalty", "augmented"))
+        gap_tol = c.get("gap_tolerance", "float", None, positive=True)
+        gap_rel = c.get("gap_tolerance_relative", "float", None, positive=True)
+        max_aug = c.get("max_augmentations", "int", 20, positive=True)
+        if method == "augmented" and gap_tol is None and gap_rel is None:
+            gap_rel = 1e-3
+        if method == "penalty" and (gap_tol is not None or gap_rel is not None):
+            c.fail("gap tolerances need method = \"augmented\"")
         weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area"))
         tangent = c.get("tangent", "str", "a", choices=TANGENT_CASES)
         two_pass = c.get("two_pass", "bool", False)
@@ -262,7 +274,9 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         eps_t = c.get("tangential_penalty", "float", None, positive=True)
         c.done()
         contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass,
-                                    friction=mu, tangential_penalty=eps_t))
+                                    friction=mu, tangential_penalty=eps_t, method=method, gap_tolerance=gap_tol,
+                                    gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
+                                    auto_factor=auto_factor))
 
     steps_sec = top.get("steps", "table", None)
     if steps_sec is None:

@@ -113,3 +113,7 @@ class Model:
 
     def active_set_settled(self) -> bool:
         return True
+
+    def augment(self) -> bool:
+        """One Uzawa update of the augmented-Lagrangian pairs; True when another Newton solve is needed."""
+        return bool(getattr(self.contact, "augment", lambda: False)())

@@ -41,6 +41,7 @@ class StepOutcome:
     records: list[IterationRecord] = field(default_factory=list)
     residual_norms: list[float] = field(default_factory=list)
     reason: str = ""
+    augmentation: int = 0
 
 
 class Newton:
@@ -167,6 +168,17 @@ class Newton:
             except (InvertedElementError, SingularMatrixError) as exc:
                 res = StepOutcome(converged=False, reason=str(exc))
             outcomes.append(res)
+            if res.converged:
+                # augmented Lagrangian: Uzawa updates at the converged state, each followed by Newton
+                augment = 0
+                while res.converged and self.model.augment():
+                    augment += 1
+                    try:
+                        res = self.step(u, target, target)
+                    except (InvertedElementError, SingularMatrixError) as exc:
+                        res = StepOutcome(converged=False, reason=str(exc))
+                    res.augmentation = augment
+                    outcomes.append(res)
             if res.converged:
                 self.model.commit()
                 lam = target

@@ -109,6 +109,9 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
             if conv else [],
             "cutbacks": cutbacks,
         }
+        aug = max((o.augmentation for o in outcomes), default=0)
+        if aug or any(getattr(c, "method", "penalty") == "augmented" for c in problem.contacts):
+            entry["uzawa_iterations"] = sum(1 for o in outcomes if o.augmentation > 0)
         if cutbacks:
             entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
         if success:
