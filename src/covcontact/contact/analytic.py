@@ -11,9 +11,11 @@ being the solid inside the surface; sigma = -1 for a hollow one touched from ins
             axis is the frame axis most nearly perpendicular to the point (so sin theta >= sqrt(2/3),
             far from the poles); n = sigma e_r, a = diag(R^2, R^2 sin^2), h = -sigma a / R.
 
-A rigid master has no dofs: the element acts on the slave node only (3 x 3). Tangent parts: main
-eps H n(x)n, curvature -eps H g h^ij rho_i(x)rho_j, rotational zero, and exact
-eps H (n(x)n + (a^ij - c^ij) rho_i(x)rho_j), the exact Hessian of 1/2 eps <g>^2.
+A rigid master has no dofs: the element acts on the slave node only (3 x 3). With the effective gap
+g_e = g + lam_k / eps (lam_k <= 0 the Uzawa multiplier, 0 for pure penalty; active when g_e <= 0):
+residual eps g_e n, tangent parts main eps H n(x)n, curvature -eps H g_e h^ij rho_i(x)rho_j,
+rotational zero, and exact eps H (n(x)n + g_e/g (a^ij - c^ij) rho_i(x)rho_j), the exact Hessian of
+eps/2 <g_e>^2 = 1/(2 eps) <lam_k + eps g>^2 (c_ij = a_ij - g h_ij with the geometric g).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from covcontact.contact.element import (
     ContactResult,
     _mat2_prod3,
     check_inputs,
+    check_multiplier,
 )
 from covcontact.contact.rigid import RigidMotion
 
@@ -169,12 +172,14 @@ def _add_rr(coef, rho_cov, scale, K):
 
 @njit(cache=True)
 def analytic_core(
-    kind, origin, frame, radius, sigma, xs, eps_n, case, want_parts, xi, R_out, K_out, P_out, work
+    kind, origin, frame, radius, sigma, xs, eps_n, case, want_parts, xi, R_out, K_out, P_out, work, lam_k=0.0
 ):
     """Project ``xs`` and evaluate the 3 x 3 rigid-master contact element; returns (g, chart).
 
     xi: (2,) out. R_out (3,), K_out (3, 3), P_out (4, 3, 3) out (P_out untouched unless want_parts);
-    order of parts as ``PART_NAMES``. ``work[4]`` holds the normal on return.
+    order of parts as ``PART_NAMES``. ``work[4]`` holds the normal on return. lam_k: Uzawa multiplier
+    (<= 0, fixed during Newton; 0 = penalty). g is the geometric gap; outputs are zero when
+    lam_k + eps_n g > 0.
     """
     rho, rho_cov, a_cov, a_con, n, h_cov, h_con, c_con, D1, D2 = work
     g, chart = analytic_geometry(
@@ -187,10 +192,11 @@ def analytic_core(
             if want_parts:
                 for k in range(4):
                     P_out[k, p, q] = 0.0
-    if g > 0.0:
+    ge = g + lam_k / eps_n  # effective gap: lam_N = eps_n ge
+    if ge > 0.0:
         return g, chart
     for p in range(3):
-        R_out[p] = eps_n * g * n[p]
+        R_out[p] = eps_n * ge * n[p]
     _mat2_prod3(a_con, h_cov, a_con, h_con, 1.0)
     c00 = a_cov[0, 0] - g * h_cov[0, 0]
     c01 = a_cov[0, 1] - g * h_cov[0, 1]
@@ -205,8 +211,8 @@ def analytic_core(
         for i in range(2):
             for j in range(2):
                 c_con[i, j] = a_con[i, j]
-    _mat2_prod3(a_con, h_cov, c_con, D1, g)  # c^ij - a^ij
-    _mat2_prod3(a_con, h_cov, D1, D2, -g)  # a^ij - c^ij + g h^ij
+    _mat2_prod3(a_con, h_cov, c_con, D1, ge)  # ge/g (c^ij - a^ij)
+    _mat2_prod3(a_con, h_cov, D1, D2, -g)  # ge/g (a^ij - c^ij + g h^ij)
     for p in range(3):
         for q in range(3):
             K_out[p, q] = eps_n * n[p] * n[q]
@@ -219,24 +225,39 @@ def analytic_core(
             for j in range(2):
                 D1[i, j] = -D1[i, j]
     elif case == CASE_A or case == CASE_C:
-        _add_rr(h_con, rho_cov, -eps_n * g, K_out)
+        _add_rr(h_con, rho_cov, -eps_n * ge, K_out)
     if want_parts:
         for p in range(3):
             for q in range(3):
                 P_out[0, p, q] = eps_n * n[p] * n[q]
-        _add_rr(h_con, rho_cov, -eps_n * g, P_out[2])
+        _add_rr(h_con, rho_cov, -eps_n * ge, P_out[2])
         _add_rr(D2, rho_cov, eps_n, P_out[3])
     return g, chart
 
 
 @njit(cache=True, parallel=True)
 def analytic_batch(
-    kind, origin, frame, radius, sigma, xs, eps, case, R_out, K_out, g_out, xi_out, n_out, chart_out
+    kind,
+    origin,
+    frame,
+    radius,
+    sigma,
+    xs,
+    eps,
+    case,
+    R_out,
+    K_out,
+    g_out,
+    xi_out,
+    n_out,
+    chart_out,
+    lam_k=None,
 ):
     """Many slave points (ns, 3) against one analytic surface, parallel over slaves.
 
     eps: (ns,) penalties (already weighted). Outputs: R_out (ns, 3), K_out (ns, 3, 3), g_out (ns,),
-    xi_out (ns, 2), n_out (ns, 3), chart_out (ns,) int64.
+    xi_out (ns, 2), n_out (ns, 3), chart_out (ns,) int64. lam_k: (ns,) Uzawa multipliers (<= 0),
+    None (default): pure penalty.
     """
     ns = xs.shape[0]
     nchunk = (ns + _CHUNK - 1) // _CHUNK
@@ -246,6 +267,9 @@ def analytic_batch(
         lo = c * _CHUNK
         hi = min(ns, lo + _CHUNK)
         for s in range(lo, hi):
+            lk = 0.0
+            if lam_k is not None:
+                lk = lam_k[s]
             g, chart = analytic_core(
                 kind,
                 origin,
@@ -261,6 +285,7 @@ def analytic_batch(
                 K_out[s],
                 dummy,
                 work,
+                lk,
             )
             g_out[s] = g
             chart_out[s] = chart
@@ -343,9 +368,15 @@ class _Analytic:
         )
         return AnalyticProjection(float(g), xi, int(chart), rho, rc, a, h, n)
 
-    def contact(self, slave_xyz, eps_n, parts: str = "a", lam: float = 1.0) -> ContactResult:
-        """Contact element of one slave node (3 x 3, slave dofs only); see ``ContactResult``."""
+    def contact(
+        self, slave_xyz, eps_n, parts: str = "a", lam: float = 1.0, multiplier: float = 0.0
+    ) -> ContactResult:
+        """Contact element of one slave node (3 x 3, slave dofs only); see ``ContactResult``.
+
+        lam is the load factor of the motion; multiplier the Uzawa multiplier lam_k <= 0 (0: penalty).
+        """
         xs, eps, case, _ = check_inputs(slave_xyz, eps_n, parts, None)
+        lam_k = check_multiplier(multiplier)
         origin, frame = self.placement(lam)
         work = new_analytic_work()
         xi, R, K, P = np.zeros(2), np.zeros(3), np.zeros((3, 3)), np.zeros((4, 3, 3))
@@ -364,6 +395,7 @@ class _Analytic:
             K,
             P,
             work,
+            lam_k,
         )
         return ContactResult(
             gap=float(g),
@@ -375,8 +407,12 @@ class _Analytic:
             parts={name: P[k] for k, name in enumerate(PART_NAMES)},
         )
 
-    def evaluate(self, slave_xyz, eps, parts: str = "a", lam: float = 1.0) -> AnalyticBatch:
-        """Compiled batch over slave points (ns, 3) with penalties ``eps`` (scalar or (ns,))."""
+    def evaluate(self, slave_xyz, eps, parts: str = "a", lam: float = 1.0, multiplier=None) -> AnalyticBatch:
+        """Compiled batch over slave points (ns, 3) with penalties ``eps`` (scalar or (ns,)).
+
+        lam: load factor of the motion. multiplier: Uzawa multipliers lam_k <= 0 (scalar or (ns,));
+        None: pure penalty.
+        """
         xs = np.ascontiguousarray(np.asarray(slave_xyz, dtype=np.float64))
         if xs.ndim != 2 or xs.shape[1] != 3:
             raise ValueError(f"slave_xyz must have shape (ns, 3), got {xs.shape}")
@@ -385,6 +421,11 @@ class _Analytic:
         _, _, case, _ = check_inputs(np.zeros(3), 1.0, parts, None)
         if not (np.all(np.isfinite(xs)) and np.all(np.isfinite(e)) and np.all(e > 0.0)):
             raise ValueError("slave_xyz must be finite and eps positive")
+        lk = None
+        if multiplier is not None:
+            lk = np.ascontiguousarray(np.broadcast_to(np.asarray(multiplier, dtype=np.float64), (ns,)))
+            if not (np.all(np.isfinite(lk)) and np.all(lk <= 0.0)):
+                raise ValueError("multiplier must be finite and <= 0")
         origin, frame = self.placement(lam)
         out = AnalyticBatch(
             np.zeros(ns),
@@ -410,6 +451,7 @@ class _Analytic:
                 out.xi,
                 out.normal,
                 out.chart,
+                lk,
             )
         return out
 

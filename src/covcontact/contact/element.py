@@ -1,18 +1,25 @@
 """Covariant node-to-surface contact element: one slave node against one master facet.
 
-Implements FORMULATION.md sections 3-4 (penalty, internal-force convention). Dof order: the n
-master nodes first, the slave node last (paper eq. 14); dof of block b, direction p is 3 b + p.
+Implements FORMULATION.md sections 3-4 (penalty or augmented Lagrangian normal law,
+internal-force convention). Dof order: the n master nodes first, the slave node last (paper eq. 14);
+dof of block b, direction p is 3 b + p.
+
+Normal law: with the multiplier lam_k <= 0 of the last Uzawa update (0 for pure penalty) the
+effective gap is g_e = g + lam_k / eps, the traction lam_N = eps <g_e> = <lam_k + eps g> and the
+energy W = eps/2 <g_e>^2 = 1/(2 eps) <lam_k + eps g>^2; the pair is active when g_e <= 0 (also at a
+small positive geometric gap g when lam_k < 0).
 
 With alpha_b = -N_b (master), 1 (slave) and beta_ib = -N_b,i (master), 0 (slave), the position
 matrices are A = [alpha_b I] and A_,i = [beta_ib I], and every tangent part has the block form
 
     K_bc = eps H [ alpha_b alpha_c (c_nn n(x)n + M^ij rho_i(x)rho_j)
-                   + g (alpha_c n(x)u_b + alpha_b u_c(x)n) - g^2 s_bc n(x)n ],
+                   + g_e (alpha_c n(x)u_b + alpha_b u_c(x)n) - g_e g s_bc n(x)n ],
     u_b = beta_ib W^ij rho_j,   s_bc = beta_ib S^ij beta_jc
 
-with (c_nn, M, W, S) = main (1, 0, 0, 0), rotational (0, 0, a^ij, 0), curvature (0, -g h^ij, 0, 0),
-second order (0, a^ij - c^ij + g h^ij, c^ij - a^ij, c^ij); their sum is the exact Hessian of
-1/2 eps <g>^2 (c_ij = a_ij - g h_ij).
+with (c_nn, M, W, S) = main (1, 0, 0, 0), rotational (0, 0, a^ij, 0), curvature (0, -g_e h^ij, 0, 0),
+second order (0, g_e/g (a^ij - c^ij + g h^ij), c^ij - a^ij, c^ij); their sum is the exact Hessian
+eps H grad g (x) grad g + lam_N hess g of W (c_ij = a_ij - g h_ij with the geometric g). For lam_k = 0,
+g_e = g and this is the penalty element of 1/2 eps <g>^2, bit for bit.
 """
 
 from __future__ import annotations
@@ -68,12 +75,16 @@ def new_work():
         np.empty((2, 2)),  # 17 Mc
         np.empty((2, 2)),  # 18 Wc
         np.empty((2, 2)),  # 19 Sc
+        np.empty((2, 2)),  # 20 D1 with the effective gap, g_e a^ik h_kl c^lj
     )
 
 
 @njit(cache=True)
-def add_terms(nb, alpha, beta, n, rho_cov, g, c_nn, Mc, Wc, Sc, use_w, use_s, scale, K, u, M):
-    """K += scale * (block form of the module docstring) for coefficient tensors Mc, Wc, Sc."""
+def add_terms(nb, alpha, beta, n, rho_cov, g, ge, c_nn, Mc, Wc, Sc, use_w, use_s, scale, K, u, M):
+    """K += scale * (block form of the module docstring) for coefficient tensors Mc, Wc, Sc.
+
+    g: geometric gap; ge: effective gap g + lam_k / eps (ge = g for pure penalty).
+    """
     for p in range(3):
         for q in range(3):
             M[p, q] = c_nn * n[p] * n[q]
@@ -100,15 +111,18 @@ def add_terms(nb, alpha, beta, n, rho_cov, g, c_nn, Mc, Wc, Sc, use_w, use_s, sc
                 for q in range(3):
                     v = ab * M[p, q]
                     if use_w:
-                        v += g * (alpha[c] * n[p] * u[b, q] + alpha[b] * u[c, p] * n[q])
+                        v += ge * (alpha[c] * n[p] * u[b, q] + alpha[b] * u[c, p] * n[q])
                     if use_s:
-                        v -= g * g * sbc * n[p] * n[q]
+                        v -= ge * g * sbc * n[p] * n[q]
                     K[3 * b + p, 3 * c + q] += scale * v
 
 
 @njit(cache=True)
-def _set_coeffs(which, g, a_con, h_con, c_con, D1, D2, Mc, Wc, Sc):
-    """Coefficients (c_nn, use_w, use_s) and Mc, Wc, Sc of a case (0-4) or a part (10 + index)."""
+def _set_coeffs(which, ge, a_con, h_con, c_con, D1, D1e, D2, Mc, Wc, Sc):
+    """Coefficients (c_nn, use_w, use_s) and Mc, Wc, Sc of a case (0-4) or a part (10 + index).
+
+    ge: effective gap; D1 = c^ij - a^ij, D1e = ge/g D1, D2 = ge/g (a^ij - c^ij + g h^ij).
+    """
     c_nn = 0.0
     use_w = False
     use_s = False
@@ -127,7 +141,7 @@ def _set_coeffs(which, g, a_con, h_con, c_con, D1, D2, Mc, Wc, Sc):
         use_s = True
         for i in range(2):
             for j in range(2):
-                Mc[i, j] = -D1[i, j]
+                Mc[i, j] = -D1e[i, j]
                 Wc[i, j] = c_con[i, j]
                 Sc[i, j] = c_con[i, j]
     if rot:
@@ -138,7 +152,7 @@ def _set_coeffs(which, g, a_con, h_con, c_con, D1, D2, Mc, Wc, Sc):
     if curv:
         for i in range(2):
             for j in range(2):
-                Mc[i, j] = -g * h_con[i, j]
+                Mc[i, j] = -ge * h_con[i, j]
     if which == 13:
         use_w = True
         use_s = True
@@ -166,7 +180,7 @@ def _mat2_prod3(A, B, C, out, fac):
 
 
 @njit(cache=True)
-def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out, work):
+def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out, work, lam_k=0.0):
     """Residual and tangent of one slave node against one facet at the converged projection.
 
     Args:
@@ -176,9 +190,11 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
         want_parts: also fill P_out[0..3] with main, rotational, curvature, second order.
         R_out: (3(n+1),) out. K_out: (3(n+1), 3(n+1)) out. P_out: (4, 3(n+1), 3(n+1)) out, or any
             array when ``want_parts`` is False. work: tuple from ``new_work``.
+        lam_k: normal multiplier (<= 0) of the last Uzawa update, fixed during Newton; 0 = penalty.
 
     Returns:
-        g = (r_s - rho) . n; +inf at a degenerate facet point. Outputs are zero when g > 0.
+        g = (r_s - rho) . n (geometric); +inf at a degenerate facet point. Outputs are zero when
+        lam_k + eps_n g > 0.
     """
     (
         N,
@@ -201,6 +217,7 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
         Mc,
         Wc,
         Sc,
+        D1e,
     ) = work
     nen = xyz.shape[0]
     nb = nen + 1
@@ -218,7 +235,8 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
     if area == 0.0:
         return np.inf
     g = (xs[0] - rho[0]) * n[0] + (xs[1] - rho[1]) * n[1] + (xs[2] - rho[2]) * n[2]
-    if g > 0.0:
+    ge = g + lam_k / eps_n  # effective gap: lam_N = eps_n ge
+    if ge > 0.0:
         return g
     for k in range(nen):
         alpha[k] = -N[k]
@@ -229,8 +247,9 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
     beta[1, nen] = 0.0
     for b in range(nb):
         for p in range(3):
-            R_out[3 * b + p] = eps_n * g * alpha[b] * n[p]
-    # h^ij, c^ij = (a_ij - g h_ij)^-1, D1 = c^ij - a^ij = g a^ik h_kl c^lj, D2 = -g a^ik h_kl D1^lj
+            R_out[3 * b + p] = eps_n * ge * alpha[b] * n[p]
+    # h^ij, c^ij = (a_ij - g h_ij)^-1, D1 = c^ij - a^ij = g a^ik h_kl c^lj, D1e = ge a^ik h_kl c^lj,
+    # D2 = -g a^ik h_kl D1e^lj
     for i in range(2):
         for j in range(2):
             s = 0.0
@@ -252,24 +271,28 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
             for j in range(2):
                 c_con[i, j] = a_con[i, j]
     _mat2_prod3(a_con, h_cov, c_con, D1, g)
-    _mat2_prod3(a_con, h_cov, D1, D2, -g)
-    c_nn, use_w, use_s = _set_coeffs(case, g, a_con, h_con, c_con, D1, D2, Mc, Wc, Sc)
-    add_terms(nb, alpha, beta, n, rho_cov, g, c_nn, Mc, Wc, Sc, use_w, use_s, eps_n, K_out, u, M)
+    _mat2_prod3(a_con, h_cov, c_con, D1e, ge)
+    _mat2_prod3(a_con, h_cov, D1e, D2, -g)
+    c_nn, use_w, use_s = _set_coeffs(case, ge, a_con, h_con, c_con, D1, D1e, D2, Mc, Wc, Sc)
+    add_terms(nb, alpha, beta, n, rho_cov, g, ge, c_nn, Mc, Wc, Sc, use_w, use_s, eps_n, K_out, u, M)
     if want_parts:
         for k in range(4):
-            c_nn, use_w, use_s = _set_coeffs(10 + k, g, a_con, h_con, c_con, D1, D2, Mc, Wc, Sc)
-            add_terms(nb, alpha, beta, n, rho_cov, g, c_nn, Mc, Wc, Sc, use_w, use_s, eps_n, P_out[k], u, M)
+            c_nn, use_w, use_s = _set_coeffs(10 + k, ge, a_con, h_con, c_con, D1, D1e, D2, Mc, Wc, Sc)
+            add_terms(
+                nb, alpha, beta, n, rho_cov, g, ge, c_nn, Mc, Wc, Sc, use_w, use_s, eps_n, P_out[k], u, M
+            )
     return g
 
 
 @njit(cache=True)
-def contact_element(xyz, xs, xi, eps_n, case, want_parts, R_out, K_out, P_out):
+def contact_element(xyz, xs, xi, eps_n, case, want_parts, R_out, K_out, P_out, lam_k=0.0):
     """Compiled single-pair entry point: ``element_core`` with its own scratch arrays.
 
-    xi: (2,) converged projection. Returns g (see ``element_core``).
+    xi: (2,) converged projection. lam_k: Uzawa multiplier (0 = penalty). Returns g (see
+    ``element_core``).
     """
     work = new_work()
-    return element_core(xyz, xs, xi[0], xi[1], eps_n, case, want_parts, R_out, K_out, P_out, work)
+    return element_core(xyz, xs, xi[0], xi[1], eps_n, case, want_parts, R_out, K_out, P_out, work, lam_k)
 
 
 @dataclass
@@ -281,7 +304,8 @@ class ContactResult:
         xi: (2,) projection in the master's coordinates.
         normal: (3,) unit outward normal of the master at xi.
         inside: whether the projection lies on the facet (|xi^i| <= 1 + INSIDE_TOL).
-        residual: (m,) eps_N <g> A^T n, internal-force convention.
+        residual: (m,) lam_N A^T n, lam_N = <lam_k + eps_N g> (eps_N <g> for pure penalty),
+            internal-force convention.
         tangent: (m, m) tangent of the requested case.
         parts: "main", "rotational", "curvature", "second_order" matrices.
         status: projection status (0 converged, 1 not converged).
@@ -319,7 +343,15 @@ def check_inputs(slave_xyz, eps_n, parts, xi0):
     return xs, eps, CASES[parts], xi0
 
 
-def node_to_surface(master_xyz, slave_xyz, eps_n, parts="a", xi0=None) -> ContactResult:
+def check_multiplier(multiplier):
+    """Validate a Uzawa multiplier (finite, <= 0); returns it as float."""
+    lk = float(multiplier)
+    if not np.isfinite(lk) or lk > 0.0:
+        raise ValueError(f"multiplier must be a finite number <= 0, got {multiplier!r}")
+    return lk
+
+
+def node_to_surface(master_xyz, slave_xyz, eps_n, parts="a", xi0=None, multiplier=0.0) -> ContactResult:
     """Contact of one slave node against one quad4/quad9 master facet (INTERFACE.md section 4).
 
     Args:
@@ -328,12 +360,14 @@ def node_to_surface(master_xyz, slave_xyz, eps_n, parts="a", xi0=None) -> Contac
         eps_n: penalty parameter (> 0).
         parts: tangent case "a", "b", "c", "d" or "exact".
         xi0: (2,) projection start; default the natural coordinates of the nearest facet node.
+        multiplier: augmented Lagrangian multiplier lam_k <= 0 of the last Uzawa update (0: penalty).
 
     Returns:
-        ContactResult; residual and tangent are zero when g > 0.
+        ContactResult; residual and tangent are zero when multiplier + eps_n g > 0.
     """
     xyz = _as_points(master_xyz, lambda s: s in ((4, 3), (9, 3)), "master_xyz (expected (4, 3) or (9, 3))")
     xs, eps, case, xi = check_inputs(slave_xyz, eps_n, parts, xi0)
+    lam_k = check_multiplier(multiplier)
     nen = xyz.shape[0]
     if xi is None:
         k = int(np.argmin(np.sum((xyz - xs) ** 2, axis=1)))
@@ -345,7 +379,7 @@ def node_to_surface(master_xyz, slave_xyz, eps_n, parts="a", xi0=None) -> Contac
     R = np.zeros(m)
     K = np.zeros((m, m))
     P = np.zeros((4, m, m))
-    g = contact_element(xyz, xs, xi, eps, case, True, R, K, P)
+    g = contact_element(xyz, xs, xi, eps, case, True, R, K, P, lam_k)
     nrm = np.zeros(3)
     facet_geometry(
         xyz,

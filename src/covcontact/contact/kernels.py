@@ -6,7 +6,10 @@ Case codes (``case`` argument), as in ``element.CASES``:
 - ``CASE_B`` (1): main + rotational;
 - ``CASE_C`` (2): main + curvature;
 - ``CASE_D`` (3): main only;
-- ``CASE_EXACT`` (4): exact Hessian of the penalty energy (adds the second-order terms).
+- ``CASE_EXACT`` (4): exact Hessian of the contact energy (adds the second-order terms).
+
+Normal law: penalty, or augmented Lagrangian with the per-pair Uzawa multipliers ``lam_k`` (see
+``element``).
 
 Parts in ``P_out[:, k]`` follow ``PART_NAMES``: 0 main, 1 rotational, 2 curvature, 3 second order.
 """
@@ -34,7 +37,9 @@ _CHUNK = 16
 
 
 @njit(cache=True, parallel=True)
-def contact_batch(x_nodes, facet_conn, slave_ids, xi, eps, case, want_parts, R_out, K_out, P_out, g_out):
+def contact_batch(
+    x_nodes, facet_conn, slave_ids, xi, eps, case, want_parts, R_out, K_out, P_out, g_out, lam_k=None
+):
     """Residuals and tangents of npair slave-facet pairs of one facet type, parallel over pairs.
 
     Args:
@@ -47,7 +52,10 @@ def contact_batch(x_nodes, facet_conn, slave_ids, xi, eps, case, want_parts, R_o
         want_parts: fill P_out with the four parts.
         R_out: (npair, 3(n+1)) out. K_out: (npair, 3(n+1), 3(n+1)) out.
         P_out: (npair, 4, 3(n+1), 3(n+1)) out, or a dummy (e.g. (1, 4, 1, 1)) if not want_parts.
-        g_out: (npair,) out, gaps (+inf at a degenerate facet point; zero R, K when g > 0).
+        g_out: (npair,) out, geometric gaps (+inf at a degenerate facet point; zero R, K when
+            lam_k + eps g > 0).
+        lam_k: (npair,) augmented Lagrangian multipliers (<= 0) of the last Uzawa update, held
+            fixed during Newton; None (default) or zeros: pure penalty.
 
     Local dof order of a pair: the n master nodes, then the slave (paper eq. 14).
     """
@@ -67,11 +75,14 @@ def contact_batch(x_nodes, facet_conn, slave_ids, xi, eps, case, want_parts, R_o
             s = slave_ids[k]
             for p in range(3):
                 xs[p] = x_nodes[s, p]
+            lk = 0.0
+            if lam_k is not None:
+                lk = lam_k[k]
             if want_parts:
                 g_out[k] = element_core(
-                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, True, R_out[k], K_out[k], P_out[k], work
+                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, True, R_out[k], K_out[k], P_out[k], work, lk
                 )
             else:
                 g_out[k] = element_core(
-                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, False, R_out[k], K_out[k], P_out[0], work
+                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, False, R_out[k], K_out[k], P_out[0], work, lk
                 )

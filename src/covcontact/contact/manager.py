@@ -218,7 +218,7 @@ class ContactManager:
         ok = res.kind != 0
         p.prev_facet = np.where(ok, res.facet, -1)
         p.prev_xi = np.where(ok[:, None], res.xi, 0.0)
-        active = ok & (res.g <= 0.0)
+        active = ok & (res.g + p.lam_mult / p.eps <= 0.0)
         return res, active
 
     def _dofs(self, nodes: np.ndarray) -> np.ndarray:
@@ -257,7 +257,8 @@ class ContactManager:
             K = np.zeros((idx.size, nd, nd))
             P = np.zeros((idx.size, 4, nd, nd)) if want_parts else np.zeros((1, 4, 1, 1))
             g = np.zeros(idx.size)
-            contact_batch(xe, conn, sl, xi, eps, case, want_parts, R, K, P, g)
+            lam_k = np.ascontiguousarray(p.lam_mult[idx]) if p.augmented else None
+            contact_batch(xe, conn, sl, xi, eps, case, want_parts, R, K, P, g, lam_k)
             if p.mu > 0.0 and not want_parts:
                 R, K, g = self._facet_friction(p, xe, idx, conn, sl, xi, eps)
             p.g[idx] = g
@@ -324,7 +325,8 @@ class ContactManager:
     def _analytic_pass(self, p: Pass, xe, case, want_K, want_parts, r, rows, cols, vals, parts_acc):
         xs = np.ascontiguousarray(xe[p.slaves])
         parts = {v: k for k, v in CASES.items()}[case]
-        out = p.analytic.evaluate(xs, p.eps, parts=parts, lam=self.lam)
+        mult = p.lam_mult if p.augmented else None
+        out = p.analytic.evaluate(xs, p.eps, parts=parts, lam=self.lam, multiplier=mult)
         if p.mu > 0.0 and not want_parts:
             ns = len(xs)
             origin, frame = p.analytic.placement(self.lam)
@@ -342,7 +344,7 @@ class ContactManager:
             p.hist_trial[:] = hist_out
             p.state[:] = state
         p.g = out.gap
-        active = out.gap <= 0.0
+        active = out.gap + p.lam_mult / p.eps <= 0.0
         p.force = -out.residual
         idx = np.flatnonzero(active)
         if idx.size == 0:
@@ -350,9 +352,9 @@ class ContactManager:
         dofs = self._dofs(p.slaves[idx][:, None])
         self._scatter(dofs, out.residual[idx], out.tangent[idx] if want_K else None, r, rows, cols, vals)
         if want_parts:
-            d = p.analytic.evaluate(xs, p.eps, parts="d", lam=self.lam)
-            c = p.analytic.evaluate(xs, p.eps, parts="c", lam=self.lam)
-            e = p.analytic.evaluate(xs, p.eps, parts="exact", lam=self.lam)
+            d = p.analytic.evaluate(xs, p.eps, parts="d", lam=self.lam, multiplier=mult)
+            c = p.analytic.evaluate(xs, p.eps, parts="c", lam=self.lam, multiplier=mult)
+            e = p.analytic.evaluate(xs, p.eps, parts="exact", lam=self.lam, multiplier=mult)
             zero = np.zeros_like(r)
             self._scatter(dofs, np.zeros((idx.size, 3)), d.tangent[idx], zero, *parts_acc[0])
             self._scatter(dofs, np.zeros((idx.size, 3)), c.tangent[idx] - d.tangent[idx], zero, *parts_acc[2])
@@ -424,13 +426,17 @@ class ContactManager:
             again = True
         return again
 
+    @staticmethod
+    def _active(p: Pass) -> np.ndarray:
+        return p.g + p.lam_mult / p.eps <= 0.0
+
     def active_count(self) -> int:
-        return int(sum(np.count_nonzero(p.g <= 0.0) for p in self.passes))
+        return int(sum(np.count_nonzero(self._active(p)) for p in self.passes))
 
     def coupled_dofs(self) -> np.ndarray:
         nodes = []
         for p in self.passes:
-            act = p.g <= 0.0
+            act = self._active(p)
             nodes.append(p.slaves[act])
             if p.surface is not None:
                 f = p.prev_facet[act]
@@ -453,12 +459,15 @@ class ContactManager:
             p.g, p.force, p.state = kept
         pairs = {}
         for p in self.passes:
-            act = p.g <= 0.0
+            act = self._active(p)
             pairs[p.name] = {"active_contacts": int(act.sum()),
                              **({"stick": int(np.count_nonzero(act & (p.state == STICK))),
                                  "slip": int(np.count_nonzero(act & (p.state == SLIP)))} if p.mu > 0 else {}),
                              "min_gap": float(p.g.min()) if len(p.g) and np.isfinite(p.g.min()) else None,
-                             "contact_force": p.force[act].sum(axis=0).tolist()}
+                             "contact_force": p.force[act].sum(axis=0).tolist(),
+                             **({"augmentations": p.n_aug, "max_penetration": float(np.max(-p.g[act],
+                                                                                            initial=0.0))}
+                                if p.augmented else {})}
         total_force = np.sum([v["contact_force"] for v in pairs.values()], axis=0).tolist()
         gaps = [v["min_gap"] for v in pairs.values() if v["min_gap"] is not None]
         return {"active_contacts": self.active_count(), "min_gap": min(gaps) if gaps else None,
@@ -472,7 +481,7 @@ class ContactManager:
             s = p.slaves
             sel = s < n
             gap[s[sel]] = np.where(np.isfinite(p.g[sel]), p.g[sel], np.nan)
-            act = (p.g <= 0.0)
+            act = self._active(p)
             status[s[sel]] = np.where(act[sel], 1.0, 0.0)
             fn = np.linalg.norm(p.force, axis=1) / np.maximum(p.area, 1e-300)
             pressure[s[sel]] = np.where(act[sel], fn[sel], 0.0)
