@@ -107,19 +107,15 @@ def make_solver(name: str = "auto", symmetric: bool = True, **options) -> Linear
         **options: backend options (``check_tol`` for all; ``spd``/``matching`` for pardiso;
             ``ordering`` for mumps; ``rtol``/``maxiter`` for cg-amg).
     """
-    here = available()
     key = name.lower().strip()
-    if key == "auto":
-        for cand in here:
-            if cand in _DIRECT and (symmetric or cand != "cholmod"):
-                key = cand
-                break
+    if key == "auto":  # probe lazily: importing every optional backend costs time
+        key = next(c for c in _DIRECT if (symmetric or c != "cholmod") and _probe(c)[0])
     if key not in BACKENDS:
-        raise ValueError(f"unknown linear solver {name!r}; available here: {', '.join(here)}")
-    if key not in here:
+        raise ValueError(f"unknown linear solver {name!r}; available here: {', '.join(available())}")
+    if not _probe(key)[0]:
         raise ValueError(
             f"linear solver {name!r} is not available here ({_probe(key)[2]}); "
-            f"available: {', '.join(here)}"
+            f"available: {', '.join(available())}"
         )
     if key == "cholmod" and not symmetric:
         raise ValueError("cholmod factorises symmetric matrices only; use pardiso, mumps or superlu")

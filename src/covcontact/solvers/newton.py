@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..assembly.system import InvertedElementError
-from .linear import SingularMatrixError, make_solver
+from .linear import LinearSolverError, SingularMatrixError, make_solver
 
 
 class StepFailed(RuntimeError):
@@ -165,7 +165,7 @@ class Newton:
             self.model.save_state()
             try:
                 res = self.step(u, lam, target)
-            except (InvertedElementError, SingularMatrixError) as exc:
+            except (InvertedElementError, LinearSolverError) as exc:
                 res = StepOutcome(converged=False, reason=str(exc))
             outcomes.append(res)
             if res.converged:
@@ -175,7 +175,7 @@ class Newton:
                     augment += 1
                     try:
                         res = self.step(u, target, target)
-                    except (InvertedElementError, SingularMatrixError) as exc:
+                    except (InvertedElementError, LinearSolverError) as exc:
                         res = StepOutcome(converged=False, reason=str(exc))
                     res.augmentation = augment
                     outcomes.append(res)
