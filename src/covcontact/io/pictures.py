@@ -106,6 +106,10 @@ def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title:
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     x, mag, quads, rigid = state
+    tol = 1e-3 * float((hi - lo).max())
+    inside = np.all((x[quads] >= lo - tol) & (x[quads] <= hi + tol), axis=(1, 2))
+    keep = ~rigid | inside  # rigid faces leaving the frame are left out (matplotlib does not clip in 3D)
+    quads, rigid = quads[keep], rigid[keep]
     polys = x[quads]
     cmap = matplotlib.colormaps["viridis"]
     norm = matplotlib.colors.Normalize(0.0, vmax)
