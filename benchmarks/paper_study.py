@@ -143,8 +143,8 @@ def table1(rec: dict, cases: tuple[str, ...] = ("a", "b", "d")) -> str:
 
 def summary_table(record: dict) -> str:
     """Totals per study and case, the largest eps, and the wall time per case."""
-    lines = ["| study | variant | dofs | a | b | c | d | exact | eps rot. max % | eps curv. max % | "
-             "wall time per case, s (a / b / c / d / exact) |", "|" + "---|" * 11]
+    lines = [("| study | variant | dofs | a | b | c | d | exact | eps rot. max % | eps curv. max % | "
+              "wall time per case, s (a / b / c / d / exact) |"), "|" + "---|" * 11]
     for rec in record["studies"]:
         cs = rec["cases"]
         tot = [str(cs[c]["total_iterations"]) + ("" if cs[c]["converged"] else " (failed)") if c in cs else "-"
@@ -178,8 +178,9 @@ def main(argv: list[str] | None = None) -> int:
         merged = {"studies": [rec for path in args.report for rec in json.loads(Path(path).read_text())["studies"]]}
         print(report(merged))
         return 0
-    from covcontact import __version__
     from numba import get_num_threads
+
+    from covcontact import __version__
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

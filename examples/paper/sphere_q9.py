@@ -21,8 +21,17 @@ from pathlib import Path
 from covcontact.elements.solidshell import check_options
 from covcontact.materials import SaintVenantKirchhoff
 from covcontact.mesh.generators import plate, sphere_patch
-from covcontact.problem import (Body, ContactPair, Dirichlet, NodalForce, OutputOptions, Problem, RigidBody,
-                                SolverOptions, Steps)
+from covcontact.problem import (
+    Body,
+    ContactPair,
+    Dirichlet,
+    NodalForce,
+    OutputOptions,
+    Problem,
+    RigidBody,
+    SolverOptions,
+    Steps,
+)
 
 SPHERE_CENTRE = (30.3, 20.3, -30.001)   # top 1e-3 mm below the plate, off the plate's node grid
 
