@@ -135,6 +135,7 @@ class SolverOptions:
     rtol: float = 1e-8
     atol: float = 1e-12
     etol: float = 1e-16
+    criterion: str = "residual"
     max_cutbacks: int = 6
     line_search: bool = False
     divergence_factor: float = 1e4

@@ -21,10 +21,10 @@ RIGID_SHAPES = ("plane", "cylinder", "sphere", "mesh")
 
 
 def _generators() -> dict:
-    from ..mesh import generators
+    from ..mesh import generators, generators_solid
 
-    return {name: fn for name, fn in vars(generators).items()
-            if inspect.isfunction(fn) and not name.startswith("_") and fn.__module__ == generators.__name__
+    return {name: fn for mod in (generators, generators_solid) for name, fn in vars(mod).items()
+            if inspect.isfunction(fn) and not name.startswith("_") and fn.__module__ == mod.__name__
             and "cell" in inspect.signature(fn).parameters}
 
 
@@ -302,6 +302,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             rtol=s.get("rtol", "float", solver.rtol, positive=True),
             atol=s.get("atol", "float", solver.atol, nonnegative=True),
             etol=s.get("etol", "float", solver.etol, nonnegative=True),
+            criterion=s.get("criterion", "str", solver.criterion, choices=("residual", "energy", "both")),
             max_cutbacks=s.get("max_cutbacks", "int", solver.max_cutbacks, nonnegative=True),
             line_search=s.get("line_search", "bool", solver.line_search),
             divergence_factor=s.get("divergence_factor", "float", solver.divergence_factor, positive=True),

@@ -2,11 +2,18 @@
 
 One step goes from load factor lam_a to lam_b. The first iteration is a predictor with the tangent at the
 converged state and the prescribed displacement increment on the right-hand side (-R - K_fd du_d); the
-remaining iterations are plain Newton with homogeneous Dirichlet conditions. A step converges when
+remaining iterations are plain Newton with homogeneous Dirichlet conditions. Convergence criteria
+(``SolverOptions.criterion``):
 
-    ||R_free|| <= max(rtol * ||R_0||, atol * F)   and   |du_k . R_(k-1)| <= etol * |du_1 . R_0|
+- ``"residual"`` (default): ||R_k|| <= max(rtol * max(||R_0||, ||R_1||), atol * F), with R_0 the
+  predictor's right-hand side (for a load step: the load increment), R_1 the out-of-balance after the
+  predictor and F a force scale of the step (loads, reactions);
+- ``"energy"``: |du_k . R_(k-1)| <= etol * |du_1 . R_0| (the energy norm of FEAP-like codes; it measures
+  the residual of the previous iteration, so it needs one iteration more than the residual test);
+- ``"both"``: both.
 
-with R_0 the predictor's right-hand side and F a force scale of the step. A step that diverges, runs out of
+Whatever the criterion, a step also converges on the round-off floor: the energy criterion holds and the
+residual stopped falling (thin shells: about eps_mach E A per node, whatever the load increment). A step that diverges, runs out of
 iterations, inverts an element or meets a singular matrix is cut back (its increment halved) up to
 ``max_cutbacks`` times in a row.
 """
@@ -138,13 +145,15 @@ class Newton:
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
                 return out
+            if it == 1:
+                r_ref = max(r0, rn)
             scale_k = max(scale, reactions)
             conv_energy = energy <= opt.etol * e0
-            conv_res = rn <= max(opt.rtol * r0, opt.atol * scale_k)
-            # round-off floor: the energy criterion holds and the residual stopped falling (thin shells:
-            # about eps_mach E A per node, whatever the load increment)
+            conv_res = rn <= max(opt.rtol * r_ref, opt.atol * scale_k)
+            # round-off floor: the energy criterion holds and the residual stopped falling
             floor = conv_energy and it >= 2 and rn >= 0.5 * out.residual_norms[-2]
-            if (conv_res and conv_energy) or floor:
+            conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
+            if conv or floor:
                 if m.active_set_settled():
                     out.converged = True
                     return out
