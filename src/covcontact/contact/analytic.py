@@ -344,6 +344,21 @@ class _Analytic:
     _origin: np.ndarray
     _frame: np.ndarray
 
+    def _place(self, kind, origin, origin_name, axis=None, axis_name="", radius=None, outside=True):
+        """Validate and store kind, radius and sigma (if ``radius`` is given), origin and frame.
+
+        The frame is built around the unit ``axis`` (the identity without one).
+        """
+        self.kind = kind
+        if radius is not None:
+            if not (np.isfinite(radius) and radius > 0.0):
+                raise ValueError(f"radius must be positive, got {radius!r}")
+            self.sigma = 1.0 if outside else -1.0
+        self._origin = np.asarray(origin, dtype=np.float64).copy()
+        if self._origin.shape != (3,) or not np.all(np.isfinite(self._origin)):
+            raise ValueError(f"{origin_name} must be 3 finite numbers, got {origin!r}")
+        self._frame = np.eye(3) if axis is None else _frame_from_axis(_unit(axis, axis_name))
+
     def placement(self, lam: float = 1.0):
         """Current origin (3,) and frame (3, 3) (rows e1, e2, e3) at load factor ``lam``."""
         origin = np.ascontiguousarray(self.motion.apply(self._origin, lam))
@@ -465,11 +480,7 @@ class Plane(_Analytic):
     motion: RigidMotion = field(default_factory=RigidMotion)
 
     def __post_init__(self):
-        self.kind = PLANE
-        self._origin = np.asarray(self.point, dtype=np.float64).copy()
-        if self._origin.shape != (3,) or not np.all(np.isfinite(self._origin)):
-            raise ValueError(f"point must be 3 finite numbers, got {self.point!r}")
-        self._frame = _frame_from_axis(_unit(self.normal, "normal"))
+        self._place(PLANE, self.point, "point", self.normal, "normal")
 
 
 @dataclass
@@ -487,14 +498,7 @@ class Cylinder(_Analytic):
     motion: RigidMotion = field(default_factory=RigidMotion)
 
     def __post_init__(self):
-        self.kind = CYLINDER
-        if not (np.isfinite(self.radius) and self.radius > 0.0):
-            raise ValueError(f"radius must be positive, got {self.radius!r}")
-        self.sigma = 1.0 if self.outside else -1.0
-        self._origin = np.asarray(self.center, dtype=np.float64).copy()
-        if self._origin.shape != (3,) or not np.all(np.isfinite(self._origin)):
-            raise ValueError(f"center must be 3 finite numbers, got {self.center!r}")
-        self._frame = _frame_from_axis(_unit(self.axis, "axis"))
+        self._place(CYLINDER, self.center, "center", self.axis, "axis", self.radius, self.outside)
 
 
 @dataclass
@@ -507,11 +511,4 @@ class Sphere(_Analytic):
     motion: RigidMotion = field(default_factory=RigidMotion)
 
     def __post_init__(self):
-        self.kind = SPHERE
-        if not (np.isfinite(self.radius) and self.radius > 0.0):
-            raise ValueError(f"radius must be positive, got {self.radius!r}")
-        self.sigma = 1.0 if self.outside else -1.0
-        self._origin = np.asarray(self.center, dtype=np.float64).copy()
-        if self._origin.shape != (3,) or not np.all(np.isfinite(self._origin)):
-            raise ValueError(f"center must be 3 finite numbers, got {self.center!r}")
-        self._frame = np.eye(3)
+        self._place(SPHERE, self.center, "center", radius=self.radius, outside=self.outside)

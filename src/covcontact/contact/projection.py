@@ -27,30 +27,38 @@ _EPS = 2.220446049250313e-16
 
 
 @njit(cache=True)
+def projection_work(nen):
+    """Scratch arrays for ``project_on_facet_work`` (allocate once per thread, reuse for every call)."""
+    return (np.empty(nen), np.empty((nen, 2)), np.empty((nen, 2, 2)), np.empty(3), np.empty(3),
+            np.empty((2, 3)), np.empty((2, 2)), np.empty((2, 2)), np.empty(3), np.empty((2, 2)))
+
+
+@njit(cache=True)
 def project_on_facet_info(xyz, xs, xi, max_iter=30, tol=1e-12):
     """As ``project_on_facet``, and also returns the number of Newton iterations used.
 
     Returns:
         (status, g, nit).
     """
-    nen = xyz.shape[0]
-    N = np.empty(nen)
-    dN = np.empty((nen, 2))
-    ddN = np.empty((nen, 2, 2))
-    rho = np.empty(3)
-    rho_t = np.empty(3)
-    rho_cov = np.empty((2, 3))
-    a_cov = np.empty((2, 2))
-    a_con = np.empty((2, 2))
-    nrm = np.empty(3)
-    h_cov = np.empty((2, 2))
+    return project_on_facet_work(xyz, xs, xi, projection_work(xyz.shape[0]), max_iter, tol)
+
+
+@njit(cache=True)
+def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
+    """As ``project_on_facet_info`` with the caller's scratch ``work = projection_work(nen)``: no allocation,
+    for hot loops over many slaves.
+
+    Returns:
+        (status, g, nit).
+    """
+    N, dN, ddN, rho, rho_t, rho_cov, a_cov, a_con, nrm, h_cov = work
 
     # guard against non-finite input: never propagate NaN
     scale = 0.0
     for k in range(3):
         if not np.isfinite(xs[k]):
             return DEGENERATE, 0.0, 0
-    for a in range(nen):
+    for a in range(xyz.shape[0]):
         for p in range(3):
             v = xyz[a, p]
             if not np.isfinite(v):
@@ -113,6 +121,11 @@ def project_on_facet_info(xyz, xs, xi, max_iter=30, tol=1e-12):
             xi[1] += dx1
             status = CONVERGED
             break
+        if newton and s < 1e-2:
+            # small full Newton step on a positive definite Hessian: the quadratic model holds, no check
+            xi[0] += dx0
+            xi[1] += dx1
+            continue
         # step halving on the distance; f is known only up to its round-off |d| * floor
         f_tol = 1e-13 * f0 + 4.0 * floor * (np.sqrt(2.0 * f0) + floor)
         t = 1.0

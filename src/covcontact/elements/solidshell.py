@@ -24,13 +24,12 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import get_num_threads, set_parallel_chunksize
+from numba import get_num_threads
 
-from ..assembly.pattern import Pattern, scatter_matrices, scatter_vectors
 from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
-from ..fem.shapes import NNODES, NODES, shape_functions
+from ..fem.shapes import NODES, shape_functions
 from ..materials.hyperelastic import Material
-from .solid import BLOCKS_PER_THREAD, SolidStress
+from .base import ElementBody
 from .solidshell_loops import solidshell_chunk, solidshell_fields
 
 SHELL_CELLS = ("hex8", "hex18")
@@ -215,8 +214,12 @@ def eas_tables(cell_type: str, neas: int, gauss_points: np.ndarray) -> tuple[np.
     return comp, np.ascontiguousarray(val)
 
 
-class SolidShellBody:
+class SolidShellBody(ElementBody):
     """A solid-shell body (hex8 or hex18), the :class:`SolidBody` interface plus EAS history.
+
+    ``check_reference`` tests the centre and every evaluation point; ``assemble`` and the fields solve
+    the EAS parameters for u (local Newton from their last values) and return condensed tangents;
+    ``stress`` pushes S forward with the compatible F and reports the assumed strain.
 
     Args:
         cell_type: "hex8" (quad4 faces) or "hex18" (quad9 faces).
@@ -230,20 +233,10 @@ class SolidShellBody:
     def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
                  chunk_bytes: int = 32 * 2**20, **options: Any) -> None:
         self.options = normalize_options(cell_type, options)
-        self.cell_type = cell_type
-        self.X = np.ascontiguousarray(X, dtype=np.float64)
-        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
-        nen = NNODES[cell_type]
-        if self.X.ndim != 2 or self.X.shape[1] != 3:
-            raise ValueError(f"X must have shape (nnode, 3), got {self.X.shape}")
-        if self.cells.ndim != 2 or self.cells.shape[1] != nen:
-            raise ValueError(f"{cell_type} cells must have shape (nelem, {nen}), got {self.cells.shape}")
-        if self.cells.size and (self.cells.min() < 0 or self.cells.max() >= self.X.shape[0]):
-            raise ValueError(f"cells refer to nodes outside [0, {self.X.shape[0]})")
+        super().__init__(cell_type, X, cells, material, chunk_bytes)
         msg = mesh_problem(cell_type, self.X, self.cells)
         if msg is not None:
             raise ValueError(msg)
-        self.material = material
         o = self.options
         pts, self.weights, self.tie_ptr, self.tie_pt, self.tie_w = tying_tables(
             cell_type, o["ans_shear"], o["ans_thickness"], o["ans_membrane"])
@@ -255,37 +248,16 @@ class SolidShellBody:
         self.alpha = np.zeros((self.n_elements, self.neas))
         self._alpha_saved = self.alpha.copy()
         self._alpha_committed = self.alpha.copy()
-        nd = 3 * nen
-        self.chunk = int(max(1, min(self.n_elements, chunk_bytes // (8 * nd * nd))))
-        self._Ke = np.empty((0, nd, nd))
-        self._fe = np.empty((0, nd))
-        self._flags = np.empty(0, dtype=np.int64)
-        self._ranks_key: tuple[Pattern, int] | None = None
-        self._ranks = np.empty((0, nen, nen), dtype=np.int32)
 
-    @property
-    def n_nodes(self) -> int:
-        return int(self.X.shape[0])
+    def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks) -> None:
+        solidshell_chunk(self.material.kind, self.material.params, self.X, u, self.cells, e0, self.alpha, self.dNp,
+                         self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
+                         want_K, Ke, fe, flags, nblocks)
 
-    @property
-    def n_elements(self) -> int:
-        return int(self.cells.shape[0])
-
-    @property
-    def nen(self) -> int:
-        return int(self.cells.shape[1])
-
-    def _u(self, u: np.ndarray) -> np.ndarray:
-        u = np.ascontiguousarray(u, dtype=np.float64)
-        return u if u.shape == self.X.shape else u.reshape(self.X.shape)
-
-    def _fields(self, u: np.ndarray, mode: int, ncol: int) -> np.ndarray:
-        out = np.empty((self.n_elements, ncol))
-        if self.n_elements:
-            solidshell_fields(self.material.kind, self.material.params, self.X, self._u(u), self.cells,
-                              self.alpha, self.dNp, self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w,
-                              self.eas_comp, self.eas_val, mode, out, get_num_threads())
-        return out
+    def _gauss_fields(self, u, mode, out) -> None:
+        solidshell_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.alpha, self.dNp,
+                          self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
+                          mode, out, get_num_threads())
 
     # -- history --------------------------------------------------------------------------------
     def save_state(self) -> None:
@@ -300,88 +272,3 @@ class SolidShellBody:
         """The step converged: its parameters become the committed history."""
         self._alpha_committed = self.alpha.copy()
         self._alpha_saved = self.alpha.copy()
-
-    # -- evaluation -----------------------------------------------------------------------------
-    def check_reference(self) -> list[int]:
-        """Elements with det J0 <= 0 at the centre or an evaluation point (the caller raises)."""
-        det = self._fields(np.zeros_like(self.X), 1, 1)[:, 0]
-        return [int(e) for e in np.flatnonzero(~(det > 0.0))]
-
-    def ranks(self, pattern: Pattern, node_offset: int = 0) -> np.ndarray:
-        """Node-pair ranks of this body's cells in ``pattern`` (cached for the last pattern)."""
-        if self._ranks_key is None or self._ranks_key[0] is not pattern or self._ranks_key[1] != node_offset:
-            self._ranks = pattern.ranks(self.cells, node_offset)
-            self._ranks_key = (pattern, int(node_offset))
-        return self._ranks
-
-    def assemble(self, u: np.ndarray, data: np.ndarray, rhs: np.ndarray, pattern: Pattern | None,
-                 node_offset: int = 0, want_K: bool = True) -> int:
-        """Add internal forces to ``rhs`` and (if want_K) condensed element tangents to ``data``.
-
-        The EAS parameters are solved for ``u`` (local Newton from their last values), so the result
-        depends on u only. Returns -1, or the first element with an inadmissible strain, det J0 <= 0
-        or a failed local solve; the outputs then stay finite.
-        """
-        u = self._u(u)
-        nd = 3 * self.nen
-        if rhs.dtype != np.float64 or rhs.ndim != 1 or rhs.size < 3 * (node_offset + self.n_nodes):
-            raise ValueError("rhs must be float64 (ndofs,) covering this body's dofs")
-        if want_K:
-            if pattern is None:
-                raise ValueError("want_K needs the pattern")
-            if data.shape != (pattern.nnz,) or data.dtype != np.float64:
-                raise ValueError(f"data must be float64 of shape ({pattern.nnz},)")
-            ranks = self.ranks(pattern, node_offset)
-            node_ptr = pattern.node_ptr
-        else:
-            ranks = self._ranks
-            node_ptr = np.zeros(1, dtype=np.int64)
-        if self._fe.shape[0] != self.chunk:
-            self._fe = np.empty((self.chunk, nd))
-            self._flags = np.empty(self.chunk, dtype=np.int64)
-        if want_K and self._Ke.shape[0] != self.chunk:
-            self._Ke = np.empty((self.chunk, nd, nd))
-        off = np.int64(node_offset)
-        nblocks = BLOCKS_PER_THREAD * get_num_threads()
-        old = set_parallel_chunksize(1)
-        try:
-            first_bad = -1
-            kind, params = self.material.kind, self.material.params
-            for e0 in range(0, self.n_elements, self.chunk):
-                nc = min(self.chunk, self.n_elements - e0)
-                Ke = self._Ke[:nc] if want_K else self._Ke
-                fe = self._fe[:nc]
-                flags = self._flags[:nc]
-                solidshell_chunk(kind, params, self.X, u, self.cells, e0, self.alpha, self.dNp, self.dNc,
-                                 self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
-                                 want_K, Ke, fe, flags, nblocks)
-                scatter_vectors(rhs, self.cells, off, fe, e0)
-                if want_K:
-                    scatter_matrices(data, node_ptr, self.cells, off, ranks, Ke, e0)
-                if first_bad < 0:
-                    bad = np.flatnonzero(flags)
-                    if bad.size:
-                        first_bad = e0 + int(bad[0])
-        finally:
-            set_parallel_chunksize(old)
-        return first_bad
-
-    def energy(self, u: np.ndarray) -> float:
-        """Strain energy int W(E) dV at the solved EAS parameters (inf if a strain is inadmissible)."""
-        return float(self._fields(u, 0, 1).sum())
-
-    def stress(self, u: np.ndarray) -> SolidStress:
-        """Element averages of Cauchy stress (compatible F), S and the assumed strain; nodal Cauchy."""
-        f = self._fields(u, 2, 18)
-        cauchy = np.ascontiguousarray(f[:, :6])
-        count = np.bincount(self.cells.ravel(), minlength=self.n_nodes).astype(np.float64)
-        nodal = np.empty((self.n_nodes, 6))
-        for I in range(6):
-            nodal[:, I] = np.bincount(self.cells.ravel(), weights=np.repeat(cauchy[:, I], self.nen),
-                                      minlength=self.n_nodes)
-        nodal /= np.maximum(count, 1.0)[:, None]
-        s = cauchy
-        vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)
-                     + 3.0 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
-        return SolidStress(cauchy=cauchy, pk2=np.ascontiguousarray(f[:, 6:12]),
-                           green_lagrange=np.ascontiguousarray(f[:, 12:]), cauchy_nodal=nodal, von_mises=vm)

@@ -8,13 +8,19 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..materials.hyperelastic import VOIGT_PAIRS, material_energy
-from .solid import _jacobian
+from ..materials.hyperelastic import material_energy
+from .base import add_cauchy_pk2, block_range, gather
+from .solid import _jacobian, _kinematics
 from .solidshell_kernels import FLAG_INVERTED, FLAG_REFERENCE, _element, _local_solve, _prepare, _stretch
 
 
 @njit(cache=True)
-def _scratch(nen, npt, ng, neas):
+def _scratch(conn, dNp, w, eas_comp):
+    """Per-block work arrays: Xe, ue (nen, 3) and the grouped work arrays of the element kernels."""
+    nen = conn.shape[1]
+    npt = dNp.shape[0]
+    ng = w.size
+    neas = eas_comp.size
     nd = 3 * nen
     ne = max(neas, 1)
     ws3 = (np.empty((npt, 3, 3)), np.empty((npt, 3, 3)), np.empty((npt, 3, 3)))
@@ -24,7 +30,7 @@ def _scratch(nen, npt, ng, neas):
     wv = (np.empty((3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((3, 3)), np.empty(6), np.empty(ne),
           np.empty((ne, ne)), np.empty((ne, ne)), np.empty(ne), np.empty(ne), np.empty(ne), np.empty((6, nd)),
           np.empty((6, nd)), np.empty((6, nd)), np.empty((6, ne)), np.empty((nd, ne)))
-    return ws3, ws4, ws2, wsg, wv
+    return np.empty((nen, 3)), np.empty((nen, 3)), ws3, ws4, ws2, wsg, wv
 
 
 @njit(parallel=True, cache=True)
@@ -36,25 +42,14 @@ def solidshell_chunk(kind, params, X, u, conn, e0, alpha, dNp, dNc, w, tie_ptr, 
     with the solution.
     """
     nc = fe.shape[0]
-    nen = conn.shape[1]
-    npt = dNp.shape[0]
-    ng = w.size
-    neas = eas_comp.size
     nblk = max(1, min(nblocks, nc))
     for t in prange(nblk):
-        lo = t * nc // nblk
-        hi = (t + 1) * nc // nblk
-        Xe = np.empty((nen, 3))
-        ue = np.empty((nen, 3))
-        ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
+        lo, hi = block_range(t, nc, nblk)
+        Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
         Kdummy = np.empty((0, 0))
         for c in range(lo, hi):
             e = e0 + c
-            for a in range(nen):
-                n = conn[e, a]
-                for i in range(3):
-                    Xe[a, i] = X[n, i]
-                    ue[a, i] = u[n, i]
+            gather(X, u, conn, e, Xe, ue)
             Kc = Ke[c] if want_K else Kdummy
             flags[c] = _element(kind, params, Xe, ue, alpha[e], dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
                                 eas_val, want_K, Kc, fe[c], ws3, ws4, ws2, wsg, wv)
@@ -73,27 +68,19 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
     nen = conn.shape[1]
     npt = dNp.shape[0]
     ng = w.size
-    neas = eas_comp.size
     nblk = max(1, min(nthreads, ne))
     for t in prange(nblk):
-        lo = t * ne // nblk
-        hi = (t + 1) * ne // nblk
-        Xe = np.empty((nen, 3))
-        ue = np.empty((nen, 3))
+        lo, hi = block_range(t, ne, nblk)
+        Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
         Gx = np.empty((nen, 3))
         Fc = np.empty((3, 3))
-        ws3, ws4, ws2, wsg, wv = _scratch(nen, npt, ng, neas)
         Gp, gp, _sig = ws3
         Tg, D = ws4
         Ep, S, Et, Ec = ws2
         Gam, detg = wsg
         J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua = wv
         for e in range(lo, hi):
-            for a in range(nen):
-                n = conn[e, a]
-                for i in range(3):
-                    Xe[a, i] = X[n, i]
-                    ue[a, i] = u[n, i]
+            gather(X, u, conn, e, Xe, ue)
             for r in range(out.shape[1]):
                 out[e, r] = 0.0
             if mode == 1:
@@ -122,31 +109,11 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
                     else:
                         out[e, 0] = np.inf
                     continue
-                # compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
+                # Cauchy stress with the compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
                 _jacobian(Xe, dNp[g], J0, Ji)
-                for a in range(nen):
-                    for j in range(3):
-                        Gx[a, j] = dNp[g, a, 0] * Ji[0, j] + dNp[g, a, 1] * Ji[1, j] + dNp[g, a, 2] * Ji[2, j]
-                for i in range(3):
-                    for j in range(3):
-                        s = 1.0 if i == j else 0.0
-                        for a in range(nen):
-                            s += ue[a, i] * Gx[a, j]
-                        Fc[i, j] = s
-                J = (Fc[0, 0] * (Fc[1, 1] * Fc[2, 2] - Fc[1, 2] * Fc[2, 1])
-                     - Fc[0, 1] * (Fc[1, 0] * Fc[2, 2] - Fc[1, 2] * Fc[2, 0])
-                     + Fc[0, 2] * (Fc[1, 0] * Fc[2, 1] - Fc[1, 1] * Fc[2, 0]))
-                rJ = wd / J if J > 0.0 else 0.0
+                _kinematics(dNp[g], Ji, ue, Gx, Fc)
+                add_cauchy_pk2(Fc, S[g], wd, out[e])
                 for I in range(6):
-                    i = VOIGT_PAIRS[I, 0]
-                    j = VOIGT_PAIRS[I, 1]
-                    s = 0.0
-                    for k in range(3):
-                        for m in range(3):
-                            K = k if k == m else (3 if k + m == 1 else (4 if k + m == 3 else 5))
-                            s += Fc[i, k] * S[g, K] * Fc[j, m]
-                    out[e, I] += rJ * s
-                    out[e, 6 + I] += wd * S[g, I]
                     out[e, 12 + I] += wd * (Et[g, I] if I < 3 else 0.5 * Et[g, I])
             if mode == 2 and vol > 0.0:
                 for r in range(18):

@@ -16,25 +16,67 @@ Backends, in order of preference (``available()`` lists those usable on this mac
 Every solver keeps its symbolic analysis while the sparsity pattern (indptr, indices) is unchanged,
 records the time of its last analysis, factorisation and solve, checks the residual of each solve
 and raises ``SingularMatrixError`` for a singular matrix or a non-finite solution.
+
+The backend classes live in :mod:`covcontact.solvers.backends` (imported on first use, and re-exported
+here: ``from covcontact.solvers.linear import PardisoSolver`` works). A new backend is a
+:class:`LinearSolver` subclass with a static ``probe()`` in its own module of this package, registered by
+one :data:`REGISTRY` entry, e.g. ``"petsc": Backend("petsc_backend", "PetscSolver", auto=False)``.
 """
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
-import platform
+import importlib
 import time
-import warnings
-from functools import cache, lru_cache
-from typing import Any
+from dataclasses import dataclass
+from functools import cache
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as sla
 
-#: all backends, in order of preference
-BACKENDS = ("pardiso", "cholmod", "mumps", "superlu", "cg-amg")
-_DIRECT = ("pardiso", "cholmod", "mumps", "superlu")
+if TYPE_CHECKING:  # re-exported lazily by __getattr__ (backends imports this module)
+    from .backends import AMGSolver, CholmodSolver, MumpsSolver, PardisoSolver, SuperLUSolver  # noqa: F401
+
+
+@dataclass(frozen=True)
+class Backend:
+    """A registry entry: class ``cls`` of module ``module`` (of this package, imported on first use).
+
+    Attributes:
+        module: module name relative to :mod:`covcontact.solvers`.
+        cls: a :class:`LinearSolver` subclass with a static ``probe()`` -> (available, version, note)
+            that raises ImportError / OSError when its package is missing.
+        auto: whether ``make_solver("auto")`` may choose it (direct solvers).
+        symmetric_only: whether it refuses non-symmetric matrices.
+    """
+
+    module: str
+    cls: str
+    auto: bool = True
+    symmetric_only: bool = False
+
+
+#: all backends, in order of preference; a new backend is one more entry
+REGISTRY: dict[str, Backend] = {
+    "pardiso": Backend("backends", "PardisoSolver"),
+    "cholmod": Backend("backends", "CholmodSolver", symmetric_only=True),
+    "mumps": Backend("backends", "MumpsSolver"),
+    "superlu": Backend("backends", "SuperLUSolver"),
+    "cg-amg": Backend("backends", "AMGSolver", auto=False),
+}
+BACKENDS = tuple(REGISTRY)
+_DIRECT = tuple(name for name, b in REGISTRY.items() if b.auto)
+#: names re-exported from the backend module
+_REEXPORT = ("AMGSolver", "CholmodSolver", "MumpsSolver", "PardisoSolver", "SuperLUSolver", "_PARDISO_ERRORS",
+             "_pardiso_function", "_upper_structure")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _REEXPORT:
+        from . import backends
+
+        return getattr(backends, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class LinearSolverError(RuntimeError):
@@ -48,39 +90,21 @@ class SingularMatrixError(LinearSolverError):
 # ----------------------------------------------------------------------------- availability
 
 
+def backend_class(name: str) -> type[LinearSolver]:
+    """The solver class of registered backend ``name`` (imports its module)."""
+    b = REGISTRY[name]
+    return getattr(importlib.import_module(f".{b.module}", __package__), b.cls)
+
+
 @cache
 def _probe(name: str) -> tuple[bool, str, str]:
     """(available, version, note) of one backend; imports it if possible."""
+    if name not in REGISTRY:
+        raise ValueError(name)
     try:
-        if name == "pardiso":
-            if platform.machine().lower() not in ("x86_64", "amd64"):
-                return False, "", "MKL PARDISO needs x86-64"
-            import pypardiso
-
-            _pardiso_function()
-            return True, getattr(pypardiso, "__version__", ""), "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
-        if name == "cholmod":
-            import sksparse
-            import sksparse.cholmod
-
-            return True, getattr(sksparse, "__version__", ""), "CHOLMOD Cholesky, symmetric only"
-        if name == "mumps":
-            import mumps
-
-            if not hasattr(mumps, "Context"):
-                return False, "", "the installed 'mumps' module is not python-mumps"
-            return True, getattr(mumps, "__version__", ""), "MUMPS LDL^T / LU"
-        if name == "superlu":
-            import scipy
-
-            return True, scipy.__version__, "SciPy SuperLU (symmetric mode for symmetric matrices)"
-        if name == "cg-amg":
-            import pyamg
-
-            return True, pyamg.__version__, "iterative: CG/GMRES + smoothed-aggregation AMG"
+        return backend_class(name).probe()
     except (ImportError, OSError) as exc:
         return False, "", f"not installed ({exc.__class__.__name__}: {exc})"
-    raise ValueError(name)
 
 
 def available() -> list[str]:
@@ -109,7 +133,7 @@ def make_solver(name: str = "auto", symmetric: bool = True, **options) -> Linear
     """
     key = name.lower().strip()
     if key == "auto":  # probe lazily: importing every optional backend costs time
-        key = next(c for c in _DIRECT if (symmetric or c != "cholmod") and _probe(c)[0])
+        key = next(c for c in _DIRECT if (symmetric or not REGISTRY[c].symmetric_only) and _probe(c)[0])
     if key not in BACKENDS:
         raise ValueError(f"unknown linear solver {name!r}; available here: {', '.join(available())}")
     if not _probe(key)[0]:
@@ -117,16 +141,11 @@ def make_solver(name: str = "auto", symmetric: bool = True, **options) -> Linear
             f"linear solver {name!r} is not available here ({_probe(key)[2]}); "
             f"available: {', '.join(available())}"
         )
-    if key == "cholmod" and not symmetric:
-        raise ValueError("cholmod factorises symmetric matrices only; use pardiso, mumps or superlu")
-    cls = {
-        "pardiso": PardisoSolver,
-        "cholmod": CholmodSolver,
-        "mumps": MumpsSolver,
-        "superlu": SuperLUSolver,
-        "cg-amg": AMGSolver,
-    }[key]
-    return cls(symmetric=symmetric, **options)
+    if REGISTRY[key].symmetric_only and not symmetric:
+        alt = [c for c in _DIRECT if not REGISTRY[c].symmetric_only]
+        use = " or ".join([", ".join(alt[:-1]), alt[-1]] if len(alt) > 1 else alt)
+        raise ValueError(f"{key} factorises symmetric matrices only; use {use}")
+    return backend_class(key)(symmetric=symmetric, **options)
 
 
 def rigid_body_modes(points: np.ndarray, dofs: np.ndarray | None = None) -> np.ndarray:
@@ -188,6 +207,11 @@ class LinearSolver:
 
     name = "base"
     direct = True
+
+    @staticmethod
+    def probe() -> tuple[bool, str, str]:
+        """(available, version, note) of this backend here; ImportError / OSError: not installed."""
+        raise NotImplementedError
 
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6):
         self.symmetric = symmetric
@@ -305,365 +329,3 @@ class LinearSolver:
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
         raise NotImplementedError
-
-
-# ----------------------------------------------------------------------------- PARDISO
-
-_PARDISO_ERRORS = {
-    -1: "input inconsistent",
-    -2: "not enough memory",
-    -3: "reordering problem",
-    -4: "zero pivot (numerical factorisation or iterative refinement problem)",
-    -5: "unclassified internal error",
-    -6: "reordering failed",
-    -7: "diagonal matrix is singular",
-    -8: "32-bit integer overflow",
-    -9: "not enough memory for out-of-core",
-}
-
-
-@lru_cache(maxsize=1)
-def _pardiso_function():
-    """The ``pardiso`` entry point of the MKL runtime located by pypardiso."""
-    import pypardiso
-
-    lib = pypardiso.PyPardisoSolver().libmkl
-    fn = lib["pardiso"]  # a fresh function pointer: our own argtypes
-    i32p = ctypes.POINTER(ctypes.c_int32)
-    fn.argtypes = [ctypes.c_void_p] + [i32p] * 5 + [ctypes.c_void_p] + [i32p] * 6 + [ctypes.c_void_p] * 2 + [i32p]
-    fn.restype = None
-    return fn
-
-
-def _upper_structure(K: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """CSR structure (ia, ja int32) of the upper triangle of K with every diagonal entry present,
-    and for each entry its position in K.data (K.nnz for a structural zero on the diagonal)."""
-    n = K.shape[0]
-    rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(K.indptr))
-    keep = np.flatnonzero(K.indices >= rows)
-    r, c, pos = rows[keep], K.indices[keep].astype(np.int64), keep
-    has_diag = np.zeros(n, dtype=bool)
-    has_diag[r[c == r]] = True
-    missing = np.flatnonzero(~has_diag)
-    if missing.size:  # PARDISO needs the diagonal in the structure of symmetric matrices
-        r = np.concatenate([r, missing])
-        c = np.concatenate([c, missing])
-        pos = np.concatenate([pos, np.full(missing.size, K.nnz)])
-        order = np.lexsort((c, r))
-        r, c, pos = r[order], c[order], pos[order]
-    ia = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(np.bincount(r, minlength=n), out=ia[1:])
-    return ia, c.astype(np.int32), pos
-
-
-class PardisoSolver(LinearSolver):
-    """MKL PARDISO with the analysis (phase 11) redone only when the pattern changes.
-
-    Options: ``spd=True`` uses Cholesky (mtype 2; falls back to -2 if the matrix is not positive
-    definite); ``matching=True`` adds weighted matching and scaling to LDL^T (saddle-point
-    matrices with zero diagonal blocks).
-    """
-
-    name = "pardiso"
-
-    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, spd: bool = False,
-                 matching: bool = False):
-        super().__init__(symmetric, check_tol)
-        self._fn = _pardiso_function()
-        self.mtype = (2 if spd else -2) if symmetric else 11
-        self.matching = matching
-        self.pt = np.zeros(64, dtype=np.int64)
-        self.iparm = np.zeros(64, dtype=np.int32)
-        self._n = 0
-        self._a = np.zeros(1)
-        self._ia = self._ja = np.zeros(1, dtype=np.int32)
-        self._pos: np.ndarray | None = None
-        self._pad = False
-        self.n_perturbed = 0
-        self.inertia: tuple[int, int] | None = None
-
-    def _set_iparm(self) -> None:
-        ip = self.iparm
-        ip[:] = 0
-        ip[0] = 1  # user-supplied parameters
-        ip[1] = 2  # METIS nested dissection
-        ip[7] = 0  # iterative refinement: automatic (2 steps after perturbed pivots)
-        ip[34] = 1  # zero-based indexing
-        if self.mtype == 11:
-            ip[9], ip[10], ip[12] = 13, 1, 1  # pivot perturbation 1e-13, scaling, matching
-        else:
-            ip[9] = 8  # pivot perturbation 1e-8
-            ip[20] = 1  # Bunch-Kaufman 1x1 and 2x2 pivots
-            if self.matching:
-                ip[10], ip[12] = 1, 1
-
-    def _call(self, phase: int, b: np.ndarray | None = None, x: np.ndarray | None = None) -> int:
-        err = ctypes.c_int32(0)
-        nrhs = 1 if b is None or b.ndim == 1 else b.shape[1]
-        dummy = np.zeros(1)
-        c = ctypes.c_int32
-
-        def ref(v):
-            return ctypes.byref(c(v))
-
-        i32p = ctypes.POINTER(ctypes.c_int32)
-        self._fn(self.pt.ctypes.data, ref(1), ref(1), ref(self.mtype), ref(phase), ref(self._n),
-                 self._a.ctypes.data, self._ia.ctypes.data_as(i32p), self._ja.ctypes.data_as(i32p),
-                 None, ref(nrhs), self.iparm.ctypes.data_as(i32p), ref(0),
-                 (dummy if b is None else b).ctypes.data, (dummy if x is None else x).ctypes.data,
-                 ctypes.byref(err))
-        return err.value
-
-    def _values(self, K: sp.csr_matrix) -> np.ndarray:
-        """Values in PARDISO's structure; kept alive, PARDISO refines with them in phase 33."""
-        if self._pos is None:
-            return K.data.copy()
-        if self._pad:
-            return np.append(K.data, 0.0)[self._pos]
-        return K.data[self._pos]
-
-    def _analyze(self, K: sp.csr_matrix) -> None:
-        self._release()
-        self._n = K.shape[0]
-        if self.mtype == 11:
-            self._ia, self._ja, self._pos = K.indptr.astype(np.int32), K.indices.astype(np.int32), None
-        else:
-            self._ia, self._ja, self._pos = _upper_structure(K)
-            self._pad = bool((self._pos == K.nnz).any())
-        self._set_iparm()
-        self._a = self._values(K)
-        err = self._call(11)
-        if err:
-            self._release()
-            raise LinearSolverError(f"pardiso analysis failed: {_PARDISO_ERRORS.get(err, err)}")
-
-    def _factor(self, K: sp.csr_matrix) -> None:
-        self._a = self._values(K)
-        err = self._call(22)
-        if err == -4 and self.mtype == 2:  # not positive definite: continue with LDL^T
-            self.mtype = -2
-            self._analyze(K)
-            err = self._call(22)
-        if err:
-            cls = SingularMatrixError if err in (-4, -7) else LinearSolverError
-            raise cls(f"pardiso factorisation failed: {_PARDISO_ERRORS.get(err, err)}")
-        self.n_perturbed = int(self.iparm[13])
-        self.inertia = (int(self.iparm[21]), int(self.iparm[22])) if self.mtype == -2 else None
-
-    def _solve(self, b: np.ndarray) -> np.ndarray:
-        bf = np.array(b, dtype=np.float64, order="F")
-        x = np.zeros_like(bf, order="F")
-        err = self._call(33, bf, x)
-        if err:
-            raise LinearSolverError(f"pardiso solve failed: {_PARDISO_ERRORS.get(err, err)}")
-        return np.ascontiguousarray(x)
-
-    def _diagnosis(self) -> str:
-        return f" ({self.n_perturbed} perturbed pivots)" if self.n_perturbed else ""
-
-    def _release(self) -> None:
-        if self._n and self.pt.any():
-            self._call(-1)
-        self.pt[:] = 0
-
-    def __del__(self):
-        with contextlib.suppress(Exception):  # interpreter shutdown
-            self.close()
-
-
-# ----------------------------------------------------------------------------- SuperLU
-
-
-class SuperLUSolver(LinearSolver):
-    """SciPy SuperLU. SuperLU offers no reuse of the analysis: every factorisation is complete.
-
-    K^T is handed over as CSC (a free view of the CSR arrays) and solved transposed.
-    """
-
-    name = "superlu"
-
-    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, diag_pivot_thresh: float = 1e-3):
-        super().__init__(symmetric, check_tol)
-        self.diag_pivot_thresh = diag_pivot_thresh
-        self._lu: Any = None
-
-    def _factor(self, K: sp.csr_matrix) -> None:
-        Kt = sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape)
-        self._lu = None
-        try:
-            if self.symmetric:
-                self._lu = sla.splu(Kt, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=self.diag_pivot_thresh,
-                                    options={"SymmetricMode": True})
-            else:
-                self._lu = sla.splu(Kt)
-        except RuntimeError as exc:
-            raise SingularMatrixError(f"superlu: {exc}") from exc
-
-    def _solve(self, b: np.ndarray) -> np.ndarray:
-        return self._lu.solve(np.ascontiguousarray(b), trans="T")
-
-    def _release(self) -> None:
-        self._lu = None
-
-
-# ----------------------------------------------------------------------------- CHOLMOD
-
-
-class CholmodSolver(LinearSolver):
-    """CHOLMOD supernodal Cholesky with the symbolic analysis kept per pattern.
-
-    A matrix that is not positive definite is factorised by the ``fallback`` backend instead
-    (``last_backend`` tells which one solved).
-    """
-
-    name = "cholmod"
-
-    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6):
-        if not symmetric:
-            raise ValueError("cholmod factorises symmetric matrices only")
-        super().__init__(symmetric, check_tol)
-        self._factor_obj: Any = None
-        self._fallback: LinearSolver | None = None
-        self.last_backend = self.name
-
-    def _analyze(self, K: sp.csr_matrix) -> None:
-        from sksparse.cholmod import analyze
-
-        self._factor_obj = analyze(sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape))
-
-    def _factor(self, K: sp.csr_matrix) -> None:
-        from sksparse.cholmod import CholmodNotPositiveDefiniteError
-
-        self.last_backend = self.name
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error")
-                self._factor_obj.cholesky_inplace(sp.csc_matrix((K.data, K.indices, K.indptr), shape=K.shape))
-            return
-        except (CholmodNotPositiveDefiniteError, Warning):
-            pass
-        if self._fallback is None:
-            nxt = "mumps" if "mumps" in available() else "superlu"
-            self._fallback = make_solver(nxt, symmetric=True, check_tol=self.check_tol)
-        self._fallback.factorize(K)
-        self.last_backend = self._fallback.name
-
-    def _solve(self, b: np.ndarray) -> np.ndarray:
-        if self.last_backend != self.name:
-            assert self._fallback is not None
-            return self._fallback._solve(b)
-        return self._factor_obj(b)
-
-
-# ----------------------------------------------------------------------------- MUMPS
-
-
-class MumpsSolver(LinearSolver):
-    """MUMPS (python-mumps): LDL^T with pivoting for symmetric matrices, LU otherwise."""
-
-    name = "mumps"
-
-    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, ordering: str = "auto"):
-        super().__init__(symmetric, check_tol)
-        import mumps
-
-        self._mumps = mumps
-        self.ordering = ordering
-        self._ctx = mumps.Context()
-        self._fresh = False
-
-    def _set(self, K: sp.csr_matrix) -> None:
-        self._ctx.set_matrix(K, symmetric=self.symmetric)
-
-    def _analyze(self, K: sp.csr_matrix) -> None:
-        self._set(K)
-        try:
-            self._ctx.analyze(ordering=self.ordering)
-        except self._mumps.MUMPSError as exc:
-            raise LinearSolverError(f"mumps analysis: {exc}") from exc
-        self._fresh = True
-
-    def _factor(self, K: sp.csr_matrix) -> None:
-        if not self._fresh:
-            self._set(K)
-        self._fresh = False
-        try:
-            self._ctx.factor(reuse_analysis=True)
-        except self._mumps.MUMPSError as exc:
-            cls = SingularMatrixError if exc.error in (-6, -10) else LinearSolverError
-            raise cls(f"mumps factorisation: {exc}") from exc
-
-    def _solve(self, b: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(self._ctx.solve(b))
-
-
-# ----------------------------------------------------------------------------- AMG
-
-
-class AMGSolver(LinearSolver):
-    """pyamg smoothed aggregation as a preconditioner; CG for symmetric matrices (GMRES if CG does
-    not converge, e.g. indefinite ones) and GMRES for non-symmetric ones. ``factorize`` builds the
-    hierarchy; ``rtol`` is the relative residual reached by each solve."""
-
-    name = "cg-amg"
-    direct = False
-
-    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, rtol: float = 1e-10,
-                 maxiter: int = 2000):
-        super().__init__(symmetric, max(check_tol, 10 * rtol))
-        self.rtol, self.maxiter = rtol, maxiter
-        self._B: np.ndarray | None = None
-        self._geometry: tuple[np.ndarray, np.ndarray | None] | None = None
-        self._ml: Any = None
-        self.iterations = 0
-
-    def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
-        self._geometry = (np.asarray(points, dtype=np.float64), dofs)
-        self._indptr = None  # rebuild the hierarchy with the new near-null space
-
-    def _factor(self, K: sp.csr_matrix) -> None:
-        import pyamg
-
-        B = None
-        if self._geometry is not None:
-            B = rigid_body_modes(*self._geometry)
-            if B.shape[0] != K.shape[0]:
-                raise ValueError(f"geometry gives {B.shape[0]} dofs, the matrix has {K.shape[0]}")
-        self._ml = pyamg.smoothed_aggregation_solver(
-            K, B=B, symmetry="symmetric" if self.symmetric else "nonsymmetric", max_coarse=500,
-            coarse_solver="splu",  # the default dense pseudo-inverse costs minutes on a stalled 2500-dof level
-        )
-
-    def _solve(self, b: np.ndarray) -> np.ndarray:
-        if b.ndim == 2:
-            return np.stack([self._solve(b[:, j]) for j in range(b.shape[1])], axis=1)
-        K = self._K
-        assert K is not None
-        M = self._ml.aspreconditioner(cycle="V")
-        nb = np.linalg.norm(b)
-        count = [0]
-
-        def tick(_):
-            count[0] += 1
-
-        for accel in ["cg", "gmres"] if self.symmetric else ["gmres"]:
-            x = np.zeros_like(b)
-            for k in range(3):  # restart with a tighter tolerance if the true residual lags behind
-                tol = self.rtol * 0.1**k
-                if accel == "cg":
-                    x, info = sla.cg(K, b, x0=x, rtol=tol, atol=0.0, maxiter=self.maxiter, M=M, callback=tick)
-                else:
-                    x, info = sla.gmres(K, b, x0=x, rtol=tol, atol=0.0, restart=50, M=M, callback=tick,
-                                     maxiter=max(1, self.maxiter // 50), callback_type="pr_norm")
-                if not np.isfinite(x).all():
-                    break
-                if np.linalg.norm(K @ x - b) <= self.rtol * nb:
-                    self.iterations = count[0]
-                    return x
-                if info != 0:  # no convergence (or breakdown): try the next method
-                    break
-        self.iterations = count[0]
-        raise LinearSolverError(
-            f"cg-amg: no convergence to {self.rtol:.0e} within {count[0]} iterations "
-            "(singular, strongly indefinite or badly scaled matrix?)"
-        )

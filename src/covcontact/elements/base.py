@@ -1,0 +1,240 @@
+"""What every hexahedral body shares: input checks, chunked assembly, rank cache, energy, stress output.
+
+:class:`ElementBody` holds the generic layer; a subclass sets its element tables and implements two
+kernel calls, :meth:`ElementBody._chunk` (element buffers of one chunk) and
+:meth:`ElementBody._gauss_fields` (per-element Gauss-point quantities). The compiled helpers below are
+the pieces the parallel element loops of the subclasses have in common.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import get_num_threads, njit, set_parallel_chunksize
+
+from ..assembly.pattern import Pattern, scatter_matrices, scatter_vectors
+from ..fem.shapes import NNODES
+from ..materials.hyperelastic import VOIGT, VOIGT_PAIRS, Material
+
+#: parallel blocks per thread and chunk (handed out dynamically, for load balance on shared cores)
+BLOCKS_PER_THREAD = 8
+
+
+# ----------------------------------------------------------------------------- compiled helpers
+
+
+@njit(cache=True, inline="always")
+def block_range(t, n, nblk):
+    """Items lo .. hi - 1 of block t when n items are split into nblk contiguous blocks."""
+    return t * n // nblk, (t + 1) * n // nblk
+
+
+@njit(cache=True, inline="always")
+def gather(X, u, conn, e, Xe, ue):
+    """Reference coordinates Xe (nen, 3) and displacements ue (nen, 3) of the nodes of element e."""
+    for a in range(conn.shape[1]):
+        n = conn[e, a]
+        for i in range(3):
+            Xe[a, i] = X[n, i]
+            ue[a, i] = u[n, i]
+
+
+@njit(cache=True, inline="always")
+def add_cauchy_pk2(F, S, wd, row):
+    """row[0:6] += wd sigma (Cauchy stress J^-1 F S F^T; 0 if det F <= 0), row[6:12] += wd S (Voigt)."""
+    J = (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
+         - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+         + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
+    rJ = wd / J if J > 0.0 else 0.0
+    for I in range(6):
+        i = VOIGT_PAIRS[I, 0]
+        j = VOIGT_PAIRS[I, 1]
+        sig = 0.0
+        for k in range(3):
+            for m in range(3):
+                sig += F[i, k] * S[VOIGT[k, m]] * F[j, m]
+        row[I] += rJ * sig
+        row[6 + I] += wd * S[I]
+
+
+# ----------------------------------------------------------------------------- output
+
+
+@dataclass
+class SolidStress:
+    """Stress and strain of a solid body (Voigt order 11, 22, 33, 12, 23, 13; tensor shear E_12).
+
+    Attributes:
+        cauchy: (nelem, 6) Cauchy stress averaged over each element.
+        pk2: (nelem, 6) second Piola-Kirchhoff stress averaged over each element.
+        green_lagrange: (nelem, 6) Green-Lagrange strain averaged over each element.
+        cauchy_nodal: (nnode, 6) Cauchy stress averaged at the nodes over the adjacent elements.
+        von_mises: (nelem,) von Mises equivalent of ``cauchy``.
+    """
+
+    cauchy: np.ndarray
+    pk2: np.ndarray
+    green_lagrange: np.ndarray
+    cauchy_nodal: np.ndarray
+    von_mises: np.ndarray
+
+    def cell_data(self) -> dict[str, np.ndarray]:
+        """Cell fields by output name."""
+        return {"cauchy": self.cauchy, "pk2": self.pk2, "green_lagrange": self.green_lagrange,
+                "von_mises": self.von_mises}
+
+    def point_data(self) -> dict[str, np.ndarray]:
+        """Point fields by output name."""
+        return {"cauchy_nodal": self.cauchy_nodal}
+
+
+# ----------------------------------------------------------------------------- body
+
+
+class ElementBody:
+    """Generic body of one hexahedral cell type (the subclass checks ``cell_type`` first).
+
+    Args:
+        cell_type: a key of :data:`covcontact.fem.shapes.NNODES`.
+        X: (nnode, 3) reference coordinates.
+        cells: (nelem, nen) connectivity (local node ids).
+        material: a :mod:`covcontact.materials` material.
+        chunk_bytes: size of the per-chunk element tangent buffer.
+    """
+
+    def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
+                 chunk_bytes: int = 32 * 2**20) -> None:
+        self.cell_type = cell_type
+        self.X = np.ascontiguousarray(X, dtype=np.float64)
+        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
+        nen = NNODES[cell_type]
+        if self.X.ndim != 2 or self.X.shape[1] != 3:
+            raise ValueError(f"X must have shape (nnode, 3), got {self.X.shape}")
+        if self.cells.ndim != 2 or self.cells.shape[1] != nen:
+            raise ValueError(f"{cell_type} cells must have shape (nelem, {nen}), got {self.cells.shape}")
+        if self.cells.size and (self.cells.min() < 0 or self.cells.max() >= self.X.shape[0]):
+            raise ValueError(f"cells refer to nodes outside [0, {self.X.shape[0]})")
+        self.material = material
+        nd = 3 * nen
+        self.chunk = int(max(1, min(self.n_elements, chunk_bytes // (8 * nd * nd))))
+        self._Ke = np.empty((0, nd, nd))
+        self._fe = np.empty((0, nd))
+        self._flags = np.empty(0, dtype=np.int64)
+        self._ranks_key: tuple[Pattern, int] | None = None
+        self._ranks = np.empty((0, nen, nen), dtype=np.int32)
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.X.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.cells.shape[0])
+
+    @property
+    def nen(self) -> int:
+        return int(self.cells.shape[1])
+
+    # -- kernel calls (subclass) ----------------------------------------------------------------
+    def _chunk(self, u: np.ndarray, e0: int, want_K: bool, Ke: np.ndarray, fe: np.ndarray,
+               flags: np.ndarray, nblocks: int) -> None:
+        """Fill Ke (nc, nd, nd) if want_K, fe (nc, nd), flags (nc,) for elements e0 .. e0 + nc - 1."""
+        raise NotImplementedError
+
+    def _gauss_fields(self, u: np.ndarray, mode: int, out: np.ndarray) -> None:
+        """Per-element fields into out (nelem, ncol): mode 0 energy, 1 min det J0, 2 stress (18)."""
+        raise NotImplementedError
+
+    # -- evaluation -----------------------------------------------------------------------------
+    def _u(self, u: np.ndarray) -> np.ndarray:
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        return u if u.shape == self.X.shape else u.reshape(self.X.shape)
+
+    def _fields(self, u: np.ndarray, mode: int, ncol: int) -> np.ndarray:
+        out = np.empty((self.n_elements, ncol))
+        if self.n_elements:
+            self._gauss_fields(self._u(u), mode, out)
+        return out
+
+    def check_reference(self) -> list[int]:
+        """Elements with det J0 <= 0 at some evaluation point (the caller raises)."""
+        det = self._fields(np.zeros_like(self.X), 1, 1)[:, 0]
+        return [int(e) for e in np.flatnonzero(~(det > 0.0))]
+
+    def ranks(self, pattern: Pattern, node_offset: int = 0) -> np.ndarray:
+        """Node-pair ranks of this body's cells in ``pattern`` (cached for the last pattern)."""
+        if self._ranks_key is None or self._ranks_key[0] is not pattern or self._ranks_key[1] != node_offset:
+            self._ranks = pattern.ranks(self.cells, node_offset)
+            self._ranks_key = (pattern, int(node_offset))
+        return self._ranks
+
+    def assemble(self, u: np.ndarray, data: np.ndarray, rhs: np.ndarray, pattern: Pattern | None,
+                 node_offset: int = 0, want_K: bool = True) -> int:
+        """Add internal forces to ``rhs`` and (if want_K) element tangents to the CSR ``data``.
+
+        Dofs are 3 (node_offset + a) + i. Element history (the EAS parameters of solid-shells) is
+        solved for ``u``, so the result depends on u only. Returns -1, or the first element with an
+        inadmissible strain (det F <= 0), det J0 <= 0 or a failed local solve at a Gauss point; the
+        outputs then stay finite but may be meaningless.
+        """
+        u = self._u(u)
+        nd = 3 * self.nen
+        if rhs.dtype != np.float64 or rhs.ndim != 1 or rhs.size < 3 * (node_offset + self.n_nodes):
+            raise ValueError("rhs must be float64 (ndofs,) covering this body's dofs")
+        if want_K:
+            if pattern is None:
+                raise ValueError("want_K needs the pattern")
+            if data.shape != (pattern.nnz,) or data.dtype != np.float64:
+                raise ValueError(f"data must be float64 of shape ({pattern.nnz},)")
+            ranks = self.ranks(pattern, node_offset)
+            node_ptr = pattern.node_ptr
+        else:
+            ranks = self._ranks
+            node_ptr = np.zeros(1, dtype=np.int64)
+        if self._fe.shape[0] != self.chunk:
+            self._fe = np.empty((self.chunk, nd))
+            self._flags = np.empty(self.chunk, dtype=np.int64)
+        if want_K and self._Ke.shape[0] != self.chunk:
+            self._Ke = np.empty((self.chunk, nd, nd))
+        off = np.int64(node_offset)
+        nblocks = BLOCKS_PER_THREAD * get_num_threads()
+        old_chunksize = set_parallel_chunksize(1)  # blocks handed out dynamically (shared cores)
+        try:
+            first_bad = -1
+            for e0 in range(0, self.n_elements, self.chunk):
+                nc = min(self.chunk, self.n_elements - e0)
+                Ke = self._Ke[:nc] if want_K else self._Ke
+                fe = self._fe[:nc]
+                flags = self._flags[:nc]
+                self._chunk(u, e0, want_K, Ke, fe, flags, nblocks)
+                scatter_vectors(rhs, self.cells, off, fe, e0)
+                if want_K:
+                    scatter_matrices(data, node_ptr, self.cells, off, ranks, Ke, e0)
+                if first_bad < 0:
+                    bad = np.flatnonzero(flags)
+                    if bad.size:
+                        first_bad = e0 + int(bad[0])
+        finally:
+            set_parallel_chunksize(old_chunksize)
+        return first_bad
+
+    def energy(self, u: np.ndarray) -> float:
+        """Strain energy int W dV (inf if a strain is inadmissible, e.g. an inverted Neo-Hooke element)."""
+        return float(self._fields(u, 0, 1).sum())
+
+    def stress(self, u: np.ndarray) -> SolidStress:
+        """Element-averaged Cauchy stress, S and Green-Lagrange strain; nodal averaged Cauchy stress."""
+        f = self._fields(u, 2, 18)
+        cauchy = np.ascontiguousarray(f[:, :6])
+        count = np.bincount(self.cells.ravel(), minlength=self.n_nodes).astype(np.float64)
+        nodal = np.empty((self.n_nodes, 6))
+        for I in range(6):
+            nodal[:, I] = np.bincount(self.cells.ravel(), weights=np.repeat(cauchy[:, I], self.nen),
+                                      minlength=self.n_nodes)
+        nodal /= np.maximum(count, 1.0)[:, None]
+        s = cauchy
+        vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)
+                     + 3.0 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
+        return SolidStress(cauchy=cauchy, pk2=np.ascontiguousarray(f[:, 6:12]),
+                           green_lagrange=np.ascontiguousarray(f[:, 12:]), cauchy_nodal=nodal, von_mises=vm)
