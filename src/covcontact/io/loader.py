@@ -7,6 +7,7 @@ the key path (or line) and what is wrong.
 from __future__ import annotations
 
 import inspect
+import math
 import tomllib
 from pathlib import Path
 
@@ -97,6 +98,52 @@ def _motion(sec: Section | None) -> RigidMotion:
     return m
 
 
+def _user_sets(sec: Section | None, mesh) -> None:
+    """Node sets defined in the input: ``sets = { NAME = { box = [[x0, y0, z0], [x1, y1, z1]] } }`` (the nodes
+    inside an axis-aligned box, bounds included), ``{ closest = [x, y, z] }`` or ``{ closest = [[...], ...] }``
+    (the node nearest to each point) or ``{ nodes = [i, j, ...] }`` (node numbers of the mesh, from 0)."""
+    if sec is None:
+        return
+    X = mesh.points
+    for name in list(sec.data):
+        if name in mesh.node_sets:
+            sec.fail(f"a node set {name!r} exists already (from the mesh)", name)
+        d = sec.get(name, "table")
+        given = [k for k in ("box", "closest", "nodes") if d.has(k)]
+        if len(given) != 1:
+            d.fail("give exactly one of 'box', 'closest' or 'nodes'")
+        kind = given[0]
+        raw = d.get(kind, "any")
+        d.done()
+        key = d.key_path(kind)
+        where = f"{d.file}: {key}"
+        if kind == "nodes":
+            if not isinstance(raw, list) or not raw or not all(isinstance(v, int) and not isinstance(v, bool)
+                                                               for v in raw):
+                raise InputError(f"{where}: must be a non-empty array of node numbers")
+            ids = np.asarray(raw, dtype=np.int64)
+            if ids.min() < 0 or ids.max() >= len(X):
+                raise InputError(f"{where}: node numbers must lie in [0, {len(X) - 1}]")
+        else:
+            pts = raw if isinstance(raw, list) and raw and isinstance(raw[0], list) else [raw]
+            ok = all(isinstance(q, list) and len(q) == 3 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in q)
+                for q in pts)
+            if not ok or (kind == "box" and len(pts) != 2):
+                shape = "two points [[x0, y0, z0], [x1, y1, z1]]" if kind == "box" else \
+                    "a point [x, y, z] or an array of points"
+                raise InputError(f"{where}: must be {shape}")
+            P = np.asarray(pts, dtype=float)
+            if kind == "box":
+                lo, hi = P.min(axis=0), P.max(axis=0)
+                ids = np.flatnonzero(np.all((X >= lo) & (X <= hi), axis=1))
+                if ids.size == 0:
+                    raise InputError(f"{where}: no node lies in the box")
+            else:
+                ids = np.unique(np.argmin(((X[None, :, :] - P[:, None, :]) ** 2).sum(axis=2), axis=1))
+        mesh.node_sets[name] = np.unique(ids).astype(np.int64)
+
+
 def _split_ref(sec: Section, key: str, value: str) -> tuple[str, str]:
     if "." in value:
         body, name = value.split(".", 1)
@@ -137,6 +184,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         options = options.rest() if options is not None else {}
         material = _material(b.get("material", "table"))
         mesh = build_mesh(b.get("mesh", "table"), base, element)
+        _user_sets(b.get("sets", "table", None), mesh)
         b.done()
         if formulation == "solid-shell":
             from ..elements.solidshell import check_options
@@ -175,6 +223,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         else:
             element = r.get("element", "str", None, choices=CELLS)
             mesh = build_mesh(r.get("mesh", "table"), base, element)
+            _user_sets(r.get("sets", "table", None), mesh)
         motion = _motion(r.get("motion", "table", None))
         r.done()
         rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params))
