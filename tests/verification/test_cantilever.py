@@ -69,10 +69,11 @@ def test_cantilever_converges_to_elastica(tmp_path):
         assert res.exit_code == 0
         d = tip(res, prob.bodies[0].mesh) / 10.0
         errors.append(abs(-d[2] - w_ref) / w_ref)
-        # every step reaches the round-off floor of this slender beam (2e-9 .. 1e-8 relative)
+        # every step converges (residual 1e-8 below the step's out-of-balance, or the round-off floor of this
+        # slender beam, 2e-9 .. 1e-8 of the load increment) within 12 iterations
         for s in res.summary["steps"]:
             r = s["residual_norms"]
-            assert r[-1] < 3e-8 and s["iterations"] <= 12
+            assert r[-1] < max(3e-8, 1e-8 * max(r[:2])) and s["iterations"] <= 12
     assert errors[-1] < 0.01, errors
     assert errors[2] < errors[0], errors
 

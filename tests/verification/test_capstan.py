@@ -152,9 +152,10 @@ def test_full_sliding_ratio_is_exp_mu_theta(theta, mu):
     n_slaves = 2 * (n_circ + 1)
     assert len(ms) == 4
     for m in ms[1:]:
-        # every inner-face node touches and slides at every measured step; the forces balance
+        # every inner-face node touches and slides at every measured step; the forces balance (to Newton's
+        # residual tolerance, 1e-8 of the step's out-of-balance)
         assert m["active"] == m["slip"] == n_slaves and m["stick"] == 0, m
-        assert m["balance"] < 1e-9, m
+        assert m["balance"] < 1e-8, m
         # penetration: the largest pressure T_high / (R b) over eps_N
         p_max = m["load_factor"] * T_LOW * math.exp(mu * theta) / (R * WIDTH)
         assert -1.1 * p_max / 1.0e6 < m["min_gap"] < 0.0, m
@@ -181,7 +182,7 @@ def test_turning_drum_gives_the_same_ratio():
     theta, mu = 0.5 * math.pi, 0.3
     drum = _measures(theta, mu, 16, mode="drum")
     for m in drum[1:]:
-        assert m["active"] == m["slip"] == 34 and m["balance"] < 1e-9, m
+        assert m["active"] == m["slip"] == 34 and m["balance"] < 1e-8, m
     assert drum[-1]["ratio"] == pytest.approx(_measures(theta, mu, 16)[-1]["ratio"], rel=1e-4)
 
 

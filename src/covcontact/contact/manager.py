@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..fem.shapes import shape_functions
 from .analytic import Cylinder, Plane, Sphere
 from .driver import EDGE, FACET, VERTEX, project_slaves
+from .edge import edge_vertex_contact
 from .element import CASES
 from .friction import HIST_SIZE, SLIP, STICK, analytic_friction_batch, friction_batch, transfer_history
 from .kernels import contact_batch
@@ -268,23 +268,20 @@ class ContactManager:
             if want_parts:
                 for k in range(4):
                     self._scatter(dofs, np.zeros_like(R), P[:, k], np.zeros_like(r), *parts_acc[k])
-        # edge and vertex points: penalty on the distance to a fixed point of the facet boundary
+        # edge and vertex points: the distance to the closest point of the facet boundary (contact.edge)
         idx = np.flatnonzero(active & ((res.kind == EDGE) | (res.kind == VERTEX)))
         if idx.size:
-            cell = "quad4" if nen == 4 else "quad9"
             conn = p.surface.faces[res.facet[idx]]
             sl = p.slaves[idx]
             nd = 3 * (nen + 1)
             R = np.zeros((idx.size, nd))
             K = np.zeros((idx.size, nd, nd))
             for j, s in enumerate(idx):
-                N, _, _ = shape_functions(cell, res.xi[s][None, :])
-                A = np.zeros((3, nd))
-                for a in range(nen):
-                    A[:, 3 * a: 3 * a + 3] = -N[0, a] * np.eye(3)
-                A[:, -3:] = np.eye(3)
-                R[j] = p.eps[s] * res.g[s] * (A.T @ res.normal[s])
-                K[j] = p.eps[s] * (A.T @ A)
+                lam = float(p.lam_mult[s]) if p.augmented else 0.0
+                R[j], K[j], g = edge_vertex_contact(xe[conn[j]], res.xi[s], xe[p.slaves[s]],
+                                                    1.0 if res.g[s] >= 0.0 else -1.0, float(p.eps[s]), lam,
+                                                    vertex=bool(res.kind[s] == VERTEX))
+                p.g[s] = g
             p.force[idx] = -R[:, -3:]
             dofs = self._dofs(np.hstack([conn, sl[:, None]]))
             self._scatter(dofs, R, K if want_K else None, r, rows, cols, vals)
