@@ -73,13 +73,13 @@ def facet_case(nen, curved, state, with_t, seed=3):
     return xyz, rho + GAP * n, hist, MU[state]
 
 
-def facet_eval(x, nen, xi0, hist, mu):
+def facet_eval(x, nen, xi0, hist, mu, lam_k=0.0):
     """Residual with re-projection for the dof vector x (master nodes first, slave last)."""
     xyz, xs, xi = x[:-3].reshape(nen, 3).copy(), x[-3:].copy(), xi0.copy()
     assert project_on_facet(xyz, xs, xi)[0] == 0
     m = 3 * (nen + 1)
     R, K, ho = np.zeros(m), np.zeros((m, m)), np.zeros(HIST_SIZE)
-    g, state = friction_element(xyz, xs, xi, EPS_N, EPS_T, mu, hist, R, K, ho)
+    g, state = friction_element(xyz, xs, xi, EPS_N, EPS_T, mu, hist, R, K, ho, lam_k)
     return R, K, state, xi, g
 
 
@@ -278,7 +278,7 @@ def test_friction_batch_matches_single_element(nen):
     m = 3 * (nen + 1)
     R, K, H = np.zeros((npair, m)), np.zeros((npair, m, m)), np.zeros((npair, HIST_SIZE))
     g, st = np.zeros(npair), np.zeros(npair, dtype=np.int64)
-    friction_batch(X, conn, sid, xi, eps_n, eps_t, mu, hist, R, K, H, g, st)
+    friction_batch(X, conn, sid, xi, eps_n, eps_t, mu, hist, R, K, H, g, st, np.zeros(npair))
     for k, s in enumerate(singles):
         assert st[k] == s.state and g[k] == pytest.approx(s.gap, abs=1e-14)
         np.testing.assert_allclose(R[k], s.residual, atol=1e-13)
@@ -396,7 +396,7 @@ def test_analytic_batch_matches_single():
         R, K, H = np.zeros((ns, 3)), np.zeros((ns, 3, 3)), np.zeros((ns, HIST_SIZE))
         g, xi, st = np.zeros(ns), np.zeros((ns, 2)), np.zeros(ns, dtype=np.int64)
         analytic_friction_batch(surf.kind, origin, frame, float(surf.radius), float(surf.sigma), xs, eps_n,
-                                eps_t, mu, hist, R, K, H, g, xi, st)
+                                eps_t, mu, hist, R, K, H, g, xi, st, np.zeros(ns))
         for k in range(ns):
             s = surface_friction(surf, xs[k], eps_n[k], eps_t[k], mu[k], hist[k], LAM)
             assert st[k] == s.state and g[k] == s.gap
@@ -404,3 +404,59 @@ def test_analytic_batch_matches_single():
             np.testing.assert_array_equal(K[k], s.tangent)
             np.testing.assert_array_equal(H[k], s.history)
         assert {STICK, SLIP} <= set(st.tolist())
+
+
+# ------------------------------------------------------------------ augmented Lagrangian multiplier
+
+
+@pytest.mark.parametrize("nen,curved", FACETS)
+@pytest.mark.parametrize("state", [STICK, SLIP])
+def test_facet_tangent_with_multiplier_matches_fd(nen, curved, state):
+    """Friction under the augmented normal law: the normal pressure and the Coulomb limit are
+    mu |lam_k + eps_N g|, lam_k fixed during Newton; the tangent stays exact."""
+    xyz, xs, hist, mu = facet_case(nen, curved, state, True)
+    lam_k = -0.5 * EPS_N * abs(GAP)
+    x = np.concatenate([xyz.ravel(), xs])
+    R, K, st, xi, g = facet_eval(x, nen, XI_N, hist, mu, lam_k)
+    R0, _, _, _, _ = facet_eval(x, nen, XI_N, hist, mu, 0.0)
+    assert st == state and g == pytest.approx(GAP, rel=1e-9)
+    assert np.abs(R - R0).max() > 1e-3 * np.abs(R0).max()  # the multiplier acts
+
+    def fun(y):
+        Ry, _, sy, _, _ = facet_eval(y, nen, xi, hist, mu, lam_k)
+        return Ry, sy
+
+    Kfd, states = fd_check(fun, x)
+    assert states == {state}
+    assert rel(K, Kfd) < 1e-6
+
+
+def analytic_eval(surf, y, mu, hist, lam_k):
+    origin, frame = surf.placement(LAM)
+    R, K, H = np.zeros((1, 3)), np.zeros((1, 3, 3)), np.zeros((1, HIST_SIZE))
+    g, xi, st = np.zeros(1), np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
+    analytic_friction_batch(surf.kind, origin, frame, float(surf.radius), float(surf.sigma), y[None, :],
+                            np.array([EPS_N]), np.array([EPS_T]), np.array([mu]), hist[None, :], R, K, H, g,
+                            xi, st, np.array([lam_k]))
+    return R[0], K[0], int(st[0]), float(g[0])
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("state", [STICK, SLIP])
+def test_surface_tangent_with_multiplier_matches_fd(name, state):
+    surf = surfaces()[name]
+    _, xs, hist = surface_case(surf, True)
+    mu = MU[state]
+    lam_k = -0.02 * EPS_N
+    R, K, st, g = analytic_eval(surf, xs, mu, hist, lam_k)
+    assert st == state and g < 0
+    R0 = analytic_eval(surf, xs, mu, hist, 0.0)[0]
+    assert np.abs(R - R0).max() > 1e-3 * np.abs(R0).max()
+
+    def fun(y):
+        Ry, _, sy, _ = analytic_eval(surf, y, mu, hist, lam_k)
+        return Ry, sy
+
+    Kfd, states = fd_check(fun, xs)
+    assert states == {state}
+    assert rel(K, Kfd) < 1e-6

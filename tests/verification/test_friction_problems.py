@@ -58,3 +58,29 @@ def test_friction_between_deformable_bodies(tmp_path):
     assert abs(fx) <= 0.2 * fz * (1 + 1e-9)
     rep = check_tangent(prob, step=2, tangent="exact", columns=40)
     assert rep["relative_error"] < 1e-6, rep
+
+
+def test_sliding_with_augmented_normal_law(tmp_path):
+    """Friction under the augmented Lagrangian normal law: the penetration falls below the tolerance 1e-7
+    (the penalty 1e4 alone lets the block sink about 1e-3), and the sliding force is still mu N."""
+    prob = load_problem(SLIDING)
+    pair = prob.contacts[0]
+    pair.penalty, pair.method, pair.gap_tolerance, pair.gap_tolerance_relative = 1.0e4, "augmented", 1e-7, None
+    res = prob.run(out=tmp_path)
+    assert res.exit_code == 0
+    last_step = res.summary["steps"][-1]
+    last = last_step["pairs"]["contact1"]
+    assert last["slip"] == last["active_contacts"] == 25
+    assert -1e-7 <= last["min_gap"] < 0.0
+    assert sum(s.get("uzawa_iterations", 0) for s in res.summary["steps"]) > 0
+    fx, fy, fz = last["contact_force"]
+    assert 0.2995 < -fx / fz <= 0.3 * (1 + 1e-9)
+    react = last_step["reactions"]["block.zmax"]
+    assert np.allclose(react, [-fx, -fy, -fz], rtol=1e-8, atol=1e-9 * fz)
+
+
+def test_assembled_friction_tangent_augmented():
+    prob = load_problem(SLIDING)
+    prob.contacts[0].method, prob.contacts[0].gap_tolerance_relative = "augmented", 1e-3
+    rep = check_tangent(prob, step=3, tangent="exact", columns=40)
+    assert rep["converged"] and rep["relative_error"] < 1e-6, rep

@@ -176,7 +176,7 @@ def new_analytic_friction_work():
 
 @njit(cache=True)
 def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t, mu, hist, xi,
-                           R_out, K_out, hist_out, work):
+                           R_out, K_out, hist_out, work, lam_k=0.0):
     """Friction element of one slave node against a rigid analytic surface (3 x 3, slave dofs).
 
     origin, frame: current placement (frame rows e1, e2, e3). xi: (2,) out, projection. History
@@ -186,7 +186,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
     aw, fw, geo = work
     rho, rho1, rho2, rho3, a_cov, a_con, a_n, a_ni, ar, d1, d2, r, tvec, dtdx, xin, dxi, T, pt, dummy = geo
     g, chart = analytic_core(kind, origin, frame, radius, sigma, xs, eps_n, CASE_EXACT, False, xi, R_out,
-                             K_out, dummy, aw)
+                             K_out, dummy, aw, lam_k)
     nrm = aw[4]
     surface_derivs(kind, origin, frame, radius, sigma, chart, xi, rho, rho1, rho2, rho3)
     for i in range(2):
@@ -209,7 +209,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
         hist_out[H_RHO_COV + e] = s1
         hist_out[H_RHO_COV + 3 + e] = s2
     hist_out[H_FLAG] = 1.0
-    if g > 0.0:
+    if lam_k + eps_n * g > 0.0:
         return g, OPEN
     if mu == 0.0:
         return g, SLIP
@@ -236,7 +236,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
     dxi[0] = xi[0] - xin[0]
     dxi[1] = xi[1] - xin[1]
     state = friction_generic(1, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, dxi, tvec, dtdx,
-                             eps_n, eps_t, mu, R_out, K_out, T, fw)
+                             eps_n, eps_t, mu, R_out, K_out, T, fw, lam_k)
     hist_out[H_T] = T[0]
     hist_out[H_T + 1] = T[1]
     return g, state
@@ -244,8 +244,9 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
 
 @njit(cache=True, parallel=True)
 def analytic_friction_batch(kind, origin, frame, radius, sigma, xs, eps_n, eps_t, mu, hist, R_out, K_out,
-                            hist_out, g_out, xi_out, state_out):
-    """``analytic_friction_core`` for ns slave points (ns, 3), parallel; per-slave eps_n, eps_t, mu, hist.
+                            hist_out, g_out, xi_out, state_out, lam_k):
+    """``analytic_friction_core`` for ns slave points (ns, 3), parallel; per-slave eps_n, eps_t, mu, hist and
+    lam_k (Uzawa multipliers, zeros for the penalty).
 
     Out: R_out (ns, 3), K_out (ns, 3, 3), hist_out (ns, HIST_SIZE), g_out (ns,), xi_out (ns, 2),
     state_out (ns,) int64.
@@ -258,7 +259,8 @@ def analytic_friction_batch(kind, origin, frame, radius, sigma, xs, eps_n, eps_t
         hi = min(ns, lo + _CHUNK)
         for s in range(lo, hi):
             g, st = analytic_friction_core(kind, origin, frame, radius, sigma, xs[s], eps_n[s], eps_t[s],
-                                           mu[s], hist[s], xi_out[s], R_out[s], K_out[s], hist_out[s], work)
+                                           mu[s], hist[s], xi_out[s], R_out[s], K_out[s], hist_out[s], work,
+                                           lam_k[s])
             g_out[s] = g
             state_out[s] = st
 

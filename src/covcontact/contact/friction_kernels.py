@@ -104,7 +104,7 @@ def _reduce(f, xp, m, out):
 
 @njit(cache=True)
 def friction_generic(nb, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, dxi, tvec, dtdx,
-                     eps_n, eps_t, mu, R_out, K_out, T_out, fw):
+                     eps_n, eps_t, mu, R_out, K_out, T_out, fw, lam_k=0.0):
     """Add the friction residual and exact tangent to R_out, K_out; return STICK or SLIP.
 
     Dofs: nb blocks of 3, m = 3 nb. Per block b: d r / d x_b = ar[b] I, d rho_i / d x_b = d1[i, b] I,
@@ -190,7 +190,7 @@ def friction_generic(nb, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, 
     ta0 = a_con[0, 0] * Ttr0 + a_con[0, 1] * Ttr1
     ta1 = a_con[1, 0] * Ttr0 + a_con[1, 1] * Ttr1
     nu = np.sqrt(max(Ttr0 * ta0 + Ttr1 * ta1, 0.0))
-    kappa = -mu * eps_n * g
+    kappa = -mu * (lam_k + eps_n * g)  # Coulomb limit from the normal pressure
     if nu <= kappa:
         state = STICK
         T0 = Ttr0
@@ -314,7 +314,7 @@ def new_facet_work():
 
 
 @njit(cache=True)
-def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_out, work):
+def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_out, work, lam_k=0.0):
     """Residual and exact tangent (normal + friction) of one slave node against one facet.
 
     Args:
@@ -334,7 +334,7 @@ def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_
     ar, d1, d2, r, tvec, dtdx, dxi, T, dummy = geo[21:]
     nen = xyz.shape[0]
     nb = nen + 1
-    g = element_core(xyz, xs, xi1, xi2, eps_n, CASE_EXACT, False, R_out, K_out, dummy, ew)
+    g = element_core(xyz, xs, xi1, xi2, eps_n, CASE_EXACT, False, R_out, K_out, dummy, ew, lam_k)
     for k in range(HIST_SIZE):
         hist_out[k] = hist[k]
     if g == np.inf:
@@ -363,7 +363,7 @@ def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_
     hist_out[H_T] = 0.0
     hist_out[H_T + 1] = 0.0
     hist_out[H_FLAG] = 1.0
-    if g > 0.0:
+    if lam_k + eps_n * g > 0.0:
         return g, OPEN
     if mu == 0.0:
         return g, SLIP
@@ -407,26 +407,27 @@ def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_
     dxi[0] = xi1 - hist[H_XI]
     dxi[1] = xi2 - hist[H_XI + 1]
     state = friction_generic(nb, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, dxi, tvec,
-                             dtdx, eps_n, eps_t, mu, R_out, K_out, T, fw)
+                             dtdx, eps_n, eps_t, mu, R_out, K_out, T, fw, lam_k)
     hist_out[H_T] = T[0]
     hist_out[H_T + 1] = T[1]
     return g, state
 
 
 @njit(cache=True)
-def friction_element(xyz, xs, xi, eps_n, eps_t, mu, hist, R_out, K_out, hist_out):
+def friction_element(xyz, xs, xi, eps_n, eps_t, mu, hist, R_out, K_out, hist_out, lam_k=0.0):
     """Single-pair entry point of ``friction_core`` (own scratch); xi: (2,). Returns (g, state)."""
     return friction_core(xyz, xs, xi[0], xi[1], eps_n, eps_t, mu, hist, R_out, K_out, hist_out,
-                         new_facet_work())
+                         new_facet_work(), lam_k)
 
 
 @njit(cache=True, parallel=True)
 def friction_batch(x_nodes, facet_conn, slave_ids, xi, eps_n, eps_t, mu, hist, R_out, K_out, hist_out,
-                   g_out, state_out):
+                   g_out, state_out, lam_k):
     """``friction_core`` over npair slave-facet pairs of one facet type, parallel over pairs.
 
     Args: x_nodes (nnode, 3); facet_conn (npair, n) int64; slave_ids (npair,) int64; xi (npair, 2)
-    converged projections; eps_n, eps_t, mu (npair,); hist (npair, HIST_SIZE). Out: R_out (npair, m),
+    converged projections; eps_n, eps_t, mu, lam_k (npair,) (lam_k: Uzawa multipliers, zeros for the
+    penalty); hist (npair, HIST_SIZE). Out: R_out (npair, m),
     K_out (npair, m, m), hist_out (npair, HIST_SIZE), g_out (npair,), state_out (npair,) int64.
     """
     npair, nen = facet_conn.shape
@@ -444,6 +445,6 @@ def friction_batch(x_nodes, facet_conn, slave_ids, xi, eps_n, eps_t, mu, hist, R
             for p in range(3):
                 xs[p] = x_nodes[slave_ids[k], p]
             g, st = friction_core(xyz, xs, xi[k, 0], xi[k, 1], eps_n[k], eps_t[k], mu[k], hist[k], R_out[k],
-                                  K_out[k], hist_out[k], work)
+                                  K_out[k], hist_out[k], work, lam_k[k])
             g_out[k] = g
             state_out[k] = st

@@ -314,7 +314,8 @@ class ContactManager:
         g = np.zeros(idx.size)
         state = np.zeros(idx.size, dtype=np.int64)
         friction_batch(xe, conn, sl, xi, np.ascontiguousarray(eps), np.ascontiguousarray(p.eps_t[idx]),
-                       np.full(idx.size, p.mu), hist, R, K, hist_out, g, state)
+                       np.full(idx.size, p.mu), hist, R, K, hist_out, g, state,
+                       np.ascontiguousarray(p.lam_mult[idx]) if p.augmented else np.zeros(idx.size))
         p.hist_trial[idx] = hist_out
         p.state[idx] = state
         return R, K, g
@@ -336,7 +337,8 @@ class ContactManager:
             analytic_friction_batch(p.analytic.kind, origin, frame, float(p.analytic.radius),
                                     float(p.analytic.sigma), xs, np.ascontiguousarray(p.eps),
                                     np.ascontiguousarray(p.eps_t), np.full(ns, p.mu), p.hist.copy(), R3, K3,
-                                    hist_out, g, xi, state)
+                                    hist_out, g, xi, state,
+                                    np.ascontiguousarray(p.lam_mult) if p.augmented else np.zeros(ns))
             out.residual, out.tangent, out.gap = R3, K3, g
             p.hist_trial[:] = hist_out
             p.state[:] = state
@@ -401,7 +403,7 @@ class ContactManager:
         for p in self.passes:
             p.committed = (p.prev_facet.copy(), p.prev_xi.copy())
             if p.mu > 0.0:
-                open_ = p.g > 0.0
+                open_ = ~self._active(p)
                 p.hist = p.hist_trial.copy()
                 p.hist[open_] = 0.0  # a node that lost contact starts again without history
                 p.hist_facet = p.prev_facet.copy()
