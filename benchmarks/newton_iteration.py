@@ -7,6 +7,8 @@ iterations. Writes JSON.
 
     python benchmarks/newton_iteration.py --out newton.json            # sizes up to ~3e5 dofs
     python benchmarks/newton_iteration.py --quick                      # small sizes only
+    python benchmarks/newton_iteration.py --blocks --plates 408 --iterations 2   # one 1e6-dof plate,
+                                                                       # two Newton iterations timed
 """
 
 from __future__ import annotations
@@ -50,7 +52,9 @@ def plate_problem(n: int) -> Problem:
         steps=Steps.equal(1), output=OutputOptions(vtu=False), solver=SolverOptions())
 
 
-def measure(prob: Problem) -> dict:
+def measure(prob: Problem, iterations: int | None = None) -> dict:
+    if iterations:  # time a fixed number of iterations of the first step (no cutback)
+        prob.solver = SolverOptions(max_iterations=iterations, max_cutbacks=0)
     t0 = time.perf_counter()
     model = Model(prob)
     newton = Newton(model, prob.solver)
@@ -72,16 +76,24 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=None)
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--blocks", type=int, nargs="*", help="block sizes n (n^3 hex8); none: skip the blocks")
+    ap.add_argument("--plates", type=int, nargs="*", help="plate sizes n (n x n hex8, 6 (n + 1)^2 dofs)")
+    ap.add_argument("--iterations", type=int, default=None,
+                    help="time only this many Newton iterations of the step (for the largest sizes)")
     args = ap.parse_args()
     blocks = [8, 12] if args.quick else [8, 16, 24, 32, 40]
     plates = [20, 40] if args.quick else [40, 80, 120, 160, 200]
+    if args.blocks is not None:
+        blocks = args.blocks
+    if args.plates is not None:
+        plates = args.plates
     measure(block_problem(4))  # compile
     rows = []
     for n in blocks:
-        rows.append(measure(block_problem(n)))
+        rows.append(measure(block_problem(n), args.iterations))
         print(json.dumps(rows[-1]))
     for n in plates:
-        rows.append(measure(plate_problem(n)))
+        rows.append(measure(plate_problem(n), args.iterations))
         print(json.dumps(rows[-1]))
     result = {"benchmark": "newton_iteration", "machine": platform.machine(), "threads": numba.get_num_threads(),
               "date": time.strftime("%Y-%m-%d"), "rows": rows}
