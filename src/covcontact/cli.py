@@ -53,7 +53,8 @@ def _check_solver(name: str | None) -> None:
     from .solvers.linear import available
 
     if name not in available():
-        raise InputError(f"--solver: unknown or unavailable linear solver {name!r} "
+        hint = " (needs petsc4py and mpi4py: the `mpi` extra)" if name.startswith("petsc") else ""
+        raise InputError(f"--solver: unknown or unavailable linear solver {name!r}{hint} "
                          f"(available here: {', '.join(available())})")
 
 
@@ -63,7 +64,7 @@ def cmd_run(args) -> int:
     problem = load_problem(args.problem)
     _check_solver(args.solver or problem.solver.linear)
     result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver)
-    if not args.quiet:
+    if not args.quiet and getattr(result.model, "is_root", True):  # one line from a distributed run
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code
 

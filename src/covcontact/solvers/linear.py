@@ -63,6 +63,8 @@ REGISTRY: dict[str, Backend] = {
     "mumps": Backend("backends", "MumpsSolver"),
     "superlu": Backend("backends", "SuperLUSolver"),
     "cg-amg": Backend("backends", "AMGSolver", auto=False),
+    "petsc": Backend("petsc_backend", "PetscSolver", auto=False),
+    "petsc-gamg": Backend("petsc_backend", "PetscGAMGSolver", auto=False),
 }
 BACKENDS = tuple(REGISTRY)
 _DIRECT = tuple(name for name, b in REGISTRY.items() if b.auto)

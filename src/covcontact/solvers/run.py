@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 import time
+import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -68,14 +69,59 @@ def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, st
     writer.write_vtu(step, lam, points, blocks, pdata)
 
 
+class _NoWriter:
+    """The writer of the ranks other than 0 in a distributed run: writes nothing."""
+
+    def write_vtu(self, *args, **kwargs) -> None:
+        pass
+
+    def add_iterations(self, *args, **kwargs) -> None:
+        pass
+
+    def write_summary(self, *args, **kwargs) -> None:
+        pass
+
+
+def _make_model(problem, tangent: str, linear: str | None) -> Model:
+    """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
+    from .linear import REGISTRY, backend_class
+
+    name = (linear or problem.solver.linear or "auto").lower().strip()
+    if name in REGISTRY and getattr(backend_class(name), "distributed", False):
+        from ..parallel.model import DistributedModel
+
+        return DistributedModel(problem, tangent=tangent)
+    return Model(problem, tangent=tangent)
+
+
 def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> Result:
-    """Solve ``problem`` and write its results; see ``Problem.run``."""
+    """Solve ``problem`` and write its results; see ``Problem.run``.
+
+    With a distributing backend (``petsc``, ``petsc-gamg``) every MPI rank runs this function; only
+    rank 0 writes files and prints.
+    """
     t_start = time.perf_counter()
     tangent = tangent or (problem.contacts[0].tangent if problem.contacts else "a")
     out = Path(out) if out is not None else Path("results") / problem.name
-    model = Model(problem, tangent=tangent)
+    model = _make_model(problem, tangent, linear)
+    if getattr(model, "size", 1) > 1:
+        try:
+            return _run(problem, model, out, tangent, quiet, linear, t_start)
+        except Exception:  # noqa: BLE001  (maybe on one rank only: the others would wait forever)
+            traceback.print_exc()
+            sys.stderr.flush()
+            model.comm.Abort(3)
+    return _run(problem, model, out, tangent, quiet, linear, t_start)
+
+
+def _run(problem, model, out: Path, tangent: str, quiet: bool, linear, t_start: float) -> Result:
     newton = Newton(model, problem.solver, linear=linear)
-    writer = ResultWriter(out)
+    root = getattr(model, "is_root", True)
+    writer = ResultWriter(out) if root else _NoWriter()
+
+    def say(msg: str) -> None:
+        if root:
+            print(msg, file=sys.stderr, flush=True)
     u = model.prescribed(0.0)
     summary = {
         "problem": problem.name,
@@ -88,6 +134,8 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
         "wall_time_s": 0.0,
         "steps": [],
     }
+    if hasattr(model, "partition_report"):
+        summary["parallel"] = model.partition_report()
     t_out = 0.0
     if problem.output.vtu:
         t0 = time.perf_counter()
@@ -128,7 +176,7 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
                    f"  active {model.active_count():5d}" + (f"  cutbacks {cutbacks}" if cutbacks else ""))
             if not success:
                 msg += f"  FAILED: {why}"
-            print(msg, file=sys.stderr, flush=True)
+            say(msg)
         if not success:
             ok = False
             break
@@ -140,6 +188,10 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
         summary["wall_time_s"] = time.perf_counter() - t_start
         writer.write_summary(summary)
     summary["converged"] = ok
+    if "parallel" in summary:
+        lin = newton.linear
+        summary["parallel"]["linear"] = {"analyses": lin.n_analyses, "factorizations": lin.n_factorizations,
+                                         "krylov_iterations": getattr(lin, "krylov_iterations", 0)}
     timing = dict(newton.timing)
     split = getattr(model.contact, "timing", None)
     if split:
@@ -151,13 +203,13 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> R
     summary["timing"] = {k: round(v, 4) for k, v in timing.items()}
     summary["wall_time_s"] = timing["total"]
     writer.write_summary(summary)
-    if problem.output.pictures and problem.output.vtu:
+    if problem.output.pictures and problem.output.vtu and root:
         from ..io.pictures import render_pictures
 
         for path in render_pictures(out):
             if not quiet:
-                print(f"picture {path}", file=sys.stderr, flush=True)
+                say(f"picture {path}")
     if not quiet:
         split = "  ".join(f"{k} {v:.2f}s" for k, v in summary["timing"].items())
-        print(f"time: {split}", file=sys.stderr, flush=True)
+        say(f"time: {split}")
     return Result(summary=summary, u=u, out=out, exit_code=0 if ok else 1, model=model)

@@ -1,0 +1,300 @@
+"""Distributed model: replicated state, distributed work.
+
+Every rank loads the whole problem and keeps the full node arrays, loads, Dirichlet data and displacement
+vector u. Each rank assembles only its own elements (bodies built from its cells; nodes stay global) and
+its own contact slaves, so the compiled element and contact loops run unchanged on the local part. The
+residual is summed over the ranks into a replicated vector; the tangent stays distributed: a
+:class:`DistMatrix` holds this rank's share, which the PETSc backend hands to one MPIAIJ matrix.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..assembly.pattern import Pattern
+from ..assembly.system import BodyBlock, InvertedElementError, System
+from ..elements.base import SolidStress
+from ..elements.solid import SolidBody
+from ..solvers.model import Model, NoContact
+from .comm import gather_all, share_cores, sum_all
+from .partition import DofLayout, node_owners, rcb
+
+
+class Structure:
+    """Where this rank's share of the tangent goes in PETSc (built once per partition).
+
+    Attributes:
+        keep: indices into the local pattern's data of the entries this rank may fill.
+        rows, cols: their PETSc row and column (int32/int64 as PETSc's index type wants).
+        bc: boolean over ``keep``: the entry lies in a constrained row or column.
+        diag: PETSc dofs of the constrained dofs this rank owns (they get the unit diagonal).
+    """
+
+    def __init__(self, pattern: Pattern, touched: np.ndarray, constrained: np.ndarray, layout: DofLayout):
+        rows = np.repeat(np.arange(pattern.n_dofs), np.diff(pattern.indptr))
+        cols = pattern.indices.astype(np.int64)
+        self.keep = np.flatnonzero(touched[rows // 3])
+        r, c = rows[self.keep], cols[self.keep]
+        self.bc = constrained[r] | constrained[c]
+        self.bc_data = self.keep[self.bc]  # pattern data positions zeroed by the elimination
+        self.rows = layout.to_petsc[r]
+        self.cols = layout.to_petsc[c]
+        owned = layout.owned
+        self.diag = layout.to_petsc[owned[constrained[owned]]]
+        self.layout = layout
+
+
+class DistMatrix:
+    """This rank's share of the global tangent; the global matrix is the sum over the ranks.
+
+    ``body`` is the CSR of the local elements on the local pattern, ``contact`` the CSR of the local
+    contact pairs (or None). After :meth:`eliminate` the rows and columns of constrained dofs are zero and
+    the unit diagonal is added once, by the owner of each dof. ``K @ v`` is the global product, replicated.
+    """
+
+    def __init__(self, comm, structure: Structure, body: sp.csr_matrix, contact: sp.csr_matrix | None,
+                 constrained: np.ndarray):
+        self.comm = comm
+        self.structure = structure
+        self.layout = structure.layout
+        self.body = body
+        self.contact = contact if contact is not None and contact.nnz else None
+        self.constrained = constrained
+        self.eliminated = False
+        self.shape = body.shape
+
+    def __matmul__(self, v: np.ndarray) -> np.ndarray:
+        y = self.body @ v
+        if self.contact is not None:
+            y = y + self.contact @ v
+        y = sum_all(self.comm, y)
+        if self.eliminated:
+            y[self.constrained] += v[self.constrained]
+        return y
+
+    def eliminate(self) -> DistMatrix:
+        """Zero the constrained rows and columns (unit diagonal added by the owners); in place."""
+        if self.eliminated:
+            return self
+        self.body.data[self.structure.bc_data] = 0.0
+        if self.contact is not None:
+            K = self.contact
+            rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+            K.data[self.constrained[rows] | self.constrained[K.indices]] = 0.0
+        self.eliminated = True
+        return self
+
+    def body_values(self) -> np.ndarray:
+        """Values of the entries of ``structure.rows/cols``."""
+        return self.body.data[self.structure.keep]
+
+    def contact_triplets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """PETSc rows, columns and values of the contact share (may repeat entries)."""
+        K = self.contact
+        if K is None:
+            z = np.zeros(0, dtype=np.int64)
+            return z, z, np.zeros(0)
+        rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+        t = self.layout.to_petsc
+        return t[rows], t[K.indices.astype(np.int64)], K.data
+
+
+class PartBody:
+    """A body of which this rank assembles some cells; ``stress`` gathers the fields of all ranks."""
+
+    def __init__(self, local, elements: np.ndarray, n_elements: int, comm):
+        self.local = local
+        self.elements = elements  # global element ids of the local cells
+        self.n_total = n_elements
+        self.comm = comm
+
+    def __getattr__(self, name):
+        return getattr(self.local, name)
+
+    def stress(self, u: np.ndarray) -> SolidStress:
+        """The body's stress fields (global element order), on every rank (collective)."""
+        st = self.local.stress(u)
+        cells = self.local.cells
+        n = self.local.n_nodes
+        sums = np.zeros((n, 7))
+        flat = cells.ravel()
+        for I in range(6):
+            sums[:, I] = np.bincount(flat, weights=np.repeat(st.cauchy[:, I], cells.shape[1]), minlength=n)
+        sums[:, 6] = np.bincount(flat, minlength=n)
+        sums = sum_all(self.comm, sums)
+        fields = np.hstack([st.cauchy, st.pk2, st.green_lagrange, st.von_mises[:, None]])
+        full = np.empty((self.n_total, fields.shape[1]))
+        for idx, f in gather_all(self.comm, (self.elements, fields)):
+            full[idx] = f
+        nodal = sums[:, :6] / np.maximum(sums[:, 6], 1.0)[:, None]
+        return SolidStress(cauchy=np.ascontiguousarray(full[:, :6]), pk2=np.ascontiguousarray(full[:, 6:12]),
+                           green_lagrange=np.ascontiguousarray(full[:, 12:18]), cauchy_nodal=nodal,
+                           von_mises=np.ascontiguousarray(full[:, 18]))
+
+
+def _make_body(body, cells: np.ndarray):
+    if body.formulation == "solid-shell":
+        from ..elements.solidshell import SolidShellBody
+
+        return SolidShellBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
+    return SolidBody(body.mesh.cell_type, body.mesh.points, cells, body.material)
+
+
+class DistributedSystem(System):
+    """The System of one rank: global numbering, loads and Dirichlet data; local elements only.
+
+    ``blocks[k].solid`` is a :class:`PartBody` (its ``stress`` is collective); the local pattern couples
+    only the nodes of local elements.
+    """
+
+    def __init__(self, problem, comm):
+        self.problem = problem
+        self.comm = comm
+        rank, size = comm.rank, comm.size
+        offsets, offset = [], 0
+        for body in problem.bodies:
+            offsets.append(offset)
+            offset += body.mesh.n_nodes
+        self.n_nodes = offset
+        self.n_dofs = 3 * offset
+        self.X = np.zeros((self.n_nodes, 3))
+        for off, body in zip(offsets, problem.bodies):
+            self.X[off: off + body.mesh.n_nodes] = body.mesh.points
+        cells = [body.mesh.cells + off for off, body in zip(offsets, problem.bodies)]
+        centroids = np.vstack([self.X[c].mean(axis=1) for c in cells])
+        weights = np.concatenate([np.full(len(c), float(c.shape[1]) ** 2) for c in cells])
+        part = rcb(centroids, weights, size)
+        parts = np.split(part, np.cumsum([len(c) for c in cells])[:-1])
+        self.blocks: list[BodyBlock] = []
+        local_cells = []
+        for off, body, p in zip(offsets, problem.bodies, parts):
+            elements = np.flatnonzero(p == rank)
+            local = _make_body(body, body.mesh.cells[elements])
+            self.blocks.append(BodyBlock(body.name, off, body.mesh.n_nodes,
+                                         PartBody(local, elements, body.mesh.n_cells, comm)))
+            local_cells.append(body.mesh.cells[elements] + off)
+        self.element_parts = parts
+        self.pattern = Pattern(self.n_nodes, local_cells)
+        self.owner = node_owners(self.n_nodes, cells, parts)
+        self.layout = DofLayout.from_owners(self.owner, rank, size, self.X)
+        self._build_loads()
+        self._build_dirichlet()
+        touched = np.zeros(self.n_nodes, dtype=bool)
+        for c in local_cells:
+            touched[c.ravel()] = True
+        self.structure = Structure(self.pattern, touched, self.constrained, self.layout)
+
+    def local_internal(self, u: np.ndarray, want_K: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+        """This rank's share of the internal forces (n_dofs,) and tangent data (pattern.nnz,) or None.
+
+        Raises InvertedElementError on every rank when an element of any rank is inverted.
+        """
+        data = np.zeros(self.pattern.nnz) if want_K else np.zeros(1)
+        r = np.zeros(self.n_dofs)
+        U = u.reshape(-1, 3)
+        bad = (len(self.blocks), 0)
+        for k, blk in enumerate(self.blocks):
+            e = blk.solid.local.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, self.pattern,
+                                         node_offset=blk.offset, want_K=want_K)
+            if e >= 0 and bad[0] == len(self.blocks):
+                bad = (k, int(blk.solid.elements[e]))
+        bad = min(gather_all(self.comm, bad))
+        if bad[0] < len(self.blocks):
+            raise InvertedElementError(self.blocks[bad[0]].name, bad[1])
+        return r, (data if want_K else None)
+
+    def internal(self, u: np.ndarray, want_K: bool = True):
+        """Global internal forces (replicated) and this rank's tangent share (DistMatrix or None)."""
+        r, data = self.local_internal(u, want_K)
+        K = DistMatrix(self.comm, self.structure, self.pattern.csr(data), None, self.constrained) if want_K \
+            else None
+        return sum_all(self.comm, r), K
+
+    def energy(self, u: np.ndarray) -> float:
+        U = u.reshape(-1, 3)
+        e = sum(blk.solid.local.energy(U[blk.offset: blk.offset + blk.n_nodes]) for blk in self.blocks)
+        return float(sum_all(self.comm, np.array([e]))[0])
+
+    def eliminate(self, K):
+        """Dirichlet elimination of a DistMatrix (in place); a scipy matrix as in the serial System."""
+        if isinstance(K, DistMatrix):
+            return K.eliminate()
+        return super().eliminate(K)
+
+
+class DistributedModel(Model):
+    """The Model of one rank of a distributed run (``mpiexec -n N covcontact run ... --solver petsc``).
+
+    Same interface as :class:`covcontact.solvers.model.Model`; ``evaluate`` returns the replicated
+    residual and a :class:`DistMatrix`. Collective: every rank calls the same methods in the same order.
+    """
+
+    distributed = True
+
+    def __init__(self, problem, tangent: str = "a", comm=None):
+        if comm is None:
+            from .comm import world
+
+            comm = world()
+        self.comm = comm
+        self.rank, self.size = comm.rank, comm.size
+        self.threads = share_cores(comm)
+        self.problem = problem
+        self.system = DistributedSystem(problem, comm)
+        self.tangent = tangent
+        if problem.contacts:
+            from .contact import DistributedContact
+
+            self.contact = DistributedContact(problem, self.system, tangent, comm)
+        else:
+            self.contact = NoContact()
+        self.symmetric = self.contact.symmetric
+
+    @property
+    def is_root(self) -> bool:
+        return self.rank == 0
+
+    @property
+    def layout(self) -> DofLayout:
+        return self.system.layout
+
+    def evaluate(self, u: np.ndarray, lam: float, want_K: bool = True, timing: dict | None = None):
+        """Residual R = f_int + f_contact - lam f_ext (replicated) and the tangent share (or None)."""
+        t0 = time.perf_counter()
+        r, data = self.system.local_internal(u, want_K=want_K)
+        t1 = time.perf_counter()
+        rc, Kc = self.contact.evaluate(self.positions(u), lam, want_K)
+        t2 = time.perf_counter()
+        if rc is not None:
+            r += rc
+        r = sum_all(self.comm, r)
+        t3 = time.perf_counter()
+        if timing is not None:
+            timing["assembly"] += t1 - t0
+            timing["contact"] += t2 - t1
+            timing["comm"] = timing.get("comm", 0.0) + t3 - t2
+        K = None
+        if want_K:
+            sysm = self.system
+            K = DistMatrix(self.comm, sysm.structure, sysm.pattern.csr(data), Kc, sysm.constrained)
+        return r - lam * self.f_ext, K
+
+    def eliminate(self, K):
+        return self.system.eliminate(K)
+
+    def active_count(self) -> int:
+        return self.contact.active_count()
+
+    def partition_report(self) -> dict:
+        """Elements, owned dofs and contact slaves per rank (collective)."""
+        own = sum(len(blk.solid.elements) for blk in self.system.blocks)
+        slaves = sum(len(p.slaves) for p in getattr(self.contact, "passes", []))
+        rows = gather_all(self.comm, (own, self.layout.hi - self.layout.lo, slaves))
+        return {"ranks": self.size, "elements": [r[0] for r in rows], "owned_dofs": [r[1] for r in rows],
+                "slaves": [r[2] for r in rows], "numba_threads": self.threads}
+
+
+__all__ = ["DistMatrix", "DistributedModel", "DistributedSystem", "PartBody", "Structure"]

@@ -1,0 +1,450 @@
+"""PETSc backends (petsc4py): MUMPS LU / LDL^T and CG/GMRES + GAMG, serial or distributed over MPI.
+
+- ``petsc``: KSP preonly + MUMPS; Cholesky (MUMPS LDL^T with pivoting, so indefinite tangents work) for
+  symmetric matrices, LU otherwise (friction).
+- ``petsc-gamg``: CG (GMRES if CG fails, and for non-symmetric matrices) preconditioned by PETSc's
+  smoothed-aggregation GAMG with the rigid-body modes as near-null space.
+
+Both accept a SciPy CSR matrix (one process, the interface of every backend) or the
+:class:`covcontact.parallel.model.DistMatrix` of a distributed run: each rank's share of the tangent is
+summed into one MPIAIJ matrix (block size 3) through PETSc's COO interface; the structure is set once per
+pattern (``setPreallocationCOO``) and the values every iteration (``setValuesCOO``). The contact entries
+keep a structure that only grows (entries of lost contacts stay as zeros), so the symbolic factorisation is
+redone only when a new coupling appears. The solution is gathered to every rank.
+
+Any PETSc option can be added with the prefix ``covcontact_`` through ``PETSC_OPTIONS`` (for example
+``-covcontact_pc_factor_mat_solver_type superlu_dist`` or ``-covcontact_ksp_monitor``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import time
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from .linear import LinearSolver, LinearSolverError, SingularMatrixError, rigid_body_modes
+
+PREFIX = "covcontact_"
+
+
+def petsc() -> Any:
+    """The petsc4py PETSc module, initialised once without the command line (``PETSC_OPTIONS`` applies)."""
+    from mpi4py import MPI  # noqa: F401  (mpi4py owns MPI_Init / MPI_Finalize)
+
+    if "petsc4py.PETSc" not in sys.modules:
+        import petsc4py
+
+        petsc4py.init([sys.argv[0] if sys.argv and sys.argv[0] else "covcontact"])
+    from petsc4py import PETSc
+
+    return PETSc
+
+
+def _version() -> str:
+    import petsc4py
+
+    return petsc4py.__version__
+
+
+class _Operator:
+    """One PETSc matrix, its COO structure and a KSP (one per structure)."""
+
+    def __init__(self, comm, n_local: int, n_global: int, bs: int, rows: np.ndarray, cols: np.ndarray,
+                 symmetric: bool):
+        P = petsc()
+        self.P = P
+        self.comm = comm
+        self.A = P.Mat().create(comm=comm)
+        self.A.setSizes(((n_local, n_global), (n_local, n_global)), bsize=bs)
+        self.A.setType(P.Mat.Type.AIJ)
+        self.A.setPreallocationCOO(rows.astype(P.IntType), cols.astype(P.IntType))
+        self.symmetric = symmetric
+        self.ksp = None
+        self.b = self.A.createVecLeft()
+        self.x = self.A.createVecRight()
+        self._all = None
+
+    def set_values(self, v: np.ndarray) -> None:
+        self.A.setValuesCOO(np.ascontiguousarray(v, dtype=self.P.ScalarType), addv=self.P.InsertMode.INSERT_VALUES)
+        if self.symmetric:
+            self.A.setOption(self.P.Mat.Option.SYMMETRIC, True)
+
+    def gather(self, x) -> np.ndarray:
+        """The whole vector x on every rank (PETSc order)."""
+        if self.comm.getSize() == 1:
+            return x.getArray(readonly=True).copy()
+        if self._all is None:
+            self._all = self.P.Scatter.toAll(x)
+        sc, xall = self._all
+        sc.scatter(x, xall, addv=self.P.InsertMode.INSERT_VALUES, mode=self.P.ScatterMode.FORWARD)
+        return xall.getArray(readonly=True).copy()
+
+    def destroy(self) -> None:
+        for obj in (self.ksp, self.A, self.b, self.x):
+            if obj is not None:
+                obj.destroy()
+        if self._all is not None:
+            for obj in self._all:
+                obj.destroy()
+        self.ksp = None
+
+
+class PetscSolver(LinearSolver):
+    """PETSc + MUMPS direct solver (``petsc``); serial on SciPy matrices, distributed on DistMatrix.
+
+    Options: ``icntl`` dict of MUMPS ICNTL values (default {14: 50}: 50 % extra workspace).
+    """
+
+    name = "petsc"
+    direct = True
+    distributed = True
+
+    @staticmethod
+    def probe() -> tuple[bool, str, str]:
+        P = petsc()
+        if not P.Sys.hasExternalPackage("mumps"):
+            return False, _version(), "PETSc built without MUMPS"
+        return True, _version(), "PETSc + MUMPS LDL^T / LU; distributed under mpiexec"
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, icntl: dict | None = None):
+        super().__init__(symmetric, check_tol)
+        self.P = petsc()
+        self.icntl = {14: 50} if icntl is None else dict(icntl)
+        self._op: _Operator | None = None
+        self._dist = None  # the DistMatrix of the last factorisation
+        self._structure = None
+        self._ckey: np.ndarray | None = None
+        self.iterations = 0  # Krylov iterations of the last solve
+        self.krylov_iterations = 0  # and of all solves
+        self.ranks = 1
+
+    # -- KSP set-up (backend specific) ----------------------------------------------------------
+    def _setup_ksp(self, op: _Operator) -> None:
+        P = self.P
+        ksp = P.KSP().create(comm=op.comm)
+        ksp.setOptionsPrefix(PREFIX)
+        ksp.setOperators(op.A)
+        ksp.setType(P.KSP.Type.PREONLY)
+        pc = ksp.getPC()
+        pc.setType(P.PC.Type.CHOLESKY if self.symmetric else P.PC.Type.LU)
+        pc.setFactorSolverType("mumps")
+        pc.setFactorSetUpSolverType()
+        F = pc.getFactorMatrix()
+        for k, v in self.icntl.items():
+            F.setMumpsIcntl(int(k), int(v))
+        ksp.setErrorIfNotConverged(False)
+        ksp.setFromOptions()
+        op.ksp = ksp
+
+    def _factor_op(self) -> None:
+        """Factorise (or set up the preconditioner of) the current values; raises on failure."""
+        op = self._op
+        assert op is not None
+        if op.ksp is None:
+            self._setup_ksp(op)
+        else:
+            op.ksp.setOperators(op.A)
+        err = None
+        try:
+            op.ksp.setUp()
+        except self.P.Error as exc:
+            err = exc
+        reason = self._pc_failure(op) or (str(err) if err is not None else "")
+        if op.comm.getSize() > 1:  # one decision for all ranks
+            reason = op.comm.tompi4py().bcast(reason, root=0)
+        if reason:
+            raise SingularMatrixError(f"{self.name}: factorisation failed ({reason}); the matrix is "
+                                      "singular or too ill-conditioned")
+
+    def _pc_failure(self, op: _Operator) -> str:
+        pc = op.ksp.getPC()
+        try:
+            failed = int(pc.getFailedReason())
+        except AttributeError:  # older petsc4py
+            failed = 0
+        if failed:
+            info = ""
+            try:
+                info = f", MUMPS INFOG(1) = {pc.getFactorMatrix().getMumpsInfog(1)}"
+            except (self.P.Error, AttributeError):
+                pass
+            return f"PC failed reason {failed}{info}"
+        return ""
+
+    def _ksp_solve(self, op: _Operator) -> None:
+        op.x.set(0.0)
+        op.ksp.solve(op.b, op.x)
+        reason = op.ksp.getConvergedReason()
+        self.iterations = op.ksp.getIterationNumber()
+        self.krylov_iterations += self.iterations
+        if reason < 0:
+            raise SingularMatrixError(f"{self.name}: solve failed (KSP reason {reason}); singular matrix?")
+
+    # -- serial interface (SciPy CSR, one process) ----------------------------------------------
+    def _analyze(self, K: sp.csr_matrix) -> None:
+        self._release()
+        rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+        self._op = _Operator(self.P.COMM_SELF, K.shape[0], K.shape[0], 1, rows, K.indices, self.symmetric)
+        self._prepare_serial(K.shape[0])
+
+    def _prepare_serial(self, n: int) -> None:
+        pass
+
+    def _factor(self, K: sp.csr_matrix) -> None:
+        self._dist = None
+        self._op.set_values(K.data)
+        self._factor_op()
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        if b.ndim == 2:
+            return np.stack([self._solve(b[:, j]) for j in range(b.shape[1])], axis=1)
+        op = self._op
+        op.b.getArray()[:] = b
+        self._ksp_solve(op)
+        return op.x.getArray(readonly=True).copy()
+
+    def _release(self) -> None:
+        if self._op is not None:
+            self._op.destroy()
+        self._op = None
+        self._structure = None
+        self._ckey = None
+
+    # -- distributed interface (DistMatrix) -----------------------------------------------------
+    def factorize(self, K) -> None:
+        if not hasattr(K, "structure"):
+            return super().factorize(K)
+        if not K.eliminated:
+            raise LinearSolverError("a distributed tangent must be eliminated before the solve")
+        t0 = time.perf_counter()
+        self.t_analyze = 0.0
+        st, lay = K.structure, K.layout
+        ci, cj, cv = K.contact_triplets()
+        n = lay.n_dofs
+        key = ci.astype(np.int64) * n + cj
+        ukey, inv = np.unique(key, return_inverse=True)
+        same = self._op is not None and self._structure is st and self._ckey is not None
+        if same:
+            pos = np.searchsorted(self._ckey, ukey)
+            same = bool(np.all(pos < self._ckey.size)) and bool(np.array_equal(self._ckey[np.minimum(
+                pos, self._ckey.size - 1)], ukey))
+        comm = K.comm
+        if comm.size > 1:
+            same = comm.allreduce(same, op=_mpi_op("LAND"))
+        if not same:
+            ckey = ukey
+            if self._structure is st and self._ckey is not None:
+                union = np.union1d(self._ckey, ukey)
+                if union.size <= 2 * ukey.size + 1000:
+                    ckey = union
+            self._release()
+            rows = np.concatenate([st.rows, st.diag, ckey // n])
+            cols = np.concatenate([st.cols, st.diag, ckey % n])
+            self._op = _Operator(self.P.Comm(comm), lay.hi - lay.lo, n, 3, rows, cols, self.symmetric)
+            self._structure, self._ckey = st, ckey
+            self._prepare_dist(K)
+            self.n_analyses += 1
+            self.t_analyze = time.perf_counter() - t0
+            pos = np.searchsorted(ckey, ukey)
+        cvals = np.bincount(pos[inv.ravel()], weights=cv, minlength=self._ckey.size)
+        self.ranks = comm.size
+        self._K = None
+        self._dist = K
+        self._op.set_values(np.concatenate([K.body_values(), np.ones(st.diag.size), cvals]))
+        self._factor_op()
+        self.n_factorizations += 1
+        self.t_factor = time.perf_counter() - t0
+
+    def _prepare_dist(self, K) -> None:
+        pass
+
+    def solve_factorized(self, b: np.ndarray) -> np.ndarray:
+        if self._dist is None:
+            return super().solve_factorized(b)
+        b = np.asarray(b, dtype=np.float64)
+        K = self._dist
+        if b.shape != (K.shape[0],):
+            raise ValueError(f"right-hand side of shape {b.shape} for a distributed matrix of size {K.shape[0]}")
+        t0 = time.perf_counter()
+        op, lay = self._op, K.layout
+        op.b.getArray()[:] = b[lay.owned]
+        err = ""
+        try:
+            self._ksp_solve(op)
+            res = self._dist_check(op)
+            if self.direct and res > self.check_tol and np.isfinite(res):  # one step of refinement
+                x0 = op.x.copy()
+                r = op.b.duplicate()
+                op.A.mult(x0, r)
+                r.aypx(-1.0, op.b)
+                b0 = op.b.copy()
+                op.b.getArray()[:] = r.getArray(readonly=True)
+                self._ksp_solve(op)
+                op.x.axpy(1.0, x0)
+                op.b.getArray()[:] = b0.getArray(readonly=True)
+                for v in (x0, r, b0):
+                    v.destroy()
+                res = self._dist_check(op)
+            if not res <= self.check_tol:
+                err = (f"{self.name}: relative residual {res:.2e} > {self.check_tol:.0e} after the solve; the "
+                       "matrix is singular or too ill-conditioned")
+        except LinearSolverError as exc:
+            err = str(exc)
+        err = K.comm.bcast(err, root=0) if K.comm.size > 1 else err  # one decision for all ranks
+        if err:
+            raise (LinearSolverError if "no convergence" in err else SingularMatrixError)(err)
+        xp = op.gather(op.x)
+        x = np.empty(lay.n_dofs)
+        x[lay.from_petsc] = xp
+        self.t_solve = time.perf_counter() - t0
+        return x
+
+    def _dist_check(self, op: _Operator) -> float:
+        """Relative residual (or backward error, as in LinearSolver._check) of the PETSc solve."""
+        P = self.P
+        nx = op.x.norm()
+        if not np.isfinite(nx):
+            raise SingularMatrixError(f"{self.name}: the solution has non-finite entries; the matrix is singular")
+        r = op.b.duplicate()
+        op.A.mult(op.x, r)
+        r.axpy(-1.0, op.b)
+        nr, nb = r.norm(), op.b.norm()
+        r.destroy()
+        self.residual = nr / nb if nb > 0 else nr
+        if self._K_norm is None:
+            self._K_norm = op.A.norm(P.NormType.FROBENIUS)
+        denom = self._K_norm * nx + nb
+        self.backward_error = nr / denom if denom > 0 else nr
+        if self.residual > self.check_tol and self.residual <= 1e-2 and self.backward_error <= 1e-11:
+            return self.backward_error
+        return self.residual
+
+    def close(self) -> None:
+        super().close()
+        self._dist = None
+
+    def __del__(self):
+        with contextlib.suppress(Exception):  # interpreter shutdown
+            self._release()
+
+
+class PetscGAMGSolver(PetscSolver):
+    """PETSc CG (GMRES for non-symmetric matrices, or when CG fails) + GAMG (``petsc-gamg``).
+
+    The near-null space is the six rigid-body modes: from the node coordinates of a distributed run, or
+    from ``set_geometry`` for a SciPy matrix. ``rtol``: relative residual of each solve; ``maxiter``.
+    """
+
+    name = "petsc-gamg"
+    direct = False
+
+    @staticmethod
+    def probe() -> tuple[bool, str, str]:
+        petsc()
+        return True, _version(), "iterative: PETSc CG/GMRES + GAMG with rigid-body modes; distributed under mpiexec"
+
+    def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, rtol: float = 1e-10,
+                 maxiter: int = 2000, threshold: float = 0.01):
+        super().__init__(symmetric, max(check_tol, 10 * rtol))
+        self.rtol, self.maxiter, self.threshold = rtol, maxiter, threshold
+        self._geometry: tuple[np.ndarray, np.ndarray | None] | None = None
+        self._near = None
+
+    def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
+        self._geometry = (np.asarray(points, dtype=np.float64), dofs)
+        self._indptr = None  # a new near-null space: set up again
+
+    def _prepare_serial(self, n: int) -> None:
+        self._near = None
+        if self._geometry is None:
+            return
+        P = self.P
+        B = rigid_body_modes(*self._geometry)
+        if B.shape[0] != n:
+            raise ValueError(f"geometry gives {B.shape[0]} dofs, the matrix has {n}")
+        Q, _ = np.linalg.qr(B)
+        vecs = [P.Vec().createWithArray(np.ascontiguousarray(Q[:, k]), comm=P.COMM_SELF) for k in range(6)]
+        self._near = P.NullSpace().create(vectors=vecs, comm=P.COMM_SELF)
+        self._op.A.setNearNullSpace(self._near)
+
+    def _prepare_dist(self, K) -> None:
+        P = self.P
+        coords = K.layout.owned_coordinates()
+        self._near = None
+        if coords is None:
+            return
+        c = P.Vec().createWithArray(np.ascontiguousarray(coords.ravel()), size=(coords.size, P.DECIDE),
+                                    bsize=3, comm=self._op.comm)
+        self._near = P.NullSpace().createRigidBody(c)
+        c.destroy()
+        self._op.A.setNearNullSpace(self._near)
+
+    def _setup_ksp(self, op: _Operator, method: str | None = None) -> None:
+        P = self.P
+        method = method or ("cg" if self.symmetric else "gmres")
+        ksp = P.KSP().create(comm=op.comm)
+        ksp.setOptionsPrefix(PREFIX)
+        ksp.setOperators(op.A)
+        ksp.setType(method)
+        if method == "gmres":
+            ksp.setGMRESRestart(100)
+            ksp.setPCSide(P.PC.Side.RIGHT)  # the unpreconditioned residual is what rtol measures
+        ksp.setNormType(P.KSP.NormType.UNPRECONDITIONED)
+        ksp.setTolerances(rtol=self.rtol, atol=0.0, max_it=self.maxiter)
+        pc = ksp.getPC()
+        pc.setType(P.PC.Type.GAMG)
+        opts = P.Options()
+        if not opts.hasName(f"{PREFIX}pc_gamg_threshold"):
+            opts.setValue(f"{PREFIX}pc_gamg_threshold", self.threshold)
+        ksp.setErrorIfNotConverged(False)
+        ksp.setFromOptions()
+        op.ksp = ksp
+        self.method = method
+
+    def _pc_failure(self, op: _Operator) -> str:
+        return ""
+
+    def _ksp_solve(self, op: _Operator) -> None:
+        nb = op.b.norm()
+        tries = ["cg", "gmres"] if op.ksp.getType() == "cg" else ["gmres"]
+        total = 0
+        for method in tries:
+            if op.ksp.getType() != method:
+                op.ksp.destroy()
+                self._setup_ksp(op, method)
+                op.ksp.setUp()
+            op.x.set(0.0)
+            op.ksp.setInitialGuessNonzero(False)
+            for k in range(3):  # tighter tolerance if the true residual lags behind the recursive one
+                op.ksp.setTolerances(rtol=self.rtol * 0.1**k)
+                op.ksp.solve(op.b, op.x)
+                op.ksp.setInitialGuessNonzero(True)
+                total += op.ksp.getIterationNumber()
+                reason = op.ksp.getConvergedReason()
+                r = op.b.duplicate()
+                op.A.mult(op.x, r)
+                r.axpy(-1.0, op.b)
+                nr = r.norm()
+                r.destroy()
+                if np.isfinite(nr) and nr <= self.rtol * nb:
+                    self.iterations = total
+                    self.krylov_iterations += total
+                    op.ksp.setTolerances(rtol=self.rtol)
+                    return
+                if reason < 0 or not np.isfinite(nr):
+                    break
+        self.iterations = total
+        self.krylov_iterations += total
+        op.ksp.setTolerances(rtol=self.rtol)
+        raise LinearSolverError(f"{self.name}: no convergence to {self.rtol:.0e} within {total} iterations "
+                                "(singular, strongly indefinite or badly scaled matrix?)")
+
+
+def _mpi_op(name: str):
+    from mpi4py import MPI
+
+    return getattr(MPI, name)

@@ -1,0 +1,131 @@
+"""Distributed runs on PETSc: ``--solver petsc`` on one process equals the default solver, and
+``mpiexec -n 2 ... --solver petsc`` equals the serial run (same Newton iterations per step, displacements
+to solver tolerance), for a deformable contact pair, a frictional pair, GAMG, and a failing step.
+
+Needs the ``mpi`` extra (mpi4py, petsc4py) and ``mpiexec``. Without them the tests are skipped, unless
+COVCONTACT_REQUIRE_MPI=1 (CI after installing the extra): then they fail.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from covcontact.io.loader import load_problem
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+TWO_BLOCKS = EXAMPLES / "contact" / "two_blocks.toml"
+SLIDING = EXAMPLES / "friction" / "block_sliding.toml"
+
+
+def _missing() -> str:
+    try:
+        import mpi4py  # noqa: F401
+        import petsc4py  # noqa: F401
+    except ImportError as exc:
+        return f"{exc}"
+    if shutil.which("mpiexec") is None:
+        return "mpiexec not found"
+    from covcontact.solvers.linear import available
+
+    if "petsc" not in available():
+        return "the petsc backend is not available (PETSc without MUMPS?)"
+    return ""
+
+
+MISSING = _missing()
+
+
+@pytest.fixture(autouse=True)
+def _need_mpi():
+    if MISSING:
+        if os.environ.get("COVCONTACT_REQUIRE_MPI") == "1":
+            pytest.fail(f"COVCONTACT_REQUIRE_MPI=1 but the MPI extra is missing: {MISSING}")
+        pytest.skip(f"MPI extra not installed ({MISSING}); pip install -e '.[mpi]'")
+
+
+def _serial(path: Path, out: Path, solver: str | None = None):
+    problem = load_problem(path)
+    return problem.run(out=out, quiet=True, solver=solver)
+
+
+def _mpiexec(path: Path, out: Path, solver: str, n: int = 2, extra: tuple[str, ...] = ()) -> int:
+    env = dict(os.environ)
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    cmd = ["mpiexec", "-n", str(n), "--oversubscribe", "--bind-to", "none", sys.executable, "-m",
+           "covcontact.cli", "run", str(path), "--solver", solver, "--out", str(out), "--quiet", *extra]
+    proc = subprocess.run(cmd, check=False, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode in (0, 1), proc.stderr[-3000:]
+    return proc.returncode
+
+
+def _iterations(summary: dict) -> list[int]:
+    return [s["iterations"] for s in summary["steps"]]
+
+
+def _final_displacement(out: Path) -> np.ndarray:
+    last = max(out.glob("step_*.vtu"))
+    return meshio.read(last).point_data["displacement"]
+
+
+def test_serial_petsc_matches_default(tmp_path):
+    ref = _serial(TWO_BLOCKS, tmp_path / "ref")
+    res = _serial(TWO_BLOCKS, tmp_path / "petsc", solver="petsc")
+    assert res.summary["linear_solver"] == "petsc" and res.summary["parallel"]["ranks"] == 1
+    assert res.exit_code == ref.exit_code == 0
+    assert _iterations(res.summary) == _iterations(ref.summary)
+    assert np.linalg.norm(res.u - ref.u) <= 1e-8 * np.linalg.norm(ref.u)
+    # the output fields gathered by the distributed model equal the serial ones
+    np.testing.assert_allclose(_final_displacement(tmp_path / "petsc"), _final_displacement(tmp_path / "ref"),
+                               rtol=0, atol=1e-8 * np.abs(ref.u).max())
+
+
+@pytest.mark.parametrize(("path", "solver", "tol"), [
+    (TWO_BLOCKS, "petsc", 1e-9),        # deformable master, MUMPS Cholesky (LDL^T)
+    (SLIDING, "petsc", 1e-7),           # Coulomb friction: non-symmetric, MUMPS LU, path-dependent
+    (TWO_BLOCKS, "petsc-gamg", 1e-8),   # CG + GAMG with rigid-body modes
+], ids=["deformable-pair", "friction", "gamg"])
+def test_two_ranks_match_serial(tmp_path, path, solver, tol):
+    if path == SLIDING:  # half the load steps: a shorter test, still sticking and then sliding
+        text = path.read_text().replace("count = 10", "count = 5")
+        path = tmp_path / path.name
+        path.write_text(text)
+    ref = _serial(path, tmp_path / "ref")
+    assert _mpiexec(path, tmp_path / "mpi", solver) == 0
+    summary = json.loads((tmp_path / "mpi" / "summary.json").read_text())
+    assert summary["converged"] and summary["linear_solver"] == solver
+    par = summary["parallel"]
+    assert par["ranks"] == 2 and min(par["elements"]) > 0 and min(par["owned_dofs"]) > 0
+    assert _iterations(summary) == _iterations(ref.summary)
+    for a, b in zip(summary["steps"], ref.summary["steps"]):
+        assert a["active_contacts"] == b["active_contacts"]
+        np.testing.assert_allclose(a["contact_force"], b["contact_force"], rtol=tol,
+                                   atol=tol * np.abs(b["contact_force"]).max())
+    u = _final_displacement(tmp_path / "mpi")
+    u_ref = _final_displacement(tmp_path / "ref")
+    assert np.abs(u - u_ref).max() <= tol * np.abs(u_ref).max()
+    # rank 0 alone writes: one summary, one VTU per converged step
+    assert len(list((tmp_path / "mpi").glob("step_*.vtu"))) == len(ref.summary["steps"]) + 1
+
+
+def test_two_ranks_fail_together(tmp_path):
+    """A step that cannot converge: the same cutbacks and exit code 1 as the serial run, no hang."""
+    text = TWO_BLOCKS.read_text() + "\n[solver]\nmax_iterations = 2\nmax_cutbacks = 1\n"
+    path = tmp_path / "two_blocks_failing.toml"
+    path.write_text(text)
+    ref = _serial(path, tmp_path / "ref")
+    assert ref.exit_code == 1
+    assert _mpiexec(path, tmp_path / "mpi", "petsc") == 1
+    summary = json.loads((tmp_path / "mpi" / "summary.json").read_text())
+    assert not summary["converged"]
+    assert [s["cutbacks"] for s in summary["steps"]] == [s["cutbacks"] for s in ref.summary["steps"]]
+    assert _iterations(summary) == _iterations(ref.summary)
