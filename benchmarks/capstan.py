@@ -24,7 +24,6 @@ step (active, slip, stick). Output: JSON on stdout or to --out; a Markdown table
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import platform
 import sys
@@ -35,6 +34,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
+from _report import emit
 from test_capstan import T_STRIP, capstan_problem, exp_strip, run_capstan
 
 THETAS = {"pi/2": 0.5 * math.pi, "pi": math.pi, "3pi/2": 1.5 * math.pi}
@@ -104,12 +104,7 @@ def main(argv: list[str] | None = None) -> int:
         records.append(one("pi", 0.3, 32, tangential_penalty=1.0e4))
     result = {"benchmark": "capstan", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "total_s": round(time.perf_counter() - t0, 1), "records": records}
-    text = json.dumps(result, indent=1)
-    if args.out:
-        args.out.write_text(text + "\n")
-    else:
-        print(text)
-    print(table(records), file=sys.stderr)
+    emit(result, args.out, table(records))
     # the soft eps_T = 1e4 run is expected not to slide everywhere (stick range comparable to the pull)
     ok = all(r["converged"] and (r["slip"] == r["active"] or r["tangential_penalty"] < 1e5) for r in records)
     return 0 if ok else 1

@@ -20,7 +20,6 @@ on stderr.
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import sys
 import tempfile
@@ -32,6 +31,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
+from _report import emit
 from test_hertz import (
     hertz_measures,
     hertz_mesh,
@@ -103,12 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     result = {"benchmark": "hertz", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "total_s": round(time.perf_counter() - t0, 1),
               "d_over_R": [0.01 * f for f in FACTORS], "records": records}
-    text = json.dumps(result, indent=1)
-    if args.out:
-        args.out.write_text(text + "\n")
-    else:
-        print(text)
-    print(table(records), file=sys.stderr)
+    emit(result, args.out, table(records))
     return 0 if all(r["converged"] for r in records) else 1
 
 

@@ -51,6 +51,9 @@ from test_hertz import C_HERTZ, D_MAX, E_STAR, NU, E, R, fit_hertz, hertz_measur
 
 from covcontact.contact.surface import tributary_area
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _report import emit
+
 PENALTY = 1e4
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                "CCX_NPROC_EQUATION_SOLVER", "CCX_NPROC_STIFFNESS", "CCX_NPROC_RESULTS", "NUMBER_OF_CPUS")
@@ -256,12 +259,7 @@ def main(argv: list[str] | None = None) -> int:
               "stress_scale_ccx": args.stress_scale, "penalty": PENALTY,
               "ccx_version": _ccx_version(), "covcontact": _covcontact_state(), "total_s": round(time.perf_counter() - t0, 1),
               "d_over_R": [0.01 * (k + 1) / args.steps for k in range(args.steps)], "records": records}
-    text = json.dumps(result, indent=1)
-    if args.out:
-        args.out.write_text(text + "\n")
-    else:
-        print(text)
-    print(table(records), file=sys.stderr)
+    emit(result, args.out, table(records))
     ok = all(r["ours"]["converged"] and r["ccx"]["converged"] for r in records)
     return 0 if ok else 1
 
