@@ -3,9 +3,10 @@
 The set-up is that of tests/verification/test_ironing.py at full size: slab 9 x 4 x 3 (the half y >= 0
 modelled, u_y = 0 on y = 0), E = 1, nu = 0.3, bottom fixed; rigid die of radius 3 (axis along y) centred 2.5
 from the slab's left end, down by 1.4 over the pseudo time 0 to 0.2, then along +x by 4 up to 1.5; Coulomb
-friction mu = 0.3, area-weighted penalties eps_N (normal) and eps_T (tangential). Runs: hex8 slab meshes
-18 x 2 x 6, 36 x 4 x 12 and 54 x 6 x 18 elements (element size 0.5, 0.25, 0.167), frictionless on the
-middle mesh, and eps_N = 30 on the middle mesh.
+friction mu = 0.3, area-weighted penalties eps_N (normal) and eps_T = eps_N / 10 (tangential). Runs: hex8
+slab meshes 18 x 2 x 6 and 36 x 4 x 12 elements (element size 0.5, 0.25), frictionless on the finer mesh,
+and eps_N = 30 on the finer mesh. (54 x 6 x 18 stalls near the end of the press, at a depth of 1.36 to
+1.38: docs/verification.md, "Ironing".)
 
 Per run: the die force history of the whole slab (Fx the drag along the sliding, Fz the pressing force)
 against the pseudo time, the force balance, and the peak and plateau values (means over the die moved 2
@@ -42,7 +43,7 @@ from test_ironing import (
 
 # (label, mesh divisions, mu, eps_N, press steps, slide steps)
 FULL = [("18x2x6", (18, 2, 6), MU, EPS_N, 20, 80), ("36x4x12", (36, 4, 12), MU, EPS_N, 20, 80),
-        ("54x6x18", (54, 6, 18), MU, EPS_N, 30, 120), ("36x4x12 frictionless", (36, 4, 12), 0.0, EPS_N, 20, 80),
+        ("36x4x12 frictionless", (36, 4, 12), 0.0, EPS_N, 20, 80),
         ("36x4x12 eps_N=30", (36, 4, 12), MU, 3.0 * EPS_N, 20, 80)]
 QUICK = [FULL[0], ("18x2x6 frictionless", (18, 2, 6), 0.0, EPS_N, 20, 80)]
 
