@@ -67,3 +67,57 @@ def test_bad_sets_are_one_line_errors(tmp_path, capsys, sets, words):
     assert main(["run", str(f), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and str(f) in err[0] and "sets" in err[0]
+
+
+# ------------------------------------------------------------------ rigid motion along a path
+
+RIGID = """
+[problem]
+name = "path"
+[[bodies]]
+name = "b"
+element = "hex8"
+material = {{ model = "svk", E = 1000.0, nu = 0.3 }}
+mesh = {{ generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 1, ny = 1, nz = 1 }}
+[[rigid]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, -0.1]
+normal = [0.0, 0.0, 1.0]
+motion = {{ {motion} }}
+[[contact]]
+slave = "b.zmin"
+master = "floor"
+penalty = 1.0e3
+[[dirichlet]]
+set = "b.zmax"
+components = "xyz"
+"""
+
+
+def test_motion_path_is_piecewise_linear(tmp_path):
+    f = tmp_path / "p.toml"
+    f.write_text(RIGID.format(motion="path = [[0.0, 0.0, 0.0, 0.0], [0.25, 0.0, 0.0, 0.1], [1.0, 3.0, 0.0, 0.1]]"))
+    m = load_problem(f).rigid[0].motion
+    X = np.array([[1.0, 2.0, 3.0]])
+    assert np.allclose(m.apply(X, 0.125) - X, [0.0, 0.0, 0.05])   # half of the press
+    assert np.allclose(m.apply(X, 0.25) - X, [0.0, 0.0, 0.1])
+    assert np.allclose(m.apply(X, 0.625) - X, [1.5, 0.0, 0.1])    # half of the slide
+    assert np.allclose(m.apply(X, 2.0) - X, [3.0, 0.0, 0.1])      # constant beyond the last row
+    assert np.allclose(m.rotate(np.eye(3), 0.6), np.eye(3))
+
+
+@pytest.mark.parametrize("motion, words", [
+    ("path = [[0.0, 0.0, 0.0]]", "rows"),
+    ("path = [[0.1, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0]]", "start at 0"),
+    ("path = [[0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]", "increase strictly"),
+    ("path = [[0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0]], translation = [1.0, 0.0, 0.0]", "not both"),
+])
+def test_bad_motion_path(tmp_path, capsys, motion, words):
+    f = tmp_path / "p.toml"
+    f.write_text(RIGID.format(motion=motion))
+    with pytest.raises(InputError, match=words):
+        load_problem(f)
+    assert main(["run", str(f), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "motion" in err[0]

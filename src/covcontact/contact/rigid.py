@@ -37,16 +37,35 @@ class RigidMotion:
         translation: (3,) translation at lam = 1.
         rotation: (3,) rotation vector at lam = 1 (axis times angle).
         center: (3,) centre of rotation.
+        path: optional (k, 4) rows (lam, tx, ty, tz), lam strictly increasing from 0: the translation
+            follows this polyline in the load factor (constant beyond the last row) instead of
+            lam * translation (which must then be zero), e.g. press down, then slide.
     """
 
     translation: tuple | np.ndarray = (0.0, 0.0, 0.0)
     rotation: tuple | np.ndarray = (0.0, 0.0, 0.0)
     center: tuple | np.ndarray = (0.0, 0.0, 0.0)
+    path: tuple | np.ndarray | None = None
 
     def __post_init__(self):
         self.translation = _vec3(self.translation, "translation")
         self.rotation = _vec3(self.rotation, "rotation")
         self.center = _vec3(self.center, "center")
+        if self.path is not None:
+            P = np.asarray(self.path, dtype=np.float64)
+            if P.ndim != 2 or P.shape[1] != 4 or P.shape[0] < 2 or not np.all(np.isfinite(P)):
+                raise ValueError("path must be two or more rows [lam, tx, ty, tz] of finite numbers")
+            if P[0, 0] != 0.0 or np.any(np.diff(P[:, 0]) <= 0.0):
+                raise ValueError("path load factors must start at 0 and increase strictly")
+            if np.any(self.translation != 0.0):
+                raise ValueError("give either translation or path, not both")
+            self.path = P
+
+    def offset(self, lam: float = 1.0) -> np.ndarray:
+        """Translation at load factor ``lam``."""
+        if self.path is None:
+            return float(lam) * self.translation
+        return np.array([np.interp(float(lam), self.path[:, 0], self.path[:, 1 + i]) for i in range(3)])
 
     def matrix(self, lam: float = 1.0) -> np.ndarray:
         """Rotation matrix R(lam theta)."""
@@ -58,7 +77,7 @@ class RigidMotion:
         if X.shape[-1] != 3:
             raise ValueError(f"points must have 3 coordinates in the last axis, got shape {X.shape}")
         Rm = self.matrix(lam)
-        return self.center + (X - self.center) @ Rm.T + float(lam) * self.translation
+        return self.center + (X - self.center) @ Rm.T + self.offset(lam)
 
     def rotate(self, V, lam: float = 1.0) -> np.ndarray:
         """Directions (..., 3) rotated to load factor ``lam`` (no translation)."""

@@ -13,8 +13,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..problem import (COMPONENTS, TANGENT_CASES, Body, ContactPair, Dirichlet, NodalForce, OutputOptions,
-                       Pressure, Problem, RigidBody, RigidMotion, SolverOptions, Steps, Traction)
+from ..problem import (
+    COMPONENTS,
+    TANGENT_CASES,
+    Body,
+    ContactPair,
+    Dirichlet,
+    NodalForce,
+    OutputOptions,
+    Pressure,
+    Problem,
+    RigidBody,
+    RigidMotion,
+    SolverOptions,
+    Steps,
+    Traction,
+)
 from .validate import InputError, Section
 
 CELLS = ("hex8", "hex18", "hex27")
@@ -59,7 +73,7 @@ def build_mesh(sec: Section, base: Path, element: str | None):
             allowed = ", ".join(k for k in params if k != "cell")
             sec.fail(f"unknown key for generator {name!r} (allowed: {allowed})", key)
         if isinstance(value, bool) or not isinstance(value, (int, float, str, list)):
-            sec.fail(f"must be a number, string or array", key)
+            sec.fail("must be a number, string or array", key)
         if isinstance(value, list):
             value = tuple(value)
         kwargs[key] = value
@@ -91,11 +105,24 @@ def _material(sec: Section):
 def _motion(sec: Section | None) -> RigidMotion:
     if sec is None:
         return RigidMotion()
-    m = RigidMotion(translation=sec.get("translation", "vector", (0.0, 0.0, 0.0)),
-                    rotation=sec.get("rotation", "vector", (0.0, 0.0, 0.0)),
-                    center=sec.get("center", "vector", (0.0, 0.0, 0.0)))
+    translation = sec.get("translation", "vector", (0.0, 0.0, 0.0))
+    rotation = sec.get("rotation", "vector", (0.0, 0.0, 0.0))
+    center = sec.get("center", "vector", (0.0, 0.0, 0.0))
+    path = None
+    if sec.has("path"):
+        raw = sec.get("path", "any")
+        ok = isinstance(raw, list) and all(
+            isinstance(r, list) and len(r) == 4 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in r)
+            for r in raw)
+        if not ok:
+            sec.fail("must be an array of rows [lam, tx, ty, tz]", "path")
+        path = raw
     sec.done()
-    return m
+    try:
+        return RigidMotion(translation=translation, rotation=rotation, center=center, path=path)
+    except ValueError as exc:
+        sec.fail(str(exc), "path" if path is not None else None)
 
 
 def _user_sets(sec: Section | None, mesh) -> None:
