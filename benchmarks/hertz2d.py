@@ -19,7 +19,6 @@ b_m / b_Hertz against b/R).
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import sys
 import tempfile
@@ -31,6 +30,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
+from _report import emit
 from test_hertz2d import D_MAX, R, hertz2d_measures, hertz2d_mesh, hertz2d_problem
 
 FULL = [("hex8", 16), ("hex8", 32), ("hex8", 64), ("hex27", 8), ("hex27", 16), ("hex27", 32)]
@@ -123,12 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     result = {"benchmark": "hertz2d", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "total_s": round(time.perf_counter() - t0, 1),
               "d_over_R": records[0]["d"], "records": records}
-    text = json.dumps(result, indent=1)
-    if args.out:
-        args.out.write_text(text + "\n")
-    else:
-        print(text)
-    print(table(records), file=sys.stderr)
+    emit(result, args.out, table(records))
     if args.plot:
         plot(records, args.plot)
     return 0 if all(r["converged"] for r in records) else 1

@@ -20,7 +20,6 @@ to 4). Output: JSON (histories and summary) on stdout or to --out, a Markdown ta
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import sys
 import tempfile
@@ -30,6 +29,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
+from _report import emit
 from test_ironing import (
     EPS_N,
     EPS_T,
@@ -121,12 +121,7 @@ def main(argv: list[str] | None = None) -> int:
     records = [one(*case) for case in (QUICK if args.quick else FULL)]
     result = {"benchmark": "ironing", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "total_s": round(time.perf_counter() - t0, 1), "records": records}
-    text = json.dumps(result, indent=1)
-    if args.out:
-        args.out.write_text(text + "\n")
-    else:
-        print(text)
-    print(table(records), file=sys.stderr)
+    emit(result, args.out, table(records))
     if args.plot:
         plot(records, args.plot)
     return 0 if all(r["converged"] for r in records) else 1

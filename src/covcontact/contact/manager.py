@@ -416,14 +416,17 @@ class ContactManager:
         for p in self.passes:
             if not p.augmented or p.n_aug >= p.max_aug:
                 continue
-            pen = float(np.max(-p.g[np.isfinite(p.g)], initial=0.0))
-            if pen <= p.gap_tol:
+            if self._penetration(p) <= p.gap_tol:
                 continue
             g = np.where(np.isfinite(p.g), p.g, 0.0)
             p.lam_mult = np.minimum(p.lam_mult + p.eps * g, 0.0)
             p.n_aug += 1
             again = True
         return again
+
+    def _penetration(self, p: Pass) -> float:
+        """Largest penetration of the pass's slaves (a distributed run takes the largest over the ranks)."""
+        return float(np.max(-p.g[np.isfinite(p.g)], initial=0.0))
 
     @staticmethod
     def _active(p: Pass) -> np.ndarray:

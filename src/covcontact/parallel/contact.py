@@ -47,20 +47,9 @@ class DistributedContact(ContactManager):
     def active_count(self) -> int:
         return count_all(self.comm, super().active_count())
 
-    def augment(self) -> bool:
-        """Uzawa update as in the serial manager; the penetration test looks at the slaves of all ranks."""
-        again = False
-        for p in self.passes:
-            if not p.augmented or p.n_aug >= p.max_aug:
-                continue
-            pen = max_all(self.comm, float(np.max(-p.g[np.isfinite(p.g)], initial=0.0)))
-            if pen <= p.gap_tol:
-                continue
-            g = np.where(np.isfinite(p.g), p.g, 0.0)
-            p.lam_mult = np.minimum(p.lam_mult + p.eps * g, 0.0)
-            p.n_aug += 1
-            again = True
-        return again
+    def _penetration(self, p) -> float:
+        """The Uzawa test looks at the slaves of all ranks."""
+        return max_all(self.comm, super()._penetration(p))
 
     def _global_norms(self, mats: list[sp.csr_matrix]) -> list[float]:
         """Frobenius norms of the sums over the ranks of the matrices ``mats`` (collective)."""
