@@ -1,7 +1,8 @@
 """Command line: covcontact run | study | check-tangent | info.
 
 Exit codes: 0 done; 1 a step did not converge even after cutbacks (converged steps are written);
-2 bad input (one line on stderr); 3 anything else (a bug: the traceback is printed).
+2 bad input or a checkpoint that cannot be resumed (one line on stderr); 3 anything else (a bug: the
+traceback is printed); 130 / 143 stopped by SIGINT / SIGTERM (files valid, summary status "interrupted").
 """
 
 from __future__ import annotations
@@ -32,6 +33,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--tangent", choices=TANGENT_CASES, default=None)
     r.add_argument("--solver", default=None)
     r.add_argument("--quiet", action="store_true")
+    r.add_argument("--resume", action="store_true",
+                   help="continue from the last checkpoint in the output folder (same problem, same ranks)")
     s = sub.add_parser("study", help="run a problem once per tangent case and tabulate the iterations")
     s.add_argument("problem")
     s.add_argument("--cases", default="a,b,c,d,exact")
@@ -63,7 +66,8 @@ def cmd_run(args) -> int:
 
     problem = load_problem(args.problem)
     _check_solver(args.solver or problem.solver.linear)
-    result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver)
+    result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver,
+                         resume=args.resume)
     if not args.quiet and getattr(result.model, "is_root", True):  # one line from a distributed run
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code

@@ -32,15 +32,15 @@ class Body:
 
 @dataclass
 class RigidBody:
-    """A rigid body: an analytic surface (plane, cylinder, sphere) or a mesh moving rigidly.
+    """A rigid body: an analytic surface or a mesh moving rigidly.
 
-    ``surface`` is an analytic surface object from ``covcontact.contact`` or None; ``mesh`` a Mesh whose
-    nodes carry no unknowns (slave nodes and/or master faces of contact pairs).
+    ``shape`` "plane" (``params`` point, normal), "cylinder" (center, axis, radius, outside) or "sphere"
+    (center, radius, outside) for an analytic surface; or ``mesh``, a Mesh whose nodes carry no unknowns
+    (slave nodes and/or master faces of contact pairs), with ``shape`` "mesh".
     """
 
     name: str
     motion: RigidMotion = field(default_factory=RigidMotion)
-    surface: Any = None
     mesh: Mesh | None = None
     shape: str = ""
     params: dict = field(default_factory=dict)
@@ -143,11 +143,13 @@ class SolverOptions:
 
 @dataclass
 class OutputOptions:
-    """What to write: VTU every ``every`` converged steps (the last one always)."""
+    """What to write: VTU every ``every`` converged steps, a checkpoint every ``checkpoint_every`` converged
+    steps (the last step always gets both)."""
 
     vtu: bool = True
     every: int = 1
     pictures: bool = False
+    checkpoint_every: int = 1
 
 
 @dataclass
@@ -175,8 +177,12 @@ class Problem:
         raise KeyError(f"no deformable body named {name!r}")
 
     def run(self, out: str | Path | None = None, tangent: str | None = None, quiet: bool = True,
-            solver: str | None = None):
-        """Solve the problem and write the results to ``out`` (default ``results/<name>``)."""
+            solver: str | None = None, resume: bool = False):
+        """Solve the problem and write the results to ``out`` (default ``results/<name>``).
+
+        ``tangent`` overrides every contact pair's tangent case; ``resume`` continues from the last
+        checkpoint in ``out`` (``covcontact.io.checkpoint.CheckpointError`` if there is none that fits).
+        """
         from .solvers.run import solve_problem
 
-        return solve_problem(self, out=out, tangent=tangent, quiet=quiet, linear=solver)
+        return solve_problem(self, out=out, tangent=tangent, quiet=quiet, linear=solver, resume=resume)

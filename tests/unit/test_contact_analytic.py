@@ -1,7 +1,7 @@
 """Rigid analytic master surfaces (plane, cylinder, sphere) and rigid motions.
 
-Conventions from FORMULATION.md section 1 (convex seen from outside: h negative definite, a circle of
-radius R by angle has a_11 = R^2, h_11 = -R) and section 4 (rigid master: rotational part zero, exact
+Conventions from docs/theory.md section 3 (convex seen from outside: h negative definite, a circle of
+radius R by angle has a_11 = R^2, h_11 = -R) and section 5 (rigid master: rotational part zero, exact
 tangent = eps H (n(x)n + (a^ij - c^ij) rho_i(x)rho_j), the exact Hessian of 1/2 eps <g>^2).
 """
 
@@ -87,7 +87,7 @@ def test_case_a_second_order_and_flipped_curvature(name):
 
 
 def test_rigid_case_identities():
-    # rigid master: a) = c) and b) = d) (FORMULATION.md section 4)
+    # rigid master: a) = c) and b) = d) (docs/theory.md section 5)
     surf = surfaces()["sph_out"]
     xs = slave_at(surf, POINTS[1], -0.05)
     K = {name: surf.contact(xs, EPS_N, name, LAM).tangent for name in CASES}

@@ -1,6 +1,6 @@
 """Augmented Lagrangian (Uzawa) normal law in the compiled contact kernels.
 
-Reference: FORMULATION.md section 4, last paragraph: lam_N = <lam_k + eps_N g> replaces eps_N <g> in
+Reference: docs/theory.md section 8: lam_N = <lam_k + eps_N g> replaces eps_N <g> in
 R_c and in the factors of K_rot and K_curv; the energy is W = 1/(2 eps_N) <lam_k + eps_N g>^2 and the
 exact tangent its Hessian, eps_N H grad g (x) grad g + lam_N hess g (g the geometric gap).
 """

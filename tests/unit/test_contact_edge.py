@@ -1,5 +1,6 @@
 """Edge and vertex contact points: the exact tangent against central differences of the residual, the
-closest edge point recomputed for every perturbed position (FORMULATION.md: exact tangent to 1e-6)."""
+closest edge point recomputed for every perturbed position (docs/theory.md section 5: exact tangent, to
+1e-6)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
-"""Tangent checks of the covariant contact element (VERIFICATION.md "Tangent checks").
+"""Tangent checks of the covariant contact element (docs/verification.md "Contact element and contact
+problems").
 
-Reference for all signs: FORMULATION.md sections 1-4 (exact Hessian of W_c = 1/2 eps <g>^2).
+Reference for all signs: docs/theory.md sections 3-5 (exact Hessian of W_c = 1/2 eps <g>^2).
 """
 
 import numpy as np
@@ -102,7 +103,7 @@ def test_surface_shapes_match_fem_shapes():
 
 def test_geometry_signs_on_a_sphere_patch():
     # quad9 facet on a sphere of radius R (outward node order): h negative definite, h ~ -a / R,
-    # Weingarten n_,i = -h_ij a^jk rho_k (FORMULATION.md section 1)
+    # Weingarten n_,i = -h_ij a^jk rho_k (docs/theory.md section 3)
     R = 3.0
     P = NODES["quad9"] * 0.4
     z = np.sqrt(R**2 - P[:, 0] ** 2 - P[:, 1] ** 2)
@@ -197,7 +198,7 @@ def test_parts_symmetric_and_case_identities(nen, curved):
 
 @pytest.mark.parametrize("nen", [4, 9])
 def test_flipped_curvature_is_worse(nen):
-    # FORMULATION.md section 4: a flipped curvature sign is worse than leaving the part out
+    # docs/theory.md section 5: a flipped curvature sign is worse than leaving the part out
     xyz = make_facet(nen, True, seed=60 + nen)
     r = node_to_surface(xyz, slave_at(xyz, np.array([0.3, 0.2]), -1e-2), EPS_N, "exact")
     P, K = r.parts, r.tangent

@@ -1,7 +1,7 @@
-"""Covariant Coulomb friction element (FORMULATION.md section 5; Konyukhov & Schweizerhof, Comput Mech 35
+"""Covariant Coulomb friction element (docs/theory.md section 7; Konyukhov & Schweizerhof, Comput Mech 35
 (2005)). Every tangent is checked against central differences of the residual with re-projection
-(VERIFICATION.md "Tangent checks"); the stick residual against the gradient of the stick energy
-1/2 eps_N g^2 + 1/2 eps_T a_ij dxi^i dxi^j (the sign reference).
+(docs/verification.md "Contact element and contact problems"); the stick residual against the gradient
+of the stick energy 1/2 eps_N g^2 + 1/2 eps_T a_ij dxi^i dxi^j (the sign reference).
 """
 
 import numpy as np

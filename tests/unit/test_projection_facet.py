@@ -1,4 +1,4 @@
-"""Closest point projection onto one facet (FORMULATION.md section 2), property-based."""
+"""Closest point projection onto one facet (docs/theory.md section 4), property-based."""
 
 import numpy as np
 import pytest

@@ -160,7 +160,7 @@ def test_full_sliding_ratio_is_exp_mu_theta(theta, mu):
         p_max = m["load_factor"] * T_LOW * math.exp(mu * theta) / (R * WIDTH)
         assert -1.1 * p_max / 1.0e6 < m["min_gap"] < 0.0, m
     ratio = ms[-1]["ratio"]
-    # VERIFICATION.md: within 2 % of exp(mu theta) (mu = 0.3: 1.602 at pi/2, 2.566 at pi)
+    # docs/verification.md "Capstan": within 2 % of exp(mu theta) (mu = 0.3: 1.602 at pi/2, 2.566 at pi)
     assert ratio == pytest.approx(math.exp(mu * theta), rel=0.02)
     # and within 0.25 % of the thick-strip capstan (measured: -0.21 %, -0.42 %, -0.40 %, -0.80 % from
     # exp(mu theta); +0.05 %, +0.09 %, +0.09 %, +0.18 % from exp_strip, O(h^2) under refinement)

@@ -1,7 +1,7 @@
 """Linear shell obstacle course with the solid-shell elements (one element through the thickness).
 
 References (MacNeal & Harder, Finite Elements in Analysis and Design 1 (1985) 3-20; Belytschko et al.,
-CMAME 51 (1985) 221-258), as collected in the design notes (VERIFICATION.md "Bodies"):
+CMAME 51 (1985) 221-258), as tabulated in docs/verification.md ("Shells", linear obstacle course):
 - Scordelis-Lo roof: vertical displacement at the middle of the free edge 0.3024;
 - pinched cylinder with rigid diaphragms: displacement under the load 1.8248e-5;
 - pinched hemisphere with an 18 degree hole: displacement under the loads 0.0924 (0.093-0.094);

@@ -221,10 +221,11 @@ class Pattern:
         """A zero CSR data array (nnz,) float64."""
         return np.zeros(self.nnz, dtype=np.float64)
 
-    def ranks(self, conn: np.ndarray, node_offset: int = 0) -> np.ndarray:
+    def ranks(self, conn: np.ndarray, node_offset: int = 0, strict: bool = True) -> np.ndarray:
         """(nelem, nen, nen) int32: rank of node b in the adjacency of node a, for each element.
 
-        Raises ValueError if a pair of ``conn + node_offset`` is not in the pattern.
+        Raises ValueError if a pair of ``conn + node_offset`` is not in the pattern (``strict``), else
+        marks such pairs with -1.
         """
         conn = np.ascontiguousarray(conn, dtype=np.int64)
         if conn.ndim != 2:
@@ -233,7 +234,7 @@ class Pattern:
             raise ValueError(f"conn + node_offset has node ids outside [0, {self.n_nodes})")
         out = np.empty((conn.shape[0], conn.shape[1], conn.shape[1]), dtype=np.int32)
         _ranks(self.node_ptr, self.node_adj, conn, np.int64(node_offset), out)
-        if out.size and out.min() < 0:
+        if strict and out.size and out.min() < 0:
             e = int(np.flatnonzero((out < 0).any(axis=(1, 2)))[0])
             raise ValueError(f"element {e} couples nodes that are not in the pattern")
         return out

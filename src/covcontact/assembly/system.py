@@ -141,37 +141,33 @@ class System:
         return u
 
     # -- evaluation -----------------------------------------------------------------------------
-    def internal(self, u: np.ndarray, want_K: bool = True):
-        """Internal forces (n_dofs,) and body tangent CSR (or None) at displacement u."""
-        data = np.zeros(self.pattern.nnz) if want_K else np.zeros(1)
+    def new_state(self) -> list[dict[str, np.ndarray]]:
+        """Element history of every body at the reference state (solid-shells: EAS parameters)."""
+        return [blk.solid.new_state() for blk in self.blocks]
+
+    def internal(self, u: np.ndarray, state: list[dict] | None = None, want_K: bool = True,
+                 pattern: Pattern | None = None):
+        """Internal forces (n_dofs,), the body tangent (CSR over ``pattern``, default the bodies' own, or
+        None) and the trial element history at displacement u, started from ``state`` (not changed)."""
+        pattern = self.pattern if pattern is None else pattern
+        data = np.zeros(pattern.nnz) if want_K else np.zeros(1)
         r = np.zeros(self.n_dofs)
         U = u.reshape(-1, 3)
-        for blk in self.blocks:
-            bad = blk.solid.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, self.pattern,
-                                     node_offset=blk.offset, want_K=want_K)
+        state = self.new_state() if state is None else state
+        trial = [{k: v.copy() for k, v in st.items()} for st in state]
+        for blk, st in zip(self.blocks, trial):
+            bad = blk.solid.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, pattern,
+                                     node_offset=blk.offset, want_K=want_K, state=st)
             if bad >= 0:
                 raise InvertedElementError(blk.name, int(bad))
-        K = self.pattern.csr(data) if want_K else None
-        return r, K
+        K = pattern.csr(data) if want_K else None
+        return r, K, trial
 
-    def save_state(self) -> None:
-        for blk in self.blocks:
-            if hasattr(blk.solid, "save_state"):
-                blk.solid.save_state()
-
-    def restore_state(self) -> None:
-        for blk in self.blocks:
-            if hasattr(blk.solid, "restore_state"):
-                blk.solid.restore_state()
-
-    def commit(self) -> None:
-        for blk in self.blocks:
-            if hasattr(blk.solid, "commit"):
-                blk.solid.commit()
-
-    def energy(self, u: np.ndarray) -> float:
+    def energy(self, u: np.ndarray, state: list[dict] | None = None) -> float:
         U = u.reshape(-1, 3)
-        return float(sum(blk.solid.energy(U[blk.offset: blk.offset + blk.n_nodes]) for blk in self.blocks))
+        state = self.new_state() if state is None else state
+        return float(sum(blk.solid.energy(U[blk.offset: blk.offset + blk.n_nodes], st)
+                         for blk, st in zip(self.blocks, state)))
 
     def eliminate(self, K: sp.csr_matrix) -> sp.csr_matrix:
         """Zero the rows and columns of constrained dofs and put 1 on their diagonal (in place if possible)."""

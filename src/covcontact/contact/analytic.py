@@ -1,4 +1,4 @@
-"""Rigid analytic master surfaces: plane, cylinder, sphere (FORMULATION.md sections 1-4).
+"""Rigid analytic master surfaces: plane, cylinder, sphere (docs/theory.md sections 3-5).
 
 Each surface is placed by an origin and a right-handed orthonormal frame (rows e1, e2, e3), moved by
 a ``RigidMotion`` with load factor lam. Parameterisations (sigma = +1 for ``outside=True``, the body
@@ -35,6 +35,7 @@ from covcontact.contact.element import (
     check_inputs,
     check_multiplier,
 )
+from covcontact.contact.laws import c_inverse, effective_gap, is_active
 from covcontact.contact.rigid import RigidMotion
 
 PLANE = 0
@@ -192,25 +193,13 @@ def analytic_core(
             if want_parts:
                 for k in range(4):
                     P_out[k, p, q] = 0.0
-    ge = g + lam_k / eps_n  # effective gap: lam_N = eps_n ge
-    if ge > 0.0:
+    ge = effective_gap(g, lam_k, eps_n)  # lam_N = eps_n ge
+    if not is_active(g, lam_k, eps_n):
         return g, chart
     for p in range(3):
         R_out[p] = eps_n * ge * n[p]
     _mat2_prod3(a_con, h_cov, a_con, h_con, 1.0)
-    c00 = a_cov[0, 0] - g * h_cov[0, 0]
-    c01 = a_cov[0, 1] - g * h_cov[0, 1]
-    c11 = a_cov[1, 1] - g * h_cov[1, 1]
-    detc = c00 * c11 - c01 * c01
-    if abs(detc) > 1e-14 * abs(a_cov[0, 0] * a_cov[1, 1]):
-        c_con[0, 0] = c11 / detc
-        c_con[1, 1] = c00 / detc
-        c_con[0, 1] = -c01 / detc
-        c_con[1, 0] = -c01 / detc
-    else:  # the slave sits on the focal point/axis: no exact Hessian, use a^ij
-        for i in range(2):
-            for j in range(2):
-                c_con[i, j] = a_con[i, j]
+    c_inverse(a_cov, a_con, h_cov, g, c_con)  # a^ij on the focal point/axis (no exact Hessian)
     _mat2_prod3(a_con, h_cov, c_con, D1, ge)  # ge/g (c^ij - a^ij)
     _mat2_prod3(a_con, h_cov, D1, D2, -g)  # ge/g (a^ij - c^ij + g h^ij)
     for p in range(3):

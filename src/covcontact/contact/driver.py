@@ -1,4 +1,4 @@
-"""Contact point of every slave node on a whole master surface (FORMULATION.md section 2).
+"""Contact point of every slave node on a whole master surface (docs/theory.md section 4).
 
 For each slave the driver walks over its candidate facets (from :mod:`.search`, nearest box first;
 the previous facet of the slave first when one is given, started from its previous xi) and runs the

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.shapes import shape_functions
+from .laws import normal_pressure
 
 
 def free_direction(xi: np.ndarray) -> int:
@@ -53,7 +54,7 @@ def edge_vertex_contact(xyz: np.ndarray, xi: np.ndarray, xs: np.ndarray, sign: f
     dist = float(np.linalg.norm(D))
     g = sign * dist
     n = sign * D / dist if dist > 0.0 else np.zeros(3)
-    f1 = lam + eps * g
+    f1 = normal_pressure(g, lam, eps)
     An = A.T @ n
     R = f1 * An
     H0 = A.T @ A

@@ -1,6 +1,6 @@
 """Covariant node-to-surface contact element: one slave node against one master facet.
 
-Implements FORMULATION.md sections 3-4 (penalty or augmented Lagrangian normal law,
+Implements docs/theory.md sections 5 and 8 (penalty or augmented Lagrangian normal law,
 internal-force convention). Dof order: the n master nodes first, the slave node last (paper eq. 14);
 dof of block b, direction p is 3 b + p.
 
@@ -30,6 +30,7 @@ import numpy as np
 from numba import njit
 
 from covcontact.contact.geometry import facet_geometry
+from covcontact.contact.laws import c_inverse, effective_gap, is_active
 from covcontact.contact.projection import DEGENERATE, project_on_facet
 from covcontact.fem.shapes import NODES
 
@@ -235,8 +236,8 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
     if area == 0.0:
         return np.inf
     g = (xs[0] - rho[0]) * n[0] + (xs[1] - rho[1]) * n[1] + (xs[2] - rho[2]) * n[2]
-    ge = g + lam_k / eps_n  # effective gap: lam_N = eps_n ge
-    if ge > 0.0:
+    ge = effective_gap(g, lam_k, eps_n)  # lam_N = eps_n ge
+    if not is_active(g, lam_k, eps_n):
         return g
     for k in range(nen):
         alpha[k] = -N[k]
@@ -257,19 +258,7 @@ def element_core(xyz, xs, xi1, xi2, eps_n, case, want_parts, R_out, K_out, P_out
                 for l in range(2):
                     s += a_con[i, k] * h_cov[k, l] * a_con[l, j]
             h_con[i, j] = s
-    c00 = a_cov[0, 0] - g * h_cov[0, 0]
-    c01 = a_cov[0, 1] - g * h_cov[0, 1]
-    c11 = a_cov[1, 1] - g * h_cov[1, 1]
-    detc = c00 * c11 - c01 * c01
-    if abs(detc) > 1e-14 * abs(a_cov[0, 0] * a_cov[1, 1]):
-        c_con[0, 0] = c11 / detc
-        c_con[1, 1] = c00 / detc
-        c_con[0, 1] = -c01 / detc
-        c_con[1, 0] = -c01 / detc
-    else:  # on the focal surface: the exact Hessian does not exist; use a^ij
-        for i in range(2):
-            for j in range(2):
-                c_con[i, j] = a_con[i, j]
+    c_inverse(a_cov, a_con, h_cov, g, c_con)  # a^ij on the focal surface (no exact Hessian)
     _mat2_prod3(a_con, h_cov, c_con, D1, g)
     _mat2_prod3(a_con, h_cov, c_con, D1e, ge)
     _mat2_prod3(a_con, h_cov, D1e, D2, -g)
@@ -297,7 +286,7 @@ def contact_element(xyz, xs, xi, eps_n, case, want_parts, R_out, K_out, P_out, l
 
 @dataclass
 class ContactResult:
-    """Result of one contact element evaluation (INTERFACE.md section 4).
+    """Result of one contact element evaluation (docs/theory.md section 9).
 
     Attributes:
         gap: signed normal gap g (negative: penetration).
@@ -352,7 +341,7 @@ def check_multiplier(multiplier):
 
 
 def node_to_surface(master_xyz, slave_xyz, eps_n, parts="a", xi0=None, multiplier=0.0) -> ContactResult:
-    """Contact of one slave node against one quad4/quad9 master facet (INTERFACE.md section 4).
+    """Contact of one slave node against one quad4/quad9 master facet (docs/theory.md section 9).
 
     Args:
         master_xyz: (n, 3) current facet nodes, n = 4 or 9, VTK order, outward normal.

@@ -1,6 +1,6 @@
 """Covariant Coulomb friction element: Python layer and the rigid analytic-surface twin.
 
-The compiled facet element and the mathematics are in ``friction_kernels`` (FORMULATION.md section 5).
+The compiled facet element and the mathematics are in ``friction_kernels`` (docs/theory.md section 7).
 
 History of one slave node, HIST_SIZE = 14 floats, written by every evaluation into ``hist_out`` (the
 values to commit when the step converges; the caller keeps the committed copy and the facet id):
@@ -51,6 +51,7 @@ from covcontact.contact.friction_kernels import (
     new_friction_work,
 )
 from covcontact.contact.geometry import facet_geometry
+from covcontact.contact.laws import is_active
 from covcontact.contact.projection import DEGENERATE, project_on_facet
 from covcontact.fem.shapes import NODES
 
@@ -209,7 +210,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
         hist_out[H_RHO_COV + e] = s1
         hist_out[H_RHO_COV + 3 + e] = s2
     hist_out[H_FLAG] = 1.0
-    if lam_k + eps_n * g > 0.0:
+    if not is_active(g, lam_k, eps_n):
         return g, OPEN
     if mu == 0.0:
         return g, SLIP

@@ -1,4 +1,4 @@
-"""Compiled covariant Coulomb friction element (FORMULATION.md section 5; Konyukhov & Schweizerhof 2005).
+"""Compiled covariant Coulomb friction element (docs/theory.md section 7; Konyukhov & Schweizerhof 2005).
 
 One slave node against one quad4/quad9 master facet (dofs: master nodes, then the slave) or an analytic
 rigid surface (slave dofs only). Internal-force convention, penalty regularisation in both directions.
@@ -9,10 +9,11 @@ convected with the master, t' = T^(n)_k a^kl(xi_n) rho_l(xi_n) (current configur
     T^tr_i = t' . rho_i - eps_T a_ij dxi^j,     ||T|| = sqrt(T_i a^ij T_j),     kappa = mu eps_N |g|
     stick: ||T^tr|| <= kappa, T = T^tr;         slip: T = kappa T^tr / ||T^tr||
 
-This is section 5's T_k^(n) a_(n)^kl (rho_l^(n) . rho_i) with the old base vectors taken at the same
-material point of the master now instead of stored: equal for a master at rest, and objective (a rigid
-motion of the pair leaves T unchanged), which the stored form is not (|T^tr| drops by 4 % for a 0.3 rad
-rotation about an in-plane axis). Rigid analytic surfaces: t' is the old traction carried with the body.
+This is the stored form T_k^(n) a_(n)^kl (rho_l^(n) . rho_i) of docs/theory.md section 7 with the old base
+vectors taken at the same material point of the master now instead of stored: equal for a master at rest,
+and objective (a rigid motion of the pair leaves T unchanged), which the stored form is not (|T^tr| drops
+by 4 % for a 0.3 rad rotation about an in-plane axis). Rigid analytic surfaces: t' is the old traction
+carried with the body.
 
 Residual (variational; for T^(n) = 0 in stick it is exactly the gradient of 1/2 eps_T a_ij dxi^i dxi^j):
 
@@ -36,6 +37,7 @@ from numba import njit, prange
 
 from covcontact.contact.element import CASE_EXACT, element_core, new_work
 from covcontact.contact.geometry import facet_geometry
+from covcontact.contact.laws import c_inverse, is_active, normal_pressure
 from covcontact.fem.shapes import IDX, lagrange1d
 
 #: element states
@@ -116,19 +118,10 @@ def friction_generic(nb, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, 
     m = 3 * nb
     d = m + 2
     # c_ij = a_ij - r . rho_ij and its inverse (a^ij on the focal surface)
-    c00 = a_cov[0, 0] - (r[0] * rho2[0, 0, 0] + r[1] * rho2[0, 0, 1] + r[2] * rho2[0, 0, 2])
-    c01 = a_cov[0, 1] - (r[0] * rho2[0, 1, 0] + r[1] * rho2[0, 1, 1] + r[2] * rho2[0, 1, 2])
-    c11 = a_cov[1, 1] - (r[0] * rho2[1, 1, 0] + r[1] * rho2[1, 1, 1] + r[2] * rho2[1, 1, 2])
-    detc = c00 * c11 - c01 * c01
-    if abs(detc) > 1e-14 * abs(a_cov[0, 0] * a_cov[1, 1]):
-        cc[0, 0] = c11 / detc
-        cc[1, 1] = c00 / detc
-        cc[0, 1] = -c01 / detc
-        cc[1, 0] = -c01 / detc
-    else:
-        for i in range(2):
-            for j in range(2):
-                cc[i, j] = a_con[i, j]
+    for i in range(2):  # g h_ij = r . rho_ij, held in cc until c_inverse overwrites it
+        for j in range(2):
+            cc[i, j] = r[0] * rho2[i, j, 0] + r[1] * rho2[i, j, 1] + r[2] * rho2[i, j, 2]
+    c_inverse(a_cov, a_con, cc, 1.0, cc)
     # z-gradients of r and rho_i
     for z in range(d):
         for q in range(3):
@@ -190,7 +183,7 @@ def friction_generic(nb, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, 
     ta0 = a_con[0, 0] * Ttr0 + a_con[0, 1] * Ttr1
     ta1 = a_con[1, 0] * Ttr0 + a_con[1, 1] * Ttr1
     nu = np.sqrt(max(Ttr0 * ta0 + Ttr1 * ta1, 0.0))
-    kappa = -mu * (lam_k + eps_n * g)  # Coulomb limit from the normal pressure
+    kappa = -mu * normal_pressure(g, lam_k, eps_n)  # Coulomb limit from the normal pressure
     if nu <= kappa:
         state = STICK
         T0 = Ttr0
@@ -363,7 +356,7 @@ def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_
     hist_out[H_T] = 0.0
     hist_out[H_T + 1] = 0.0
     hist_out[H_FLAG] = 1.0
-    if lam_k + eps_n * g > 0.0:
+    if not is_active(g, lam_k, eps_n):
         return g, OPEN
     if mu == 0.0:
         return g, SLIP

@@ -1,4 +1,4 @@
-"""Covariant geometry of a quad4 / quad9 master facet (FORMULATION.md section 1).
+"""Covariant geometry of a quad4 / quad9 master facet (docs/theory.md section 3).
 
 At element coordinates (xi1, xi2) of a facet with current nodal positions ``xyz`` (n, 3):
 
@@ -62,7 +62,7 @@ def facet_point(xyz, xi1, xi2, N, dN, ddN, rho):
 
 @njit(cache=True)
 def facet_geometry(xyz, xi1, xi2, N, dN, ddN, rho, rho_cov, a_cov, a_con, n, h_cov):
-    """All quantities of FORMULATION.md section 1 at (xi1, xi2).
+    """All quantities of docs/theory.md section 3 at (xi1, xi2).
 
     Args:
         xyz: (nen, 3) nodal positions, nen = 4 or 9.

@@ -1,4 +1,4 @@
-"""Closest point projection of a slave point onto one master facet (FORMULATION.md section 2).
+"""Closest point projection of a slave point onto one master facet (docs/theory.md section 4).
 
 Solves F_i(xi) = (r_s - rho(xi)) . rho_i = 0 by Newton's method with the Hessian of
 1/2 |r_s - rho|^2, c_ij = a_ij - g h_ij. Where c is not positive definite (near or beyond the

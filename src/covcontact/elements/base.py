@@ -138,23 +138,29 @@ class ElementBody:
 
     # -- kernel calls (subclass) ----------------------------------------------------------------
     def _chunk(self, u: np.ndarray, e0: int, want_K: bool, Ke: np.ndarray, fe: np.ndarray,
-               flags: np.ndarray, nblocks: int) -> None:
-        """Fill Ke (nc, nd, nd) if want_K, fe (nc, nd), flags (nc,) for elements e0 .. e0 + nc - 1."""
+               flags: np.ndarray, nblocks: int, state: dict[str, np.ndarray]) -> None:
+        """Fill Ke (nc, nd, nd) if want_K, fe (nc, nd), flags (nc,) for elements e0 .. e0 + nc - 1; the
+        arrays of ``state`` (see :meth:`new_state`) are read as the start and overwritten with the trial."""
         raise NotImplementedError
 
-    def _gauss_fields(self, u: np.ndarray, mode: int, out: np.ndarray) -> None:
+    def _gauss_fields(self, u: np.ndarray, mode: int, out: np.ndarray, state: dict[str, np.ndarray]) -> None:
         """Per-element fields into out (nelem, ncol): mode 0 energy, 1 min det J0, 2 stress (18)."""
         raise NotImplementedError
+
+    def new_state(self) -> dict[str, np.ndarray]:
+        """The element history of this body at the reference state, as named arrays (none here;
+        solid-shells hold their EAS parameters)."""
+        return {}
 
     # -- evaluation -----------------------------------------------------------------------------
     def _u(self, u: np.ndarray) -> np.ndarray:
         u = np.ascontiguousarray(u, dtype=np.float64)
         return u if u.shape == self.X.shape else u.reshape(self.X.shape)
 
-    def _fields(self, u: np.ndarray, mode: int, ncol: int) -> np.ndarray:
+    def _fields(self, u: np.ndarray, mode: int, ncol: int, state: dict | None = None) -> np.ndarray:
         out = np.empty((self.n_elements, ncol))
         if self.n_elements:
-            self._gauss_fields(self._u(u), mode, out)
+            self._gauss_fields(self._u(u), mode, out, self.new_state() if state is None else state)
         return out
 
     def check_reference(self) -> list[int]:
@@ -170,15 +176,17 @@ class ElementBody:
         return self._ranks
 
     def assemble(self, u: np.ndarray, data: np.ndarray, rhs: np.ndarray, pattern: Pattern | None,
-                 node_offset: int = 0, want_K: bool = True) -> int:
+                 node_offset: int = 0, want_K: bool = True, state: dict | None = None) -> int:
         """Add internal forces to ``rhs`` and (if want_K) element tangents to the CSR ``data``.
 
-        Dofs are 3 (node_offset + a) + i. Element history (the EAS parameters of solid-shells) is
-        solved for ``u``, so the result depends on u only. Returns -1, or the first element with an
+        Dofs are 3 (node_offset + a) + i. ``state`` holds the element history arrays (:meth:`new_state`;
+        the EAS parameters of solid-shells): read as the starting point and overwritten with the trial
+        values at ``u``; the caller passes a copy of what it must keep. Returns -1, or the first element with an
         inadmissible strain (det F <= 0), det J0 <= 0 or a failed local solve at a Gauss point; the
         outputs then stay finite but may be meaningless.
         """
         u = self._u(u)
+        state = self.new_state() if state is None else state
         nd = 3 * self.nen
         if rhs.dtype != np.float64 or rhs.ndim != 1 or rhs.size < 3 * (node_offset + self.n_nodes):
             raise ValueError("rhs must be float64 (ndofs,) covering this body's dofs")
@@ -207,7 +215,7 @@ class ElementBody:
                 Ke = self._Ke[:nc] if want_K else self._Ke
                 fe = self._fe[:nc]
                 flags = self._flags[:nc]
-                self._chunk(u, e0, want_K, Ke, fe, flags, nblocks)
+                self._chunk(u, e0, want_K, Ke, fe, flags, nblocks, state)
                 scatter_vectors(rhs, self.cells, off, fe, e0)
                 if want_K:
                     scatter_matrices(data, node_ptr, self.cells, off, ranks, Ke, e0)
@@ -219,13 +227,14 @@ class ElementBody:
             set_parallel_chunksize(old_chunksize)
         return first_bad
 
-    def energy(self, u: np.ndarray) -> float:
+    def energy(self, u: np.ndarray, state: dict | None = None) -> float:
         """Strain energy int W dV (inf if a strain is inadmissible, e.g. an inverted Neo-Hooke element)."""
-        return float(self._fields(u, 0, 1).sum())
+        return float(self._fields(u, 0, 1, state).sum())
 
-    def stress(self, u: np.ndarray) -> SolidStress:
-        """Element-averaged Cauchy stress, S and Green-Lagrange strain; nodal averaged Cauchy stress."""
-        f = self._fields(u, 2, 18)
+    def stress(self, u: np.ndarray, state: dict | None = None) -> SolidStress:
+        """Element-averaged Cauchy stress, S and Green-Lagrange strain; nodal averaged Cauchy stress at
+        displacement u and element history ``state`` (default: the reference state)."""
+        f = self._fields(u, 2, 18, state)
         cauchy = np.ascontiguousarray(f[:, :6])
         count = np.bincount(self.cells.ravel(), minlength=self.n_nodes).astype(np.float64)
         nodal = np.empty((self.n_nodes, 6))

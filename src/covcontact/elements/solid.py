@@ -249,10 +249,10 @@ class SolidBody(ElementBody):
         self.points, self.weights = _rule(cell_type, rule)
         self.dNdxi = np.ascontiguousarray(shape_functions(cell_type, self.points)[1])
 
-    def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks) -> None:
+    def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:
         solid_chunk(self.material.kind, self.material.params, self.X, u, self.cells, e0, self.dNdxi,
                     self.weights, want_K, Ke, fe, flags, nblocks)
 
-    def _gauss_fields(self, u, mode, out) -> None:
+    def _gauss_fields(self, u, mode, out, state) -> None:
         solid_gauss_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.dNdxi,
                            self.weights, mode, out, get_num_threads())

@@ -245,30 +245,17 @@ class SolidShellBody(ElementBody):
         self.dNc = np.ascontiguousarray(shape_functions(cell_type, np.zeros((1, 3)))[1][0])
         self.neas = o["eas"]
         self.eas_comp, self.eas_val = eas_tables(cell_type, self.neas, pts[: self.weights.size])
-        self.alpha = np.zeros((self.n_elements, self.neas))
-        self._alpha_saved = self.alpha.copy()
-        self._alpha_committed = self.alpha.copy()
 
-    def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks) -> None:
-        solidshell_chunk(self.material.kind, self.material.params, self.X, u, self.cells, e0, self.alpha, self.dNp,
+    def new_state(self) -> dict[str, np.ndarray]:
+        """EAS parameters alpha (nelem, neas), zero in the reference state."""
+        return {"alpha": np.zeros((self.n_elements, self.neas))}
+
+    def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:
+        solidshell_chunk(self.material.kind, self.material.params, self.X, u, self.cells, e0, state["alpha"], self.dNp,
                          self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
                          want_K, Ke, fe, flags, nblocks)
 
-    def _gauss_fields(self, u, mode, out) -> None:
-        solidshell_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.alpha, self.dNp,
+    def _gauss_fields(self, u, mode, out, state) -> None:
+        solidshell_fields(self.material.kind, self.material.params, self.X, u, self.cells, state["alpha"], self.dNp,
                           self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
                           mode, out, get_num_threads())
-
-    # -- history --------------------------------------------------------------------------------
-    def save_state(self) -> None:
-        """Remember the EAS parameters at the start of a load step."""
-        self._alpha_saved = self.alpha.copy()
-
-    def restore_state(self) -> None:
-        """Back to the parameters of :meth:`save_state` (cutback)."""
-        self.alpha[...] = self._alpha_saved
-
-    def commit(self) -> None:
-        """The step converged: its parameters become the committed history."""
-        self._alpha_committed = self.alpha.copy()
-        self._alpha_saved = self.alpha.copy()

@@ -388,7 +388,8 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     output = OutputOptions()
     if o is not None:
         output = OutputOptions(vtu=o.get("vtu", "bool", True), every=o.get("every", "int", 1, positive=True),
-                               pictures=o.get("pictures", "bool", False))
+                               pictures=o.get("pictures", "bool", False),
+                               checkpoint_every=o.get("checkpoint_every", "int", 1, positive=True))
         o.done()
     top.done()
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,

@@ -82,6 +82,24 @@ class ResultWriter:
                 os.unlink(tmp)
             raise
         self.pvd_entries.append((time_value, name))
+        self._write_pvd()
+
+    def restore(self, pvd_entries: list, step: int) -> None:
+        """Continue the files of an earlier run at the end of ``step`` (resume from a checkpoint): the
+        VTU series ``pvd_entries`` of the checkpoint, the iterations of steps up to ``step``."""
+        self.pvd_entries = [(float(t), str(f)) for t, f in pvd_entries]
+        kept = {f for _, f in self.pvd_entries}
+        for path in self.out.glob("step_*.vtu"):
+            if path.name not in kept:
+                path.unlink()
+        self._write_pvd()
+        csv = self.out / "convergence.csv"
+        if csv.is_file():
+            rows = csv.read_text().splitlines()[1:]
+            self.csv_rows += [r for r in rows if r and int(r.split(",", 1)[0]) <= step]
+        atomic_write_text(csv, "\n".join(self.csv_rows) + "\n")
+
+    def _write_pvd(self) -> None:
         lines = ['<?xml version="1.0"?>',
                  '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
                  "  <Collection>"]

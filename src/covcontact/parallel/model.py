@@ -18,7 +18,8 @@ from ..assembly.pattern import Pattern
 from ..assembly.system import BodyBlock, InvertedElementError, System
 from ..elements.base import SolidStress
 from ..elements.solid import SolidBody
-from ..solvers.model import Model, NoContact
+from ..solvers.model import Model
+from ..solvers.state import State
 from .comm import gather_all, share_cores, sum_all
 from .partition import DofLayout, node_owners, rcb
 
@@ -114,9 +115,9 @@ class PartBody:
     def __getattr__(self, name):
         return getattr(self.local, name)
 
-    def stress(self, u: np.ndarray) -> SolidStress:
+    def stress(self, u: np.ndarray, state: dict | None = None) -> SolidStress:
         """The body's stress fields (global element order), on every rank (collective)."""
-        st = self.local.stress(u)
+        st = self.local.stress(u, state)
         cells = self.local.cells
         n = self.local.n_nodes
         sums = np.zeros((n, 7))
@@ -187,8 +188,9 @@ class DistributedSystem(System):
             touched[c.ravel()] = True
         self.structure = Structure(self.pattern, touched, self.constrained, self.layout)
 
-    def local_internal(self, u: np.ndarray, want_K: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
-        """This rank's share of the internal forces (n_dofs,) and tangent data (pattern.nnz,) or None.
+    def local_internal(self, u: np.ndarray, state: list[dict], want_K: bool = True):
+        """This rank's share of the internal forces (n_dofs,), tangent data (pattern.nnz,) or None, and the
+        trial element history of its elements, started from ``state`` (not changed).
 
         Raises InvertedElementError on every rank when an element of any rank is inverted.
         """
@@ -196,26 +198,22 @@ class DistributedSystem(System):
         r = np.zeros(self.n_dofs)
         U = u.reshape(-1, 3)
         bad = (len(self.blocks), 0)
-        for k, blk in enumerate(self.blocks):
+        trial = [{k: v.copy() for k, v in st.items()} for st in state]
+        for k, (blk, st) in enumerate(zip(self.blocks, trial)):
             e = blk.solid.local.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, self.pattern,
-                                         node_offset=blk.offset, want_K=want_K)
+                                         node_offset=blk.offset, want_K=want_K, state=st)
             if e >= 0 and bad[0] == len(self.blocks):
                 bad = (k, int(blk.solid.elements[e]))
         bad = min(gather_all(self.comm, bad))
         if bad[0] < len(self.blocks):
             raise InvertedElementError(self.blocks[bad[0]].name, bad[1])
-        return r, (data if want_K else None)
+        return r, (data if want_K else None), trial
 
-    def internal(self, u: np.ndarray, want_K: bool = True):
-        """Global internal forces (replicated) and this rank's tangent share (DistMatrix or None)."""
-        r, data = self.local_internal(u, want_K)
-        K = DistMatrix(self.comm, self.structure, self.pattern.csr(data), None, self.constrained) if want_K \
-            else None
-        return sum_all(self.comm, r), K
-
-    def energy(self, u: np.ndarray) -> float:
+    def energy(self, u: np.ndarray, state: list[dict] | None = None) -> float:
         U = u.reshape(-1, 3)
-        e = sum(blk.solid.local.energy(U[blk.offset: blk.offset + blk.n_nodes]) for blk in self.blocks)
+        state = self.new_state() if state is None else state
+        e = sum(blk.solid.local.energy(U[blk.offset: blk.offset + blk.n_nodes], st)
+                for blk, st in zip(self.blocks, state))
         return float(sum_all(self.comm, np.array([e]))[0])
 
     def eliminate(self, K):
@@ -234,7 +232,7 @@ class DistributedModel(Model):
 
     distributed = True
 
-    def __init__(self, problem, tangent: str = "a", comm=None):
+    def __init__(self, problem, tangent: str | None = None, comm=None):
         if comm is None:
             from .comm import world
 
@@ -245,12 +243,9 @@ class DistributedModel(Model):
         self.problem = problem
         self.system = DistributedSystem(problem, comm)
         self.tangent = tangent
-        if problem.contacts:
-            from .contact import DistributedContact
+        from .contact import DistributedContact
 
-            self.contact = DistributedContact(problem, self.system, tangent, comm)
-        else:
-            self.contact = NoContact()
+        self.contact = DistributedContact(problem, self.system, tangent, comm)
         self.symmetric = self.contact.symmetric
 
     @property
@@ -261,15 +256,18 @@ class DistributedModel(Model):
     def layout(self) -> DofLayout:
         return self.system.layout
 
-    def evaluate(self, u: np.ndarray, lam: float, want_K: bool = True, timing: dict | None = None):
-        """Residual R = f_int + f_contact - lam f_ext (replicated) and the tangent share (or None)."""
+    def evaluate(self, u: np.ndarray, lam: float, committed, guess=None, want_K: bool = True,
+                 timing: dict | None = None):
+        """Residual R = f_int + f_contact - lam f_ext (replicated), the tangent share (or None) and the
+        trial state of this rank's elements and slaves."""
+        guess = committed if guess is None else guess
         t0 = time.perf_counter()
-        r, data = self.system.local_internal(u, want_K=want_K)
+        r, data, etrial = self.system.local_internal(u, guess.elements, want_K=want_K)
         t1 = time.perf_counter()
-        rc, Kc = self.contact.evaluate(self.positions(u), lam, want_K)
+        ev, ctrial = self.contact.evaluate(self.positions(u), lam, committed.contact, guess.contact, want_K)
+        r += ev.blocks.residual()
+        Kc = ev.blocks.csr() if want_K else None
         t2 = time.perf_counter()
-        if rc is not None:
-            r += rc
         r = sum_all(self.comm, r)
         t3 = time.perf_counter()
         if timing is not None:
@@ -280,13 +278,10 @@ class DistributedModel(Model):
         if want_K:
             sysm = self.system
             K = DistMatrix(self.comm, sysm.structure, sysm.pattern.csr(data), Kc, sysm.constrained)
-        return r - lam * self.f_ext, K
+        return r - lam * self.f_ext, K, State(etrial, ctrial, committed.stage, committed.step, lam)
 
     def eliminate(self, K):
         return self.system.eliminate(K)
-
-    def active_count(self) -> int:
-        return self.contact.active_count()
 
     def partition_report(self) -> dict:
         """Elements, owned dofs and contact slaves per rank (collective)."""

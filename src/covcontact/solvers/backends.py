@@ -354,7 +354,16 @@ class MumpsSolver(LinearSolver):
 class AMGSolver(LinearSolver):
     """pyamg smoothed aggregation as a preconditioner; CG for symmetric matrices (GMRES if CG does
     not converge, e.g. indefinite ones) and GMRES for non-symmetric ones. ``factorize`` builds the
-    hierarchy; ``rtol`` is the relative residual reached by each solve."""
+    hierarchy; ``rtol`` is the relative residual reached by each solve; ``iterations`` counts the Krylov
+    iterations of the last solve.
+
+    Near-null space: ``set_near_null_space(B)`` (e.g. ``rigid_body_modes(X, constrained)`` for the full
+    matrix with eliminated Dirichlet dofs) or ``set_geometry(points, dofs)``, whichever came last; without
+    either pyamg's default (constants). The hierarchy is rebuilt when it changes. ``blocksize``:
+    the matrix is handed to pyamg as BSR with 3 x 3 node blocks (aggregates of whole nodes) when it is
+    None and a near-null space of full size 3 nnode is set, or when it is 3 (for a size divisible by 3);
+    1 keeps CSR.
+    """
 
     name = "cg-amg"
     direct = False
@@ -366,36 +375,58 @@ class AMGSolver(LinearSolver):
         return True, pyamg.__version__, "iterative: CG/GMRES + smoothed-aggregation AMG"
 
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, rtol: float = 1e-10,
-                 maxiter: int = 2000):
+                 maxiter: int = 2000, blocksize: int | None = None):
         super().__init__(symmetric, max(check_tol, 10 * rtol))
-        self.rtol, self.maxiter = rtol, maxiter
-        self._B: np.ndarray | None = None
+        if blocksize not in (None, 1, 3):
+            raise ValueError(f"blocksize must be None, 1 or 3, got {blocksize!r}")
+        self.rtol, self.maxiter, self.blocksize = rtol, maxiter, blocksize
         self._geometry: tuple[np.ndarray, np.ndarray | None] | None = None
         self._ml: Any = None
+        self._stale = False  # the near-null space changed since the hierarchy was built
         self.iterations = 0
 
     def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
         self._geometry = (np.asarray(points, dtype=np.float64), dofs)
-        self._indptr = None  # rebuild the hierarchy with the new near-null space
+        self.near_null_space = None
+        self._stale = True
+
+    def set_near_null_space(self, B: np.ndarray | None) -> None:
+        super().set_near_null_space(B)
+        self._geometry = None
+        self._stale = True
+
+    def _candidates(self, n: int) -> tuple[np.ndarray | None, bool]:
+        """The near-null space for a matrix of size n, and whether its rows are 3 dofs per node."""
+        B, nodal = self.near_null_space, True
+        if self._geometry is not None:
+            B, nodal = rigid_body_modes(*self._geometry), self._geometry[1] is None
+        if B is not None and B.shape[0] != n:
+            raise ValueError(f"the near-null space has {B.shape[0]} rows, the matrix {n}")
+        return B, nodal
 
     def _factor(self, K: sp.csr_matrix) -> None:
         import pyamg
 
-        B = None
-        if self._geometry is not None:
-            B = rigid_body_modes(*self._geometry)
-            if B.shape[0] != K.shape[0]:
-                raise ValueError(f"geometry gives {B.shape[0]} dofs, the matrix has {K.shape[0]}")
+        B, nodal = self._candidates(K.shape[0])
+        bs = self.blocksize or (3 if B is not None and nodal else 1)
+        if K.shape[0] % bs:
+            bs = 1
+        A = K.tobsr(blocksize=(3, 3)) if bs == 3 else K  # BSR: aggregates of whole nodes
+        sym = "symmetric" if self.symmetric else "nonsymmetric"
         self._ml = pyamg.smoothed_aggregation_solver(
-            K, B=B, symmetry="symmetric" if self.symmetric else "nonsymmetric", max_coarse=500,
+            A, B=None if B is None else B.copy(), BH=None if B is None or self.symmetric else B.copy(),
+            symmetry=sym, max_coarse=500 // bs,  # pyamg counts blocks: the coarsest level has <= 500 dofs
             coarse_solver="splu",  # the default dense pseudo-inverse costs minutes on a stalled 2500-dof level
         )
+        self._stale = False
 
     def _solve(self, b: np.ndarray) -> np.ndarray:
         if b.ndim == 2:
             return np.stack([self._solve(b[:, j]) for j in range(b.shape[1])], axis=1)
         K = self._K
         assert K is not None
+        if self._stale:  # a new near-null space since factorize: rebuild the hierarchy
+            self._factor(K)
         M = self._ml.aspreconditioner(cycle="V")
         nb = np.linalg.norm(b)
         count = [0]

@@ -11,7 +11,9 @@ Backends, in order of preference (``available()`` lists those usable on this mac
 - ``superlu``: SciPy's SuperLU, always present; for symmetric matrices with the symmetric-mode
   options (MMD on A^T + A, diagonal pivots preferred), about 2.4x faster than ``spsolve``.
 - ``cg-amg``: smoothed-aggregation AMG (pyamg) as preconditioner of CG (symmetric) or GMRES, with
-  the rigid-body modes as near-null space once ``set_geometry`` has been called.
+  the rigid-body modes as near-null space once ``set_near_null_space`` (or ``set_geometry``) has been
+  called: ``solver.set_near_null_space(rigid_body_modes(X, constrained))``. Every backend has both
+  methods; the direct ones ignore them.
 
 Every solver keeps its symbolic analysis while the sparsity pattern (indptr, indices) is unchanged,
 records the time of its last analysis, factorisation and solve, checks the residual of each solve
@@ -131,7 +133,7 @@ def make_solver(name: str = "auto", symmetric: bool = True, **options) -> Linear
             handles the symmetry).
         symmetric: whether the matrices will be symmetric (they may still be indefinite).
         **options: backend options (``check_tol`` for all; ``spd``/``matching`` for pardiso;
-            ``ordering`` for mumps; ``rtol``/``maxiter`` for cg-amg).
+            ``ordering`` for mumps; ``rtol``/``maxiter``/``blocksize`` for cg-amg).
     """
     key = name.lower().strip()
     if key == "auto":  # probe lazily: importing every optional backend costs time
@@ -150,26 +152,74 @@ def make_solver(name: str = "auto", symmetric: bool = True, **options) -> Linear
     return backend_class(key)(symmetric=symmetric, **options)
 
 
-def rigid_body_modes(points: np.ndarray, dofs: np.ndarray | None = None) -> np.ndarray:
-    """The six rigid-body modes (ndof, 6) of nodes ``points`` restricted to global ``dofs``."""
-    X = np.asarray(points, dtype=np.float64)
-    if dofs is None:
-        dofs = np.arange(3 * X.shape[0])
-    dofs = np.asarray(dofs, dtype=np.int64)
+def rigid_body_modes(X: np.ndarray, constrained: np.ndarray | None = None) -> np.ndarray:
+    """The six rigid-body modes of the nodes ``X``: the near-null space of an elastic stiffness.
+
+    Columns: the unit translations along x, y, z, then the infinitesimal rotations about the x, y, z
+    axes through the centroid of ``X``, u = e_k x (x - c) / L, with L the root-mean-square distance of
+    the nodes from the centroid, so that every column has entries of order one whatever the units.
+    Row 3a+i belongs to direction i of node a.
+
+    Args:
+        X: (nnode, 3) node coordinates: the reference ones, or the current ones X + u for the tangent at
+            a deformed state (whose kernel is spanned by rotations of the current configuration).
+        constrained: either a bool mask (3 nnode,) of the Dirichlet-constrained dofs, whose rows are set
+            to zero to match a matrix with those rows and columns eliminated (result (3 nnode, 6)); or
+            an integer array of distinct global dofs, the unknowns of a reduced system (result
+            (len(dofs), 6), rows in that order); or None: all dofs, nothing zeroed.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    if X.ndim != 2 or X.shape[1] != 3:
+        raise ValueError(f"node coordinates must have shape (nnode, 3), got {X.shape}")
+    ndof = 3 * X.shape[0]
+    mask = None
+    if constrained is None:
+        dofs = np.arange(ndof)
+    else:
+        c = np.asarray(constrained)
+        if c.dtype == bool:
+            if c.shape != (ndof,):
+                raise ValueError(f"the constrained mask must have shape ({ndof},), got {c.shape}")
+            dofs, mask = np.arange(ndof), c
+        elif np.issubdtype(c.dtype, np.integer) and c.ndim == 1:
+            dofs = c.astype(np.int64)
+            if dofs.size and (dofs.min() < 0 or dofs.max() >= ndof or np.unique(dofs).size != dofs.size):
+                raise ValueError(f"dofs must be distinct integers in [0, {ndof}); pass a constrained mask "
+                                 "as a bool array")
+        else:
+            raise TypeError(f"constrained must be a bool mask or integer dofs, got {c.dtype} {c.shape}")
     node, i = dofs // 3, dofs % 3
-    x = X[node] - X.mean(axis=0)
+    c0 = X.mean(axis=0) if X.shape[0] else np.zeros(3)
+    L = float(np.sqrt(np.mean(np.sum((X - c0) ** 2, axis=1)))) if X.shape[0] else 0.0
+    x = (X[node] - c0) / (L if L > 0.0 else 1.0)
     B = np.zeros((dofs.size, 6))
-    B[np.arange(dofs.size), i] = 1.0
-    # rotation about axis k: u = e_k x x
-    for k in range(3):
+    rows = np.arange(dofs.size)
+    B[rows, i] = 1.0
+    for k in range(3):  # rotation about axis k: u = e_k x x
         rot = np.zeros((dofs.size, 3))
         rot[:, (k + 2) % 3] = x[:, (k + 1) % 3]
         rot[:, (k + 1) % 3] = -x[:, (k + 2) % 3]
-        B[:, 3 + k] = rot[np.arange(dofs.size), i]
+        B[:, 3 + k] = rot[rows, i]
+    if mask is not None:
+        B[mask] = 0.0
     return B
 
 
 # ----------------------------------------------------------------------------- common layer
+
+
+def _near_null_array(B) -> np.ndarray | None:
+    """B as a C-contiguous float64 (n, k) array with k >= 1 (a vector is one column), checked finite."""
+    if B is None:
+        return None
+    B = np.array(B, dtype=np.float64, order="C", ndmin=1)
+    if B.ndim == 1:
+        B = B[:, None]
+    if B.ndim != 2 or B.shape[1] == 0:
+        raise ValueError(f"the near-null space must have shape (n, k), k >= 1, got {B.shape}")
+    if not np.isfinite(B).all():
+        raise ValueError("the near-null space has non-finite entries")
+    return B
 
 
 def _as_csr(K) -> sp.csr_matrix:
@@ -226,6 +276,7 @@ class LinearSolver:
         self._K: sp.csr_matrix | None = None
         self._indptr: np.ndarray | None = None
         self._indices: np.ndarray | None = None
+        self.near_null_space: np.ndarray | None = None
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name} symmetric={self.symmetric}>"
@@ -281,6 +332,14 @@ class LinearSolver:
 
     def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
         """Node coordinates (nnode, 3) and the global dofs of the unknowns (used by cg-amg)."""
+
+    def set_near_null_space(self, B: np.ndarray | None) -> None:
+        """Near-null space (n, k) of the matrices to come, e.g. ``rigid_body_modes(X, constrained)``.
+
+        Rows match the rows of the matrix handed to ``solve``/``factorize``; ``None`` forgets it. Stored
+        in ``near_null_space``; only the AMG backend uses it (the direct backends ignore it).
+        """
+        self.near_null_space = _near_null_array(B)
 
     def close(self) -> None:
         """Release the factorisation and the analysis (the next ``factorize`` analyses afresh)."""

@@ -1,4 +1,8 @@
-"""The Model: what Newton iterates on: the bodies' system plus the contact pairs."""
+"""The Model: what Newton iterates on: the bodies' system plus the contact pairs.
+
+``Model.evaluate(u, lam, committed, guess)`` returns the residual, the tangent and a trial state and
+changes nothing it is given (docs/theory.md section 10).
+"""
 
 from __future__ import annotations
 
@@ -7,52 +11,25 @@ import time
 import numpy as np
 
 from ..assembly.system import System
-
-
-class NoContact:
-    """Stand-in for a problem without contact pairs."""
-
-    symmetric = True
-
-    def begin_step(self, x, lam):
-        pass
-
-    def evaluate(self, x, lam, want_K):
-        return None, None
-
-    def save_state(self):
-        pass
-
-    def restore_state(self):
-        pass
-
-    def commit(self):
-        pass
-
-    def active_count(self) -> int:
-        return 0
-
-    def step_report(self, x, lam) -> dict:
-        return {}
-
-    def point_data(self, n_nodes: int) -> dict:
-        return {}
+from ..contact.assembly import CouplingPattern
+from ..contact.manager import ContactManager
+from .state import State
 
 
 class Model:
-    """Bodies, loads, Dirichlet conditions and contact of a problem, evaluated at a displacement u."""
+    """Bodies, loads, Dirichlet conditions and contact of a problem, evaluated at a displacement u.
 
-    def __init__(self, problem, tangent: str = "a"):
+    ``tangent`` overrides the tangent case of every contact pair (None: each pair's own).
+    """
+
+    def __init__(self, problem, tangent: str | None = None):
         self.problem = problem
         self.system = System(problem)
         self.tangent = tangent
-        if problem.contacts:
-            from ..contact.manager import ContactManager
-
-            self.contact = ContactManager(problem, self.system, tangent)
-        else:
-            self.contact = NoContact()
+        self.contact = ContactManager(problem, self.system, tangent)
         self.symmetric = self.contact.symmetric
+        blocks = [body.mesh.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies)]
+        self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
 
     # delegation -------------------------------------------------------------------------------
     @property
@@ -76,44 +53,58 @@ class Model:
     def positions(self, u: np.ndarray) -> np.ndarray:
         return self.system.X + u.reshape(-1, 3)
 
+    def near_null_space(self) -> np.ndarray:
+        """Rigid-body modes of the free dofs (zero rows on constrained dofs), for AMG preconditioners."""
+        from .linear import rigid_body_modes
+
+        return rigid_body_modes(self.system.X, self.system.constrained)
+
+    # state ------------------------------------------------------------------------------------
+    def initial_state(self) -> State:
+        return State(self.system.new_state(), self.contact.initial_state())
+
+    def begin_step(self) -> None:
+        """A new Newton solve: contact searches start afresh (a cache, not state)."""
+        self.contact.begin_step()
+
+    def start_step(self, committed: State) -> State:
+        """The trial a new load step starts from."""
+        self.begin_step()
+        return State(committed.elements, self.contact.start_step(committed.contact), committed.stage,
+                     committed.step, committed.lam)
+
+    def augment(self, trial: State) -> State | None:
+        """One Uzawa update of the augmented-Lagrangian pairs: the new trial, or None when none is needed."""
+        c = self.contact.augment(trial.contact)
+        return None if c is None else State(trial.elements, c, trial.stage, trial.step, trial.lam)
+
     # evaluation -------------------------------------------------------------------------------
-    def evaluate(self, u: np.ndarray, lam: float, want_K: bool = True, timing: dict | None = None):
-        """Residual R = f_int + f_contact - lam f_ext and its tangent (CSR or None)."""
+    def evaluate(self, u: np.ndarray, lam: float, committed: State, guess: State | None = None,
+                 want_K: bool = True, timing: dict | None = None):
+        """Residual R = f_int + f_contact - lam f_ext, its tangent (CSR or None) and the trial state.
+
+        ``committed`` gives the history, ``guess`` (default ``committed``) the starting point of the local
+        iterations (EAS parameters, contact points, Uzawa multipliers). Neither is changed.
+        """
+        guess = committed if guess is None else guess
         t0 = time.perf_counter()
-        r, K = self.system.internal(u, want_K=want_K)
+        ev, ctrial = self.contact.evaluate(self.positions(u), lam, committed.contact, guess.contact, want_K)
+        pattern, triples = self.coupling.covering(ev.blocks) if want_K else (None, [])
         t1 = time.perf_counter()
-        rc, Kc = self.contact.evaluate(self.positions(u), lam, want_K)
+        r, K, etrial = self.system.internal(u, guess.elements, want_K, pattern)
         t2 = time.perf_counter()
+        r += ev.blocks.residual()
+        if want_K:
+            CouplingPattern.scatter(K.data, pattern, triples)
+        t3 = time.perf_counter()
         if timing is not None:
-            timing["assembly"] += t1 - t0
-            timing["contact"] += t2 - t1
-        if rc is not None:
-            r += rc
-        if Kc is not None and K is not None:
-            K = (K + Kc).tocsr()
-        return r - lam * self.f_ext, K
+            timing["assembly"] += t2 - t1
+            timing["contact"] += (t1 - t0) + (t3 - t2)
+        return r - lam * self.f_ext, K, State(etrial, ctrial, committed.stage, committed.step, lam)
 
-    def begin_step(self, u: np.ndarray, lam: float) -> None:
-        self.contact.begin_step(self.positions(u), lam)
+    # queries on a state -----------------------------------------------------------------------
+    def active_count(self, state: State) -> int:
+        return self.contact.active_count(state.contact)
 
-    def save_state(self) -> None:
-        self.system.save_state()
-        self.contact.save_state()
-
-    def restore_state(self) -> None:
-        self.system.restore_state()
-        self.contact.restore_state()
-
-    def commit(self) -> None:
-        self.system.commit()
-        self.contact.commit()
-
-    def active_count(self) -> int:
-        return self.contact.active_count()
-
-    def active_set_settled(self) -> bool:
-        return True
-
-    def augment(self) -> bool:
-        """One Uzawa update of the augmented-Lagrangian pairs; True when another Newton solve is needed."""
-        return bool(getattr(self.contact, "augment", lambda: False)())
+    def step_report(self, u: np.ndarray, lam: float, state: State) -> dict:
+        return self.contact.step_report(self.positions(u), lam, state.contact) if self.contact.passes else {}

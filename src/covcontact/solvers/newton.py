@@ -52,18 +52,24 @@ class StepOutcome:
 
 
 class Newton:
-    """Newton solver over a ``Model`` (``covcontact.solvers.model``)."""
+    """Newton solver over a ``Model`` (``covcontact.solvers.model``).
+
+    State (docs/theory.md section 10): a step starts from the committed state and
+    threads the trial of each evaluation into the next as its starting point; the trial of the converged
+    iterate is what :meth:`advance` returns as the new committed state. A cutback drops the trial.
+    """
 
     def __init__(self, model, options, linear: str | None = None):
         self.model = model
         self.opt = options
         self.linear = make_solver(linear or options.linear, symmetric=model.symmetric)
+        if hasattr(self.linear, "set_near_null_space") and hasattr(model, "near_null_space"):
+            self.linear.set_near_null_space(model.near_null_space())
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0}
 
     # ------------------------------------------------------------------------------------------
-    def _evaluate(self, u: np.ndarray, lam: float, want_K: bool = True):
-        R, K = self.model.evaluate(u, lam, want_K=want_K, timing=self.timing)
-        return R, K
+    def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
+        return self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=self.timing)
 
     def _solve(self, K, rhs):
         t0 = time.perf_counter()
@@ -79,9 +85,9 @@ class Newton:
             raise SingularMatrixError("linear solve returned non-finite values")
         return du
 
-    def _line_search(self, u, du, lam, R0):
+    def _line_search(self, u, du, lam, R0, committed, trial):
         s0 = float(du @ R0)
-        R1, _ = self._evaluate(u + du, lam, want_K=False)
+        R1, _, _ = self._evaluate(u + du, lam, committed, trial, want_K=False)
         s1 = float(du @ R1)
         if s0 == 0.0 or abs(s1) <= 0.8 * abs(s0):
             return 1.0
@@ -92,7 +98,7 @@ class Newton:
                 break
             eta = a1 - f1 * (a1 - a0) / (f1 - f0)
             eta = float(np.clip(eta, 0.1, 1.0))
-            Rt, _ = self._evaluate(u + eta * du, lam, want_K=False)
+            Rt, _, _ = self._evaluate(u + eta * du, lam, committed, trial, want_K=False)
             ft = float(du @ Rt)
             if abs(ft) <= 0.8 * abs(s0):
                 break
@@ -100,14 +106,18 @@ class Newton:
         return eta
 
     # ------------------------------------------------------------------------------------------
-    def step(self, u: np.ndarray, lam_a: float, lam_b: float) -> StepOutcome:
-        """Advance ``u`` in place from lam_a to lam_b; on failure ``u`` is left undefined."""
+    def step(self, u: np.ndarray, lam_a: float, lam_b: float, committed, trial=None):
+        """Advance ``u`` in place from lam_a to lam_b, starting from the state ``trial`` (default: the
+        committed one); returns (StepOutcome, the last trial). On failure ``u`` is left undefined."""
         m, opt = self.model, self.opt
         out = StepOutcome(converged=False)
         free = m.free
-        m.begin_step(u, lam_b)
+        if trial is None:
+            trial = m.start_step(committed)
+        else:
+            m.begin_step()
         du_d = m.prescribed(lam_b) - m.prescribed(lam_a)
-        R, K = self._evaluate(u, lam_b)
+        R, K, trial = self._evaluate(u, lam_b, committed, trial)
         t0 = time.perf_counter()
         rhs = -R - K @ du_d
         rhs[~free] = 0.0
@@ -116,23 +126,23 @@ class Newton:
         r0 = float(np.linalg.norm(rhs))
         scale = max(float(np.linalg.norm(lam_b * m.f_ext)), float(np.linalg.norm(R)), r0, 1e-300)
         out.residual_norms.append(r0)
-        out.records.append(IterationRecord(0, r0, 0.0, m.active_count()))
+        out.records.append(IterationRecord(0, r0, 0.0, m.active_count(trial)))
         if r0 <= opt.atol * scale and not np.any(du_d):
             out.converged = True
-            return out
+            return out, trial
         e0 = None
         for it in range(1, opt.max_iterations + 1):
             du = self._solve(K, rhs)
             du[~free] = du_d[~free] if it == 1 else 0.0
             eta = 1.0
             if opt.line_search and it > 1:
-                eta = self._line_search(u, du, lam_b, -rhs)
+                eta = self._line_search(u, du, lam_b, -rhs, committed, trial)
             energy = abs(float(du[free] @ rhs[free])) * eta
             if e0 is None:
                 e0 = max(energy, 1e-300)
             u += eta * du
             out.iterations = it
-            R, K = self._evaluate(u, lam_b)
+            R, K, trial = self._evaluate(u, lam_b, committed, trial)
             t0 = time.perf_counter()
             reactions = float(np.linalg.norm(R[~free]))
             rhs = -R
@@ -141,10 +151,10 @@ class Newton:
             self.timing["bc"] += time.perf_counter() - t0
             rn = float(np.linalg.norm(rhs))
             out.residual_norms.append(rn)
-            out.records.append(IterationRecord(it, rn, energy, m.active_count()))
+            out.records.append(IterationRecord(it, rn, energy, m.active_count(trial)))
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
-                return out
+                return out, trial
             if it == 1:
                 r_ref = max(r0, rn)
             scale_k = max(scale, reactions)
@@ -154,14 +164,23 @@ class Newton:
             floor = conv_energy and it >= 2 and rn >= 0.5 * out.residual_norms[-2]
             conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
             if conv or floor:
-                if m.active_set_settled():
-                    out.converged = True
-                    return out
+                out.converged = True
+                return out, trial
         out.reason = f"no convergence in {opt.max_iterations} iterations"
-        return out
+        return out, trial
 
-    def advance(self, u: np.ndarray, lam_a: float, lam_b: float):
-        """Reach lam_b from lam_a, cutting back on failure. Returns (ok, list of StepOutcome, cutbacks, why)."""
+    def _try(self, u, lam_a, lam_b, committed, trial):
+        try:
+            return self.step(u, lam_a, lam_b, committed, trial)
+        except (InvertedElementError, LinearSolverError) as exc:
+            return StepOutcome(converged=False, reason=str(exc)), None
+
+    def advance(self, u: np.ndarray, lam_a: float, lam_b: float, committed):
+        """Reach lam_b from lam_a from the committed state, cutting back on failure.
+
+        Returns (ok, list of StepOutcome, cutbacks, why, state): ``state`` is the new committed state (the
+        one given if nothing converged). ``u`` holds the displacement of that state.
+        """
         outcomes: list[StepOutcome] = []
         cutbacks = 0
         depth = 0
@@ -171,34 +190,25 @@ class Newton:
         while lam < lam_b - 1e-14 * max(1.0, abs(lam_b)):
             target = min(lam + inc, lam_b)
             saved = u.copy()
-            self.model.save_state()
-            try:
-                res = self.step(u, lam, target)
-            except (InvertedElementError, LinearSolverError) as exc:
-                res = StepOutcome(converged=False, reason=str(exc))
+            res, trial = self._try(u, lam, target, committed, None)
             outcomes.append(res)
+            augment = 0
+            # augmented Lagrangian: Uzawa updates at the converged state, each followed by Newton
+            while res.converged and (new := self.model.augment(trial)) is not None:
+                augment += 1
+                res, trial = self._try(u, target, target, committed, new)
+                res.augmentation = augment
+                outcomes.append(res)
             if res.converged:
-                # augmented Lagrangian: Uzawa updates at the converged state, each followed by Newton
-                augment = 0
-                while res.converged and self.model.augment():
-                    augment += 1
-                    try:
-                        res = self.step(u, target, target)
-                    except (InvertedElementError, LinearSolverError) as exc:
-                        res = StepOutcome(converged=False, reason=str(exc))
-                    res.augmentation = augment
-                    outcomes.append(res)
-            if res.converged:
-                self.model.commit()
+                committed = trial
                 lam = target
                 depth = max(depth - 1, 0)
                 continue
-            u[:] = saved
-            self.model.restore_state()
+            u[:] = saved  # the trial is dropped
             why = res.reason
             depth += 1
             cutbacks += 1
             if depth > self.opt.max_cutbacks:
-                return False, outcomes, cutbacks, why
+                return False, outcomes, cutbacks, why, committed
             inc = (target - lam) / 2.0
-        return True, outcomes, cutbacks, why
+        return True, outcomes, cutbacks, why, committed

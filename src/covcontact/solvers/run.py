@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 import traceback
@@ -10,24 +11,28 @@ from pathlib import Path
 
 import numpy as np
 
-from ..io.output import ResultWriter
+from ..io import checkpoint
+from ..io.output import ResultWriter, _jsonable
 from .model import Model
 from .newton import Newton
+from .signals import Interrupted, StopSignals
+from .state import State
 
 
 @dataclass
 class Result:
-    """What a run produced: the summary dict, the final displacement and the exit code (0 or 1)."""
+    """What a run produced: the summary dict, the final displacement and the exit code (0, 1, 130, 143)."""
 
     summary: dict
     u: np.ndarray
     out: Path
     exit_code: int
     model: Model = field(repr=False, default=None)
+    state: State = field(repr=False, default=None)  # the committed state of the last converged step
 
 
-def _reactions(model: Model, u: np.ndarray, lam: float) -> dict:
-    R, _ = model.evaluate(u, lam, want_K=False)
+def _reactions(model: Model, u: np.ndarray, lam: float, state) -> dict:
+    R, _, _ = model.evaluate(u, lam, state, want_K=False)
     out = {}
     for bc in model.problem.dirichlet:
         nodes = model.system.global_nodes(bc.body, bc.set)
@@ -38,25 +43,23 @@ def _reactions(model: Model, u: np.ndarray, lam: float) -> dict:
     return out
 
 
-def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, step: int) -> None:
+def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, step: int, state) -> None:
     sysm = model.system
     U = u.reshape(-1, 3)
     n = sysm.n_nodes
     cauchy = np.zeros((n, 6))
     blocks = []
-    for blk, body in zip(sysm.blocks, model.problem.bodies):
+    for blk, body, est in zip(sysm.blocks, model.problem.bodies, state.elements):
         sl = slice(blk.offset, blk.offset + blk.n_nodes)
-        st = blk.solid.stress(U[sl])
+        st = blk.solid.stress(U[sl], est)
         cauchy[sl] = st.cauchy_nodal
         cd = st.cell_data()
         cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
         blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
     points = sysm.X.copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
-    extra_pts, extra_blocks, extra_pdata = model.contact.visual(lam) if hasattr(model.contact, "visual") \
-        else (None, [], {})
-    cpd = model.contact.point_data(n)
-    pdata.update(cpd)
+    extra_pts, extra_blocks, extra_pdata = model.contact.visual(lam, state.contact)
+    pdata.update(model.contact.point_data(n, state.contact) if model.contact.passes else {})
     if extra_pts is not None and len(extra_pts):
         m = len(extra_pts)
         points = np.vstack([points, extra_pts])
@@ -72,6 +75,11 @@ def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, st
 class _NoWriter:
     """The writer of the ranks other than 0 in a distributed run: writes nothing."""
 
+    pvd_entries: list = []
+
+    def restore(self, *args, **kwargs) -> None:
+        pass
+
     def write_vtu(self, *args, **kwargs) -> None:
         pass
 
@@ -82,7 +90,7 @@ class _NoWriter:
         pass
 
 
-def _make_model(problem, tangent: str, linear: str | None) -> Model:
+def _make_model(problem, tangent: str | None, linear: str | None) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
     from .linear import REGISTRY, backend_class
 
@@ -94,39 +102,52 @@ def _make_model(problem, tangent: str, linear: str | None) -> Model:
     return Model(problem, tangent=tangent)
 
 
-def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None) -> Result:
+def _tangent_name(problem, tangent: str | None) -> str:
+    """The tangent case of the run: the override, else the pairs' common case (or "per-pair")."""
+    if tangent:
+        return tangent
+    cases = {c.tangent for c in problem.contacts}
+    return cases.pop() if len(cases) == 1 else ("a" if not cases else "per-pair")
+
+
+def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resume=False) -> Result:
     """Solve ``problem`` and write its results; see ``Problem.run``.
 
     With a distributing backend (``petsc``, ``petsc-gamg``) every MPI rank runs this function; only
     rank 0 writes files and prints.
     """
     t_start = time.perf_counter()
-    tangent = tangent or (problem.contacts[0].tangent if problem.contacts else "a")
     out = Path(out) if out is not None else Path("results") / problem.name
     model = _make_model(problem, tangent, linear)
     if getattr(model, "size", 1) > 1:
         try:
-            return _run(problem, model, out, tangent, quiet, linear, t_start)
+            return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
         except Exception:  # noqa: BLE001  (maybe on one rank only: the others would wait forever)
             traceback.print_exc()
             sys.stderr.flush()
             model.comm.Abort(3)
-    return _run(problem, model, out, tangent, quiet, linear, t_start)
+    return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
 
 
-def _run(problem, model, out: Path, tangent: str, quiet: bool, linear, t_start: float) -> Result:
+def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_start: float,
+         resume: bool) -> Result:
     newton = Newton(model, problem.solver, linear=linear)
     root = getattr(model, "is_root", True)
+    rank, size = getattr(model, "rank", 0), getattr(model, "size", 1)
     writer = ResultWriter(out) if root else _NoWriter()
+    case = _tangent_name(problem, tangent)
+    problem_hash = checkpoint.fingerprint(problem) + ":" + case
 
     def say(msg: str) -> None:
         if root:
             print(msg, file=sys.stderr, flush=True)
     u = model.prescribed(0.0)
+    state = model.initial_state()
     summary = {
         "problem": problem.name,
+        "status": "running",
         "converged": False,
-        "tangent": tangent,
+        "tangent": case,
         "dofs": model.n_dofs,
         "free_dofs": int(model.free.sum()),
         "linear_solver": newton.linear.name,
@@ -137,79 +158,107 @@ def _run(problem, model, out: Path, tangent: str, quiet: bool, linear, t_start: 
     if hasattr(model, "partition_report"):
         summary["parallel"] = model.partition_report()
     t_out = 0.0
-    if problem.output.vtu:
+    t_before = 0.0  # wall time of the runs before a resume
+    if resume:
+        u, arrays, meta = checkpoint.load(out, problem_hash, rank, size)
+        try:
+            state = State.from_arrays(arrays, like=state)
+        except (KeyError, ValueError) as exc:
+            raise checkpoint.CheckpointError(f"{checkpoint.path_for(out, rank, size)}: does not match the "
+                                             f"problem ({exc})") from None
+        summary = meta["summary"]
+        t_before = float(meta.get("wall_time_s", 0.0))
+        writer.restore(meta["pvd"], state.step)
+        say(f"resuming {problem.name} after step {state.step} (load factor {state.lam:.4g})")
+    elif problem.output.vtu:
         t0 = time.perf_counter()
-        _write_vtu(writer, model, u, 0.0, 0)
+        _write_vtu(writer, model, u, 0.0, 0, state)
         t_out += time.perf_counter() - t0
-    lam_prev = 0.0
-    ok = True
     nsteps = len(problem.steps.factors)
-    for k, lam in enumerate(problem.steps.factors, start=1):
-        success, outcomes, cutbacks, why = newton.advance(u, lam_prev, lam)
-        conv = [o for o in outcomes if o.converged]
-        iters = sum(o.iterations for o in outcomes)
-        entry = {
-            "step": k,
-            "load_factor": lam,
-            "converged": success,
-            "iterations": iters,
-            "residual_norms": [r / max(o.residual_norms[0], 1e-300) for o in conv[-1:] for r in o.residual_norms]
-            if conv else [],
-            "cutbacks": cutbacks,
-        }
-        aug = max((o.augmentation for o in outcomes), default=0)
-        if aug or any(getattr(c, "method", "penalty") == "augmented" for c in problem.contacts):
-            entry["uzawa_iterations"] = sum(1 for o in outcomes if o.augmentation > 0)
-        if cutbacks:
-            entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
-        if success:
-            entry.update(model.contact.step_report(model.positions(u), lam))
-            entry["reactions"] = _reactions(model, u, lam)
-        else:
-            entry["failure"] = why
-        summary["steps"].append(entry)
-        summary["total_iterations"] += iters
-        writer.add_iterations(k, [r for o in outcomes for r in o.records])
-        if not quiet:
-            rn = conv[-1].residual_norms[-1] if conv else float("nan")
-            msg = (f"step {k:4d}/{nsteps}  lambda {lam:.4g}  iterations {iters:3d}  residual {rn:.2e}"
-                   f"  active {model.active_count():5d}" + (f"  cutbacks {cutbacks}" if cutbacks else ""))
-            if not success:
-                msg += f"  FAILED: {why}"
-            say(msg)
-        if not success:
-            ok = False
-            break
-        lam_prev = lam
-        if problem.output.vtu and (k % problem.output.every == 0 or k == nsteps):
-            t0 = time.perf_counter()
-            _write_vtu(writer, model, u, lam, k)
-            t_out += time.perf_counter() - t0
-        summary["wall_time_s"] = time.perf_counter() - t_start
-        writer.write_summary(summary)
-    summary["converged"] = ok
+    status = "completed"
+    code = 0
+    with StopSignals(enabled=size == 1) as stops:
+        try:
+            for k in range(state.step + 1, nsteps + 1):
+                lam = problem.steps.factors[k - 1]
+                success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
+                conv = [o for o in outcomes if o.converged]
+                iters = sum(o.iterations for o in outcomes)
+                entry = {
+                    "step": k,
+                    "load_factor": lam,
+                    "converged": success,
+                    "iterations": iters,
+                    "residual_norms": [r / max(o.residual_norms[0], 1e-300) for o in conv[-1:]
+                                       for r in o.residual_norms] if conv else [],
+                    "cutbacks": cutbacks,
+                }
+                if any(c.method == "augmented" for c in problem.contacts):
+                    entry["uzawa_iterations"] = sum(1 for o in outcomes if o.augmentation > 0)
+                if cutbacks:
+                    entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
+                if success:
+                    state = new
+                    state.step = k
+                    entry.update(model.step_report(u, lam, state))
+                    entry["reactions"] = _reactions(model, u, lam, state)
+                else:
+                    entry["failure"] = why
+                with stops.critical():
+                    summary["steps"].append(entry)
+                    summary["total_iterations"] += iters
+                    writer.add_iterations(k, [r for o in outcomes for r in o.records])
+                    if not quiet:
+                        rn = conv[-1].residual_norms[-1] if conv else float("nan")
+                        msg = (f"step {k:4d}/{nsteps}  lambda {lam:.4g}  iterations {iters:3d}  residual {rn:.2e}"
+                               f"  active {model.active_count(state):5d}"
+                               + (f"  cutbacks {cutbacks}" if cutbacks else ""))
+                        say(msg + (f"  FAILED: {why}" if not success else ""))
+                    if not success:
+                        status, code = "failed", 1
+                        break
+                    if problem.output.vtu and (k % problem.output.every == 0 or k == nsteps):
+                        t0 = time.perf_counter()
+                        _write_vtu(writer, model, u, lam, k, state)
+                        t_out += time.perf_counter() - t0
+                    summary["wall_time_s"] = t_before + time.perf_counter() - t_start
+                    writer.write_summary(summary)
+                    if k % problem.output.checkpoint_every == 0 or k == nsteps:
+                        checkpoint.save(out, u, state.arrays(),
+                                        {"problem_hash": problem_hash, "summary": json.loads(
+                                            json.dumps(summary, default=_jsonable)),
+                                         "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"]},
+                                        rank, size)
+        except Interrupted as stop:
+            status, code = "interrupted", stop.exit_code
+            say(f"{stop}: the step in flight is dropped; resume with --resume")
+        with stops.critical():
+            _finish(problem, model, newton, summary, status, t_before, t_start, t_out, writer, root, quiet, say, out)
+    return Result(summary=summary, u=u, out=out, exit_code=code, model=model, state=state)
+
+
+def _finish(problem, model, newton, summary, status, t_before, t_start, t_out, writer, root, quiet, say, out):
+    summary["status"] = status
+    summary["converged"] = status == "completed"
     if "parallel" in summary:
         lin = newton.linear
         summary["parallel"]["linear"] = {"analyses": lin.n_analyses, "factorizations": lin.n_factorizations,
                                          "krylov_iterations": getattr(lin, "krylov_iterations", 0)}
     timing = dict(newton.timing)
-    split = getattr(model.contact, "timing", None)
-    if split:
-        timing["contact_search"] = split["search"]
-        timing["contact_projection"] = split["projection"]
-        timing["contact_assembly"] = max(timing["contact"] - split["search"] - split["projection"], 0.0)
+    split = model.contact.timing
+    timing["contact_search"] = split["search"]
+    timing["contact_projection"] = split["projection"]
+    timing["contact_assembly"] = max(timing["contact"] - split["search"] - split["projection"], 0.0)
     timing["output"] = t_out
     timing["total"] = time.perf_counter() - t_start
     summary["timing"] = {k: round(v, 4) for k, v in timing.items()}
-    summary["wall_time_s"] = timing["total"]
+    summary["wall_time_s"] = t_before + timing["total"]
     writer.write_summary(summary)
-    if problem.output.pictures and problem.output.vtu and root:
+    if status == "completed" and problem.output.pictures and problem.output.vtu and root:
         from ..io.pictures import render_pictures
 
         for path in render_pictures(out):
             if not quiet:
                 say(f"picture {path}")
     if not quiet:
-        split = "  ".join(f"{k} {v:.2f}s" for k, v in summary["timing"].items())
-        say(f"time: {split}")
-    return Result(summary=summary, u=u, out=out, exit_code=0 if ok else 1, model=model)
+        say("time: " + "  ".join(f"{k} {v:.2f}s" for k, v in summary["timing"].items()))

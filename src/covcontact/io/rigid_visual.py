@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .analytic import CYLINDER, PLANE
+from ..contact.analytic import CYLINDER, PLANE
+from ..contact.setup import analytic_surface
 
 
 def _grid_quads(nu: int, nv: int, closed_u: bool) -> np.ndarray:
@@ -50,8 +51,11 @@ def tessellate(surface, lam: float, center: np.ndarray, size: float) -> tuple[np
     return origin + R * d, _grid_quads(48, 24, True)
 
 
-def rigid_visual(manager, lam: float):
-    """(points, blocks, point_data) of all rigid bodies, numbered from 0 (the caller shifts them)."""
+def rigid_visual(manager, lam: float, fields) -> tuple:
+    """(points, blocks, point_data) of all rigid bodies, numbered from 0 (the caller shifts them).
+
+    ``fields``: (gap, pressure, status) over the extended node numbering of ``manager``.
+    """
     pts: list[np.ndarray] = []
     blocks = []
     n = 0
@@ -59,13 +63,13 @@ def rigid_visual(manager, lam: float):
     lo, hi = X.min(axis=0), X.max(axis=0)
     center, size = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo)) or 1.0
     disp = []
-    gap, pressure, status = manager._node_fields(manager.n_ext)
+    gap, pressure, status = fields
     gaps, press, stats = [], [], []
     body_id = len(manager.problem.bodies)
     for rb in manager.problem.rigid:
         if rb.mesh is not None:
             p = rb.motion.apply(rb.mesh.points, lam)
-            off = manager.rigid_offset[rb.name]
+            off = manager.num.rigid_offset[rb.name]
             sl = slice(off, off + rb.mesh.n_nodes)
             gaps.append(gap[sl])
             press.append(pressure[sl])
@@ -75,9 +79,7 @@ def rigid_visual(manager, lam: float):
             disp.append(p - rb.mesh.points)
             p = rb.mesh.points
         else:
-            from .manager import _analytic_surface
-
-            p, quads = tessellate(_analytic_surface(rb), 0.0, center, size)
+            p, quads = tessellate(analytic_surface(rb), 0.0, center, size)
             m = len(p)
             gaps.append(np.full(m, np.nan))
             press.append(np.zeros(m))

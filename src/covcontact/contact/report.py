@@ -1,0 +1,91 @@
+"""Reports on a contact state: per-step summaries, per-node output fields, the rigid bodies' pictures.
+
+Everything here reads a state and evaluates (for the contribution norms of the tangent parts) without
+changing it. What looks at all slaves goes through ``manager.gather`` and ``manager.global_norms``, which a
+distributed run reduces over the ranks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .element import CASE_A
+from .friction import SLIP, STICK
+from .state import ContactState
+
+
+def frobenius_norms(mats: list[sp.csr_matrix]) -> list[float]:
+    return [float(sp.linalg.norm(M)) if M.nnz else 0.0 for M in mats]
+
+
+def _pass_rows(manager, state: ContactState) -> list[tuple]:
+    rows = []
+    for k, p in enumerate(manager.passes):
+        s = state.passes[k]
+        act = manager.active_mask(k, state)
+        gmin = float(s.gap.min()) if len(s.gap) and np.isfinite(s.gap.min()) else np.inf
+        rows.append((int(act.sum()), int(np.count_nonzero(act & (s.status == STICK))),
+                     int(np.count_nonzero(act & (s.status == SLIP))), gmin, s.force[act].sum(axis=0),
+                     float(np.max(-s.gap[act], initial=0.0)), s.n_aug))
+    return rows
+
+
+def step_report(manager, x: np.ndarray, lam: float, state: ContactState) -> dict:
+    """Per pair: active contacts, minimum gap, force resultant; the contribution norms of the parts."""
+    ev, _ = manager.evaluate(x, lam, state, want_K=True, case=CASE_A, want_parts=True)
+    main, rot, curv, _ = [b.csr() for b in ev.parts]
+    nf, nr, nc = manager.global_norms([main + rot + curv, rot, curv])
+    contrib = {"rotational": nr / nf * 100 if nf > 0 else 0.0, "curvature": nc / nf * 100 if nf > 0 else 0.0}
+    every = manager.gather(_pass_rows(manager, state))
+    pairs = {}
+    for k, p in enumerate(manager.passes):
+        rows = [e[k] for e in every]
+        gmin = min(r[3] for r in rows)
+        entry = {"active_contacts": sum(r[0] for r in rows)}
+        if p.mu > 0:
+            entry.update(stick=sum(r[1] for r in rows), slip=sum(r[2] for r in rows))
+        entry["min_gap"] = float(gmin) if np.isfinite(gmin) else None
+        entry["contact_force"] = np.sum([r[4] for r in rows], axis=0).tolist()
+        if p.augmented:
+            entry.update(augmentations=rows[0][6], max_penetration=max(r[5] for r in rows))
+        pairs[p.name] = entry
+    total_force = np.sum([v["contact_force"] for v in pairs.values()], axis=0).tolist() if pairs else [0.0] * 3
+    gaps = [v["min_gap"] for v in pairs.values() if v["min_gap"] is not None]
+    return {"active_contacts": sum(v["active_contacts"] for v in pairs.values()),
+            "min_gap": min(gaps) if gaps else None, "contact_force": total_force,
+            "contribution_percent": contrib, "pairs": pairs}
+
+
+def node_fields(manager, n: int, state: ContactState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gap, contact pressure (force over tributary area) and status (-1 not a slave, 0 inactive, 1 active)
+    of nodes 0..n-1 of the extended numbering, from the slaves of all ranks."""
+    gap = np.full(n, np.nan)
+    pressure = np.zeros(n)
+    status = np.full(n, -1.0)
+    mine = []
+    for k, p in enumerate(manager.passes):
+        s = state.passes[k]
+        fn = np.linalg.norm(s.force, axis=1) / np.maximum(p.area, 1e-300)
+        mine.append((p.slaves, s.gap, manager.active_mask(k, state), fn))
+    every = manager.gather(mine)
+    for k in range(len(manager.passes)):
+        sl, g, act, fn = (np.concatenate([e[k][j] for e in every]) for j in range(4))
+        sel = sl < n
+        gap[sl[sel]] = np.where(np.isfinite(g[sel]), g[sel], np.nan)
+        status[sl[sel]] = np.where(act[sel], 1.0, 0.0)
+        pressure[sl[sel]] = np.where(act[sel], fn[sel], 0.0)
+    return gap, pressure, status
+
+
+def point_data(manager, n_nodes: int, state: ContactState) -> dict:
+    """Gap, contact pressure and status per deformable node."""
+    gap, pressure, status = node_fields(manager, manager.num.n_ext, state)
+    return {"gap": gap[:n_nodes], "contact_pressure": pressure[:n_nodes], "contact_status": status[:n_nodes]}
+
+
+def visual(manager, lam: float, state: ContactState):
+    """Rigid bodies for the VTU files: points, cell blocks and point data of the appended points."""
+    from ..io.rigid_visual import rigid_visual
+
+    return rigid_visual(manager, lam, node_fields(manager, manager.num.n_ext, state))

@@ -1,0 +1,154 @@
+"""Contact passes of a problem: node numbering, penalties and the static data of each pass.
+
+Node numbering: the deformable nodes 0..N-1 of the global system come first, then the nodes of rigid meshed
+bodies (no unknowns; positions from their prescribed motion). A master facet or slave node of a rigid body
+contributes to the residual and tangent only through the deformable dofs of its pair.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .analytic import Cylinder, Plane, Sphere
+from .element import CASES
+from .surface import MeshSurface, facet_sizes, tributary_area
+
+
+@dataclass
+class Pass:
+    """One slave node set against one master surface (a pair, or one direction of a two-pass pair).
+
+    Static data only; what changes during a run lives in :class:`covcontact.contact.state.PassState`.
+    """
+
+    name: str
+    slaves: np.ndarray                 # node ids in the extended numbering
+    eps: np.ndarray                    # (ns,) weighted penalty per slave
+    area: np.ndarray                   # (ns,) tributary area per slave (for the pressure output)
+    eps_t: np.ndarray                  # (ns,) tangential penalty per slave
+    case: int = 0                      # tangent case code (element.CASES)
+    surface: MeshSurface | None = None
+    analytic: object = None
+    mu: float = 0.0                    # Coulomb coefficient (0: frictionless)
+    augmented: bool = False            # augmented Lagrangian (Uzawa) instead of pure penalty
+    gap_tol: float = 0.0               # largest accepted penetration of the augmented method
+    max_aug: int = 20
+    global_index: np.ndarray | None = None  # distributed runs: positions of these slaves in the whole pass
+
+    @property
+    def ns(self) -> int:
+        return len(self.slaves)
+
+
+def analytic_surface(rb):
+    """The analytic surface of a rigid body with ``shape`` plane, cylinder or sphere."""
+    p = rb.params
+    if rb.shape == "plane":
+        return Plane(point=p["point"], normal=p["normal"], motion=rb.motion)
+    if rb.shape == "cylinder":
+        return Cylinder(center=p["center"], axis=p["axis"], radius=p["radius"], outside=p["outside"],
+                        motion=rb.motion)
+    return Sphere(center=p["center"], radius=p["radius"], outside=p["outside"], motion=rb.motion)
+
+
+class Numbering:
+    """Deformable nodes of the system first, then the nodes of the rigid meshed bodies."""
+
+    def __init__(self, problem, system):
+        self.problem = problem
+        self.system = system
+        self.N = system.n_nodes
+        self.rigid_offset: dict[str, int] = {}
+        self.rigid_meshes = []
+        n = self.N
+        for rb in problem.rigid:
+            if rb.mesh is not None:
+                self.rigid_offset[rb.name] = n
+                self.rigid_meshes.append(rb)
+                n += rb.mesh.n_nodes
+        self.n_ext = n
+        self.X_rigid = (np.vstack([rb.mesh.points for rb in self.rigid_meshes]) if self.rigid_meshes
+                        else np.zeros((0, 3)))
+
+    def mesh_of(self, body: str):
+        for b in self.problem.bodies:
+            if b.name == body:
+                return b.mesh, self.system.offset(body)
+        for rb in self.rigid_meshes:
+            if rb.name == body:
+                return rb.mesh, self.rigid_offset[body]
+        return None, None
+
+    def reference(self) -> np.ndarray:
+        return np.vstack([self.system.X, self.X_rigid])
+
+    def rigid_positions(self, lam: float) -> np.ndarray:
+        parts = [rb.motion.apply(rb.mesh.points, lam) for rb in self.rigid_meshes]
+        return np.vstack(parts) if parts else np.zeros((0, 3))
+
+    def material_E(self, body: str) -> float | None:
+        for b in self.problem.bodies:
+            if b.name == body:
+                return float(b.material.params[0])
+        return None
+
+
+def _auto_penalty(num: Numbering, pair, slave, master) -> float:
+    """eps_N per unit area: auto_factor * E / h of the master body (the slave body's if rigid)."""
+    X = num.reference()
+    for body, sset in (master, slave):
+        E = num.material_E(body)
+        mesh, off = num.mesh_of(body)
+        if E is None or mesh is None or sset not in mesh.face_sets:
+            continue
+        h = float(np.mean(facet_sizes(X, mesh.face_sets[sset] + off))) / np.sqrt(2.0)
+        return pair.auto_factor * E / h
+    raise ValueError(f"contact {pair.name}: penalty = \"auto\" needs a deformable body with a face set "
+                     f"named like its contact set")
+
+
+def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None) -> Pass:
+    """The pass of ``slave`` against ``master`` of ``pair``; ``tangent`` overrides the pair's case."""
+    smesh, soff = num.mesh_of(slave[0])
+    slaves = smesh.node_sets[slave[1]] + soff
+    X = num.reference()
+    if slave[1] in smesh.face_sets:
+        area = tributary_area(X, smesh.face_sets[slave[1]] + soff)[slaves]
+    else:
+        area = np.ones(len(slaves))
+    penalty = _auto_penalty(num, pair, slave, master) if pair.penalty == "auto" else pair.penalty
+    if pair.weighting == "area" or pair.penalty == "auto":
+        if slave[1] not in smesh.face_sets:
+            raise ValueError(f"contact {pair.name}: area weighting needs a face set named {slave[1]!r}")
+        eps = penalty * area
+    else:
+        eps = np.full(len(slaves), float(penalty))
+    ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
+    kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
+          "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations}
+    mmesh, moff = num.mesh_of(master[0])
+    if mmesh is None:
+        rb = next(r for r in num.problem.rigid if r.name == master[0])
+        h = float(np.mean(facet_sizes(X, smesh.face_sets[slave[1]] + soff))) if slave[1] in smesh.face_sets \
+            else 1.0
+        p = Pass(name, slaves, eps, area, analytic=analytic_surface(rb), **kw)
+    else:
+        faces = mmesh.face_sets[master[1]] + moff
+        h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)
+        p = Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=num.n_ext), **kw)
+    if p.augmented:
+        p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
+    return p
+
+
+def make_passes(num: Numbering, problem, tangent: str | None = None) -> list[Pass]:
+    """Every pass of the problem's contact pairs (two per two-pass pair)."""
+    out = []
+    for pair in problem.contacts:
+        out.append(make_pass(num, pair.name, pair.slave, pair.master, pair, tangent))
+        if pair.two_pass:
+            out.append(make_pass(num, pair.name + "/reverse", tuple(pair.master), tuple(pair.slave), pair,
+                                 tangent))
+    return out

@@ -1,0 +1,193 @@
+"""Checkpoints, --resume and signals, through the command line in subprocesses.
+
+A run stopped by SIGTERM half-way and resumed must give what a run that was never stopped gives: the same
+Newton iterations in every step and the same final displacements (1e-10 relative); with friction and a
+rigid path (ironing), the augmented Lagrangian and solid-shells. Checkpoints of another or a changed
+problem, damaged or missing ones are refused with exit code 2 and one line.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+
+def _variant(src: str, tmp: Path, name: str, subs: list[tuple[str, str]]) -> Path:
+    text = (EXAMPLES / src).read_text()
+    for pat, rep in subs:
+        text, n = re.subn(pat, rep, text, count=1, flags=re.S)
+        assert n == 1, f"{src}: pattern {pat!r} not found"
+    path = tmp / f"{name}.toml"
+    path.write_text(text)
+    return path
+
+
+def _steps(n: int, final: float = 1.0) -> str:
+    return "[steps]\nfactors = [" + ", ".join(f"{final * (k + 1) / n:.10g}" for k in range(n)) + "]\n"
+
+
+def ironing(tmp: Path) -> Path:
+    """The ironing set-up on a coarse slab: press to 0.2, slide to 0.6 (friction, rigid path)."""
+    press = [0.2 * (k + 1) / 4 for k in range(4)]
+    slide = [0.2 + 0.4 * (k + 1) / 12 for k in range(12)]
+    factors = ", ".join(f"{f:.10g}" for f in press + slide)
+    return _variant("verification/ironing.toml", tmp, "ironing", [
+        (r"nx = 18, ny = 2, nz = 6", "nx = 9, ny = 1, nz = 3"),
+        (r"\[steps\]\nfactors = \[[^\]]*\]", f"[steps]\nfactors = [{factors}]")])
+
+
+def augmented(tmp: Path) -> Path:
+    return _variant("contact/block_on_plane_augmented.toml", tmp, "augmented",
+                    [(r"\[steps\][^\[]*", _steps(12) + "\n")])
+
+
+def shells(tmp: Path) -> Path:
+    """The paper's shell over the rigid sphere (solid-shells), the first 16 of its 100 load steps."""
+    return _variant("paper/sphere_q4.toml", tmp, "shells", [(r"\[steps\][^\[]*", _steps(16, 0.16) + "\n"),
+                                                             (r"every = 10\npictures = true", "vtu = false")])
+
+
+def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+
+
+def _run_and_stop(problem: Path, out: Path, after: int, sig=signal.SIGTERM):
+    """Start a run, send ``sig`` once ``after`` steps are in summary.json; (exit code, stderr)."""
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    summary = out / "summary.json"
+    t0 = time.monotonic()
+    while proc.poll() is None and time.monotonic() - t0 < 600:
+        try:
+            if len(json.loads(summary.read_text())["steps"]) >= after:
+                break
+        except (OSError, ValueError):
+            pass
+        time.sleep(0.01)
+    assert proc.poll() is None, "the run ended before it could be stopped"
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=600)
+    return proc.returncode, err
+
+
+def _final_u(out: Path) -> np.ndarray:
+    with np.load(out / "checkpoint.npz") as data:
+        return data["u"]
+
+
+def _summary(out: Path) -> dict:
+    return json.loads((out / "summary.json").read_text())
+
+
+@pytest.mark.parametrize("make", [ironing, augmented, shells], ids=["ironing", "augmented", "solid-shells"])
+def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
+    problem = make(tmp_path)
+    ref = _run(problem, tmp_path / "ref")
+    assert ref.returncode == 0, ref.stderr
+    n = len(_summary(tmp_path / "ref")["steps"])
+    out = tmp_path / "stopped"
+    code, err = _run_and_stop(problem, out, after=n // 3)
+    assert code == 143, err
+    assert "Traceback" not in err
+    stopped = _summary(out)
+    assert stopped["status"] == "interrupted"
+    assert 1 <= len(stopped["steps"]) < n
+    res = _run(problem, out, "--resume")
+    assert res.returncode == 0, res.stderr
+    a, b = _summary(tmp_path / "ref"), _summary(out)
+    assert b["status"] == "completed"
+    assert [s["step"] for s in b["steps"]] == list(range(1, n + 1))
+    assert [s["iterations"] for s in b["steps"]] == [s["iterations"] for s in a["steps"]]
+    assert b["total_iterations"] == a["total_iterations"]
+    if "uzawa_iterations" in a["steps"][0]:
+        assert [s["uzawa_iterations"] for s in b["steps"]] == [s["uzawa_iterations"] for s in a["steps"]]
+    ua, ub = _final_u(tmp_path / "ref"), _final_u(out)
+    assert np.linalg.norm(ub - ua) <= 1e-10 * np.linalg.norm(ua)
+    rows = (out / "convergence.csv").read_text().splitlines()
+    ref_rows = (tmp_path / "ref" / "convergence.csv").read_text().splitlines()
+    assert [r.split(",")[:2] for r in rows] == [r.split(",")[:2] for r in ref_rows]
+
+
+def test_sigint_exit_code_and_status(tmp_path):
+    problem = ironing(tmp_path)
+    _run(problem, tmp_path / "warm")  # compiled kernels cached: the stop comes during the steps
+    out = tmp_path / "int"
+    code, err = _run_and_stop(problem, out, after=2, sig=signal.SIGINT)
+    assert code == 130, err
+    assert "Traceback" not in err
+    s = _summary(out)
+    assert s["status"] == "interrupted" and s["converged"] is False
+    # every file on disk is valid: the summary parsed above, the checkpoint loads, the CSV is complete
+    with np.load(out / "checkpoint.npz") as data:
+        assert np.all(np.isfinite(data["u"]))
+    for row in (out / "convergence.csv").read_text().splitlines()[1:]:
+        assert len(row.split(",")) == 5
+
+
+def _one_error_line(res: subprocess.CompletedProcess, *words: str) -> None:
+    assert res.returncode == 2, res.stderr
+    lines = [ln for ln in res.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1, res.stderr
+    assert "Traceback" not in res.stderr
+    for w in words:
+        assert w in lines[0], lines[0]
+
+
+def test_refused_checkpoints(tmp_path):
+    problem = augmented(tmp_path)
+    out = tmp_path / "out"
+    assert _run(problem, out, "--quiet").returncode == 0
+    # no checkpoint at all
+    _one_error_line(_run(problem, tmp_path / "empty", "--resume", "--quiet"), "no checkpoint")
+    # a changed problem (another penalty)
+    changed = tmp_path / "changed.toml"
+    text = problem.read_text()
+    changed.write_text(re.sub(r"penalty = [^\n]+", "penalty = 123.0", text, count=1))
+    assert changed.read_text() != text
+    _one_error_line(_run(changed, out, "--resume", "--quiet"), "another problem")
+    # another tangent case than the one the checkpoint was written with
+    _one_error_line(_run(problem, out, "--resume", "--quiet", "--tangent", "d"), "another problem")
+    # a damaged checkpoint
+    ck = out / "checkpoint.npz"
+    ck.write_bytes(ck.read_bytes()[: os.path.getsize(ck) // 2])
+    _one_error_line(_run(problem, out, "--resume", "--quiet"), "damaged")
+
+
+def test_resume_of_a_completed_run_changes_nothing(tmp_path):
+    problem = augmented(tmp_path)
+    out = tmp_path / "out"
+    assert _run(problem, out, "--quiet").returncode == 0
+    before = _summary(out)
+    res = _run(problem, out, "--resume", "--quiet")
+    assert res.returncode == 0, res.stderr
+    after = _summary(out)
+    assert after["status"] == "completed"
+    assert [s["iterations"] for s in after["steps"]] == [s["iterations"] for s in before["steps"]]
+
+
+def test_checkpoint_every(tmp_path):
+    problem = augmented(tmp_path)
+    text = problem.read_text()
+    assert "[output]" not in text
+    problem.write_text(text + "\n[output]\ncheckpoint_every = 5\n")
+    out = tmp_path / "out"
+    code, _ = _run_and_stop(problem, out, after=7)
+    assert code == 143
+    with np.load(out / "checkpoint.npz") as data:
+        assert int(data["step.step"]) % 5 == 0
+    res = _run(problem, out, "--resume", "--quiet")
+    assert res.returncode == 0, res.stderr
+    assert [s["step"] for s in _summary(out)["steps"]] == list(range(1, 13))
