@@ -68,7 +68,7 @@ def cmd_run(args) -> int:
     _check_solver(args.solver or problem.solver.linear)
     result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver,
                          resume=args.resume)
-    if not args.quiet and getattr(result.model, "is_root", True):  # one line from a distributed run
+    if not args.quiet and result.model.is_root:  # one line from a distributed run
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code
 

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .contact.rigid import RigidMotion
+from .motion import RigidMotion
 from .mesh import Mesh
 
 COMPONENTS = {"x": 0, "y": 1, "z": 2}

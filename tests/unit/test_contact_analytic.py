@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from covcontact.contact import CASES, Cylinder, Plane, RigidMotion, Sphere
-from covcontact.contact.rigid import rotation_matrix
+from covcontact.motion import rotation_matrix
 
 EPS_N = 3.0
 MOTION = RigidMotion(translation=(0.1, 0.2, -0.3), rotation=(0.2, -0.4, 0.3), center=(1.0, 0.0, 0.0))

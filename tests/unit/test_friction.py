@@ -25,7 +25,7 @@ from covcontact.contact.friction import (
 )
 from covcontact.contact.geometry import facet_geometry
 from covcontact.contact.projection import project_on_facet
-from covcontact.contact.rigid import rotation_matrix
+from covcontact.motion import rotation_matrix
 from covcontact.fem.shapes import NODES
 
 EPS_N = 7.0

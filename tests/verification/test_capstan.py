@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from covcontact.contact.rigid import RigidMotion
+from covcontact.motion import RigidMotion
 from covcontact.elements.solidshell import check_options
 from covcontact.io.loader import load_problem
 from covcontact.materials import SaintVenantKirchhoff

@@ -45,7 +45,9 @@ def interface_errors(prob, res) -> dict:
     """Relative error of the nodal interface pressure on each surface: the z contact force of every node
     (its own pass as slave plus what it receives as master) over its reference tributary area."""
     model = res.model
-    rc, _ = model.contact.evaluate(model.positions(res.u), prob.steps.factors[-1], want_K=False)
+    ev, _ = model.contact.evaluate(model.positions(res.u), prob.steps.factors[-1], res.state.contact,
+                                   want_K=False)
+    rc = ev.blocks.residual()
     rc = rc.reshape(-1, 3)
     out = {}
     for body, fset in SURFACES:
@@ -105,7 +107,7 @@ def test_one_pass_linear_fails_the_patch_test(runs):
     assert low[0] < 0.12 and low[1] < 0.07, low
     # on the slave surface this is the library's contact_pressure field (all 36 slave nodes active; the
     # field divides the norm of the nodal force, not its z component: same to O(tilt^2), about 1e-8)
-    pd = res.model.contact.point_data(res.model.system.n_nodes)
+    pd = res.model.contact.point_data(res.model.system.n_nodes, res.state.contact)
     act = pd["contact_status"] == 1
     assert act.sum() == 36
     off = res.model.system.offset("upper")

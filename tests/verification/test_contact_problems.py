@@ -34,7 +34,7 @@ def test_block_on_plane_uniform_pressure(block_on_plane):
     res = block_on_plane
     assert res.exit_code == 0
     last = res.summary["steps"][-1]
-    pd = res.model.contact.point_data(res.model.system.n_nodes)
+    pd = res.model.contact.point_data(res.model.system.n_nodes, res.state.contact)
     p = pd["contact_pressure"][pd["contact_status"] == 1]
     assert len(p) == 49  # every node of the 7 x 7 bottom face of 3 x 3 hex27 is in contact
     assert np.std(p) / np.mean(p) < 1e-9

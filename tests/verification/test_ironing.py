@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from covcontact.contact.rigid import RigidMotion
+from covcontact.motion import RigidMotion
 from covcontact.io.loader import load_problem
 from covcontact.materials import NeoHooke
 from covcontact.mesh import Mesh, block

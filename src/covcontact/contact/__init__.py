@@ -17,7 +17,7 @@ from covcontact.contact.friction import (HIST_SIZE, NEW, OPEN, SLIP, STICK, Fric
                                          node_to_surface_friction, surface_friction, transfer_history)
 from covcontact.contact.kernels import contact_batch
 from covcontact.contact.projection import project_on_facet
-from covcontact.contact.rigid import RigidMotion
+from covcontact.motion import RigidMotion
 from covcontact.contact.search import candidates
 from covcontact.contact.surface import MeshSurface, tributary_area
 from covcontact.contact.driver import (EDGE, FACET, NO_CONTACT, VERTEX, ProjectionResult, closest_points,

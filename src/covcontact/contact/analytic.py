@@ -36,7 +36,7 @@ from covcontact.contact.element import (
     check_multiplier,
 )
 from covcontact.contact.laws import c_inverse, effective_gap, is_active
-from covcontact.contact.rigid import RigidMotion
+from covcontact.motion import RigidMotion
 
 PLANE = 0
 CYLINDER = 1

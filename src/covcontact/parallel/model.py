@@ -249,7 +249,7 @@ class DistributedModel(Model):
         self.symmetric = self.contact.symmetric
 
     @property
-    def is_root(self) -> bool:
+    def is_root(self) -> bool:  # type: ignore[override]
         return self.rank == 0
 
     @property
@@ -286,7 +286,7 @@ class DistributedModel(Model):
     def partition_report(self) -> dict:
         """Elements, owned dofs and contact slaves per rank (collective)."""
         own = sum(len(blk.solid.elements) for blk in self.system.blocks)
-        slaves = sum(len(p.slaves) for p in getattr(self.contact, "passes", []))
+        slaves = sum(len(p.slaves) for p in self.contact.passes)
         rows = gather_all(self.comm, (own, self.layout.hi - self.layout.lo, slaves))
         return {"ranks": self.size, "elements": [r[0] for r in rows], "owned_dofs": [r[1] for r in rows],
                 "slaves": [r[2] for r in rows], "numba_threads": self.threads}

@@ -19,8 +19,13 @@ from .state import State
 class Model:
     """Bodies, loads, Dirichlet conditions and contact of a problem, evaluated at a displacement u.
 
-    ``tangent`` overrides the tangent case of every contact pair (None: each pair's own).
+    ``tangent`` overrides the tangent case of every contact pair (None: each pair's own). Satisfies
+    ``covcontact.protocols.ModelLike``; a serial model is rank 0 of 1.
     """
+
+    is_root = True
+    rank = 0
+    size = 1
 
     def __init__(self, problem, tangent: str | None = None):
         self.problem = problem
@@ -105,6 +110,10 @@ class Model:
     # queries on a state -----------------------------------------------------------------------
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)
+
+    def partition_report(self) -> dict | None:
+        """Elements and dofs per rank of a distributed model; None for a serial one."""
+        return None
 
     def step_report(self, u: np.ndarray, lam: float, state: State) -> dict:
         return self.contact.step_report(self.positions(u), lam, state.contact) if self.contact.passes else {}

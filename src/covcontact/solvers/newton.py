@@ -63,8 +63,7 @@ class Newton:
         self.model = model
         self.opt = options
         self.linear = make_solver(linear or options.linear, symmetric=model.symmetric)
-        if hasattr(self.linear, "set_near_null_space") and hasattr(model, "near_null_space"):
-            self.linear.set_near_null_space(model.near_null_space())
+        self.linear.set_near_null_space(model.near_null_space())  # rigid-body modes (AMG only)
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0}
 
     # ------------------------------------------------------------------------------------------

@@ -119,7 +119,7 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
     t_start = time.perf_counter()
     out = Path(out) if out is not None else Path("results") / problem.name
     model = _make_model(problem, tangent, linear)
-    if getattr(model, "size", 1) > 1:
+    if model.size > 1:
         try:
             return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
         except Exception:  # noqa: BLE001  (maybe on one rank only: the others would wait forever)
@@ -132,8 +132,8 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
 def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_start: float,
          resume: bool) -> Result:
     newton = Newton(model, problem.solver, linear=linear)
-    root = getattr(model, "is_root", True)
-    rank, size = getattr(model, "rank", 0), getattr(model, "size", 1)
+    root = model.is_root
+    rank, size = model.rank, model.size
     writer = ResultWriter(out) if root else _NoWriter()
     case = _tangent_name(problem, tangent)
     problem_hash = checkpoint.fingerprint(problem) + ":" + case
@@ -155,8 +155,9 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         "wall_time_s": 0.0,
         "steps": [],
     }
-    if hasattr(model, "partition_report"):
-        summary["parallel"] = model.partition_report()
+    report = model.partition_report()  # collective under mpiexec
+    if report is not None:
+        summary["parallel"] = report
     t_out = 0.0
     t_before = 0.0  # wall time of the runs before a resume
     if resume:
