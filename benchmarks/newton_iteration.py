@@ -52,6 +52,20 @@ def plate_problem(n: int) -> Problem:
         steps=Steps.equal(1), output=OutputOptions(vtu=False), solver=SolverOptions())
 
 
+def two_blocks_problem(n: int) -> Problem:
+    """A punch (n x n x n/2 hex8) pressed into a base (n x n x n/2, other grid): deformable-deformable
+    contact on mesh facets, the set-up of examples/contact/two_blocks.toml refined."""
+    base = block(2.0, 2.0, 0.5, n, n, max(n // 2, 1), cell="hex8", origin=(-1.0, -1.0, -0.5))
+    punch = block(1.0, 1.0, 0.5, n + 1, n + 1, max(n // 2, 1), cell="hex8", origin=(-0.5, -0.5, 0.0))
+    mat = SaintVenantKirchhoff(E=1000.0, nu=0.3)
+    return Problem(
+        name=f"two-blocks-{n}", bodies=[Body("base", base, mat), Body("punch", punch, mat)],
+        contacts=[ContactPair("c", ("punch", "zmin"), ("base", "zmax"), penalty=1e6, weighting="area")],
+        dirichlet=[Dirichlet("base", "zmin", (0, 1, 2), (0.0, 0.0, 0.0)),
+                   Dirichlet("punch", "zmax", (0, 1, 2), (0.0, 0.0, -0.02))],
+        steps=Steps.equal(1), output=OutputOptions(vtu=False), solver=SolverOptions())
+
+
 def measure(prob: Problem, iterations: int | None = None) -> dict:
     if iterations:  # time a fixed number of iterations of the first step (no cutback)
         prob.solver = SolverOptions(max_iterations=iterations, max_cutbacks=0)
@@ -61,7 +75,7 @@ def measure(prob: Problem, iterations: int | None = None) -> dict:
     t_setup = time.perf_counter() - t0
     u = model.prescribed(0.0)
     t0 = time.perf_counter()
-    ok, outcomes, cutbacks, why = newton.advance(u, 0.0, 1.0)
+    ok, outcomes, cutbacks, why, _ = newton.advance(u, 0.0, 1.0, model.initial_state())
     wall = time.perf_counter() - t0
     its = max(sum(o.iterations for o in outcomes), 1)
     per_it = {k: v / its for k, v in newton.timing.items()}
@@ -78,6 +92,8 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--blocks", type=int, nargs="*", help="block sizes n (n^3 hex8); none: skip the blocks")
     ap.add_argument("--plates", type=int, nargs="*", help="plate sizes n (n x n hex8, 6 (n + 1)^2 dofs)")
+    ap.add_argument("--two-blocks", type=int, nargs="*", default=[],
+                    help="two-block sizes n (mesh-facet contact between deformable bodies)")
     ap.add_argument("--iterations", type=int, default=None,
                     help="time only this many Newton iterations of the step (for the largest sizes)")
     args = ap.parse_args()
@@ -94,6 +110,9 @@ def main() -> None:
         print(json.dumps(rows[-1]))
     for n in plates:
         rows.append(measure(plate_problem(n), args.iterations))
+        print(json.dumps(rows[-1]))
+    for n in args.two_blocks:
+        rows.append(measure(two_blocks_problem(n), args.iterations))
         print(json.dumps(rows[-1]))
     result = {"benchmark": "newton_iteration", "machine": platform.machine(), "threads": numba.get_num_threads(),
               "date": time.strftime("%Y-%m-%d"), "rows": rows}

@@ -41,7 +41,7 @@ def _steps(n: int, final: float = 1.0) -> str:
 def ironing(tmp: Path) -> Path:
     """The ironing set-up on a coarse slab: press to 0.2, slide to 0.6 (friction, rigid path)."""
     press = [0.2 * (k + 1) / 4 for k in range(4)]
-    slide = [0.2 + 0.4 * (k + 1) / 12 for k in range(12)]
+    slide = [0.2 + 0.3 * (k + 1) / 8 for k in range(8)]
     factors = ", ".join(f"{f:.10g}" for f in press + slide)
     return _variant("verification/ironing.toml", tmp, "ironing", [
         (r"nx = 18, ny = 2, nz = 6", "nx = 9, ny = 1, nz = 3"),
@@ -54,8 +54,8 @@ def augmented(tmp: Path) -> Path:
 
 
 def shells(tmp: Path) -> Path:
-    """The paper's shell over the rigid sphere (solid-shells), the first 16 of its 100 load steps."""
-    return _variant("paper/sphere_q4.toml", tmp, "shells", [(r"\[steps\][^\[]*", _steps(16, 0.16) + "\n"),
+    """The paper's shell over the rigid sphere (solid-shells), the first 10 of its 100 load steps."""
+    return _variant("paper/sphere_q4.toml", tmp, "shells", [(r"\[steps\][^\[]*", _steps(10, 0.1) + "\n"),
                                                              (r"every = 10\npictures = true", "vtu = false")])
 
 

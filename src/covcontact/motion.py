@@ -83,3 +83,21 @@ class RigidMotion:
         """Directions (..., 3) rotated to load factor ``lam`` (no translation)."""
         V = np.asarray(V, dtype=np.float64)
         return V @ self.matrix(lam).T
+
+
+def unit_vector(v, what: str) -> np.ndarray:
+    """v / |v| for a non-zero finite 3-vector; ValueError naming ``what`` otherwise."""
+    a = np.asarray(v, dtype=np.float64)
+    nv = np.linalg.norm(a) if a.shape == (3,) else 0.0
+    if a.shape != (3,) or not np.isfinite(nv) or nv == 0.0:
+        raise ValueError(f"{what} must be a non-zero finite 3-vector, got {v!r}")
+    return a / nv
+
+
+def frame_from_axis(e3: np.ndarray) -> np.ndarray:
+    """A right-handed orthonormal frame (rows e1, e2, e3) around the unit vector e3."""
+    helper = np.eye(3)[int(np.argmin(np.abs(e3)))]
+    e1 = np.cross(helper, e3)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(e3, e1)
+    return np.ascontiguousarray(np.vstack([e1, e2, e3]))

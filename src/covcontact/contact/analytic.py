@@ -36,7 +36,7 @@ from covcontact.contact.element import (
     check_multiplier,
 )
 from covcontact.contact.laws import c_inverse, effective_gap, is_active
-from covcontact.motion import RigidMotion
+from covcontact.motion import RigidMotion, frame_from_axis, unit_vector
 
 PLANE = 0
 CYLINDER = 1
@@ -283,22 +283,6 @@ def analytic_batch(
             n_out[s, 2] = work[4][2]
 
 
-def _unit(v, what):
-    a = np.asarray(v, dtype=np.float64)
-    nv = np.linalg.norm(a) if a.shape == (3,) else 0.0
-    if a.shape != (3,) or not np.isfinite(nv) or nv == 0.0:
-        raise ValueError(f"{what} must be a non-zero finite 3-vector, got {v!r}")
-    return a / nv
-
-
-def _frame_from_axis(e3):
-    helper = np.eye(3)[int(np.argmin(np.abs(e3)))]
-    e1 = np.cross(helper, e3)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(e3, e1)
-    return np.ascontiguousarray(np.vstack([e1, e2, e3]))
-
-
 @dataclass
 class AnalyticProjection:
     """Closest point on an analytic surface and its covariant quantities."""
@@ -346,7 +330,7 @@ class _Analytic:
         self._origin = np.asarray(origin, dtype=np.float64).copy()
         if self._origin.shape != (3,) or not np.all(np.isfinite(self._origin)):
             raise ValueError(f"{origin_name} must be 3 finite numbers, got {origin!r}")
-        self._frame = np.eye(3) if axis is None else _frame_from_axis(_unit(axis, axis_name))
+        self._frame = np.eye(3) if axis is None else frame_from_axis(unit_vector(axis, axis_name))
 
     def placement(self, lam: float = 1.0):
         """Current origin (3,) and frame (3, 3) (rows e1, e2, e3) at load factor ``lam``."""
