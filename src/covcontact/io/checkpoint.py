@@ -4,7 +4,7 @@ One file per rank in the output folder (``checkpoint.npz``; ``checkpoint.rank<r>
 mpiexec), written atomically (temporary name, then rename). It holds the displacement, every committed
 state array (docs/theory.md section 10), the stage, step and load factor, what the
 output files held at that step (the summary and the list of VTU files) and a fingerprint of the problem
-(the problem file and every mesh, byte for byte). ``load`` refuses a checkpoint of another or a changed
+(every parameter and mesh array that decides the results). ``load`` refuses a checkpoint of another or a changed
 problem, of another number of ranks, or a damaged one with a one-line :class:`CheckpointError`.
 """
 
@@ -37,7 +37,7 @@ def _describe(obj, h) -> None:
     elif is_dataclass(obj) and not isinstance(obj, type):
         h.update(type(obj).__name__.encode())
         for f in fields(obj):
-            if f.name in ("source", "description"):
+            if f.name in ("source", "description", "output"):
                 continue
             h.update(f.name.encode())
             _describe(getattr(obj, f.name), h)
@@ -58,10 +58,10 @@ def _describe(obj, h) -> None:
 
 
 def fingerprint(problem) -> str:
-    """sha256 of the problem: its file (when read from one) and every component, meshes included."""
+    """sha256 of everything that decides the results: every body, mesh (coordinates, cells, sets),
+    material, condition, load, contact pair, step and solver option; not the output options (what is
+    written, how often) nor comments and descriptions, which a resumed run may change."""
     h = hashlib.sha256()
-    if problem.source is not None and Path(problem.source).is_file():
-        h.update(Path(problem.source).read_bytes())
     _describe(problem, h)
     return h.hexdigest()
 
