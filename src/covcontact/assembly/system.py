@@ -145,21 +145,25 @@ class System:
         """Element history of every body at the reference state (solid-shells: EAS parameters)."""
         return [blk.solid.new_state() for blk in self.blocks]
 
-    def internal(self, u: np.ndarray, state: list[dict] | None = None, want_K: bool = True,
-                 pattern: Pattern | None = None):
+    def internal(self, u: np.ndarray, committed: list[dict] | None = None, guess: list[dict] | None = None,
+                 want_K: bool = True, pattern: Pattern | None = None):
         """Internal forces (n_dofs,), the body tangent (CSR over ``pattern``, default the bodies' own, or
-        None) and the trial element history at displacement u, started from ``state`` (not changed)."""
+        None) and the trial element history at displacement u: history read from ``committed``, local
+        iterations started from ``guess`` (default ``committed``); neither is changed."""
         pattern = self.pattern if pattern is None else pattern
         data = np.zeros(pattern.nnz) if want_K else np.zeros(1)
         r = np.zeros(self.n_dofs)
         U = u.reshape(-1, 3)
-        state = self.new_state() if state is None else state
-        trial = [{k: v.copy() for k, v in st.items()} for st in state]
-        for blk, st in zip(self.blocks, trial):
+        committed = self.new_state() if committed is None else committed
+        guess = committed if guess is None else guess
+        trial = []
+        for blk, c, g in zip(self.blocks, committed, guess):
+            st = blk.solid.kernel_state(c, g)
             bad = blk.solid.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, pattern,
                                      node_offset=blk.offset, want_K=want_K, state=st)
             if bad >= 0:
                 raise InvertedElementError(blk.name, int(bad))
+            trial.append(blk.solid.trial_of(st))
         K = pattern.csr(data) if want_K else None
         return r, K, trial
 

@@ -147,10 +147,31 @@ class ElementBody:
         """Per-element fields into out (nelem, ncol): mode 0 energy, 1 min det J0, 2 stress (18)."""
         raise NotImplementedError
 
+    #: state keys that are only the starting point of a local iteration (read from the guess, e.g. the
+    #: EAS parameters); every other key is history (read from the committed state)
+    HINTS: tuple[str, ...] = ()
+
     def new_state(self) -> dict[str, np.ndarray]:
         """The element history of this body at the reference state, as named arrays (none here;
         solid-shells hold their EAS parameters)."""
         return {}
+
+    def kernel_state(self, committed: dict[str, np.ndarray], guess: dict[str, np.ndarray]) -> dict:
+        """The arrays an assembly works on (docs/theory.md section 10): for a hint key a copy of the
+        guess; for a history key ``k`` the committed array as ``k + "_n"`` (read only) and a copy of it as
+        ``k`` (overwritten with the trial). :meth:`trial_of` strips the read-only keys again."""
+        out: dict[str, np.ndarray] = {}
+        for k, v in committed.items():
+            if k in self.HINTS:
+                out[k] = guess[k].copy()
+            else:
+                out[k] = v.copy()
+                out[k + "_n"] = v
+        return out
+
+    @staticmethod
+    def trial_of(kernel_state: dict) -> dict[str, np.ndarray]:
+        return {k: v for k, v in kernel_state.items() if not k.endswith("_n")}
 
     # -- evaluation -----------------------------------------------------------------------------
     def _u(self, u: np.ndarray) -> np.ndarray:

@@ -16,7 +16,8 @@ from numba import get_num_threads, njit, prange
 
 from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
 from ..fem.shapes import shape_functions
-from ..materials.hyperelastic import VOIGT, Material, material_energy, material_response
+from ..materials.hyperelastic import VOIGT, Material, material_energy
+from ..materials.update import material_update
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
 from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather
 
@@ -71,8 +72,9 @@ def _kinematics(dNg, Ji, ue, G, F):
 
 
 @njit(cache=True)
-def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D, P, T, A, Q):
-    """Internal force fe (3 nen,) and tangent Ke (3 nen, 3 nen) of one element (overwritten).
+def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D, P, T, A, Q, hist_n, hist):
+    """Internal force fe (3 nen,) and tangent Ke (3 nen, 3 nen) of one element (overwritten); the material
+    history of its Gauss points: hist_n (ngp, nh) committed (read), hist (ngp, nh) trial (written).
 
     Returns 0, 1 if det F <= 0 at a Gauss point, 2 if det J0 <= 0 (that point is skipped).
     """
@@ -92,7 +94,7 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D,
             flag = 2
             continue
         _kinematics(dNg, Ji, ue, G, F)
-        if material_response(kind, params, F, S, D) != 0 and flag == 0:
+        if material_update(kind, params, F, hist_n[g], hist[g], S, D) != 0 and flag == 0:
             flag = 1
         wd = w[g] * det
         # P = F S (scaled by the integration weight)
@@ -151,11 +153,11 @@ def _work(nen):
 
 
 @njit(parallel=True, cache=True)
-def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, nblocks):
+def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, nblocks, hist_n, hist):
     """Element buffers Ke (nc, nd, nd), fe (nc, nd) and flags (nc,) of elements e0 .. e0 + nc - 1.
 
     The chunk is split into ``nblocks`` contiguous blocks (the parallel iterations), each with its
-    own scratch arrays.
+    own scratch arrays. hist_n, hist (nelem, ngp, nh): committed and trial material history.
     """
     nc = fe.shape[0]
     nen = conn.shape[1]
@@ -172,15 +174,16 @@ def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, n
             gather(X, u, conn, e0 + c, Xe, ue)
             Kc = Ke[c] if want_K else Kdummy
             flags[c] = _element(kind, params, Xe, ue, dNdxi, w, want_K, Kc, fe[c], J0, Ji, G, F, S, D, P,
-                                T, A, Q)
+                                T, A, Q, hist_n[e0 + c], hist[e0 + c])
 
 
 @njit(parallel=True, cache=True)
-def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads):
+def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, hist_n):
     """Per-element Gauss-point quantities (serial per block, parallel over blocks).
 
     mode 0: out (ne, 1) strain energy int W dV; mode 1: out (ne, 1) minimum det J0;
-    mode 2: out (ne, 18) volume averages of Cauchy stress, S and Green-Lagrange E (Voigt).
+    mode 2: out (ne, 18) volume averages of Cauchy stress, S and Green-Lagrange E (Voigt), with the
+    material history hist_n (ne, ngp, nh) as the committed one.
     """
     ne = conn.shape[0]
     nen = conn.shape[1]
@@ -188,6 +191,7 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads):
     for t in prange(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe, ue, G, J0, Ji, F, S, D = _work(nen)
+        hscr = np.empty(hist_n.shape[2])
         for e in range(lo, hi):
             gather(X, u, conn, e, Xe, ue)
             for r in range(out.shape[1]):
@@ -208,7 +212,7 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads):
                 if mode == 0:
                     out[e, 0] += wd * material_energy(kind, params, F)
                     continue
-                material_response(kind, params, F, S, D)
+                material_update(kind, params, F, hist_n[e, g], hscr, S, D)
                 add_cauchy_pk2(F, S, wd, out[e])
                 for I in range(6):
                     i = _PAIRS[I, 0]
@@ -249,10 +253,17 @@ class SolidBody(ElementBody):
         self.points, self.weights = _rule(cell_type, rule)
         self.dNdxi = np.ascontiguousarray(shape_functions(cell_type, self.points)[1])
 
+    def new_state(self) -> dict[str, np.ndarray]:
+        """Material history per Gauss point, ``hist`` (nelem, ngp, n_hist); n_hist = 0 for hyperelastic
+        materials."""
+        return {"hist": np.zeros((self.n_elements, self.weights.size, getattr(self.material, "n_hist", 0)))}
+
     def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:
+        hist = state["hist"]
+        hist_n = state["hist_n"] if "hist_n" in state else hist.copy()
         solid_chunk(self.material.kind, self.material.params, self.X, u, self.cells, e0, self.dNdxi,
-                    self.weights, want_K, Ke, fe, flags, nblocks)
+                    self.weights, want_K, Ke, fe, flags, nblocks, hist_n, hist)
 
     def _gauss_fields(self, u, mode, out, state) -> None:
         solid_gauss_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.dNdxi,
-                           self.weights, mode, out, get_num_threads())
+                           self.weights, mode, out, get_num_threads(), state["hist"])

@@ -246,8 +246,11 @@ class SolidShellBody(ElementBody):
         self.neas = o["eas"]
         self.eas_comp, self.eas_val = eas_tables(cell_type, self.neas, pts[: self.weights.size])
 
+    HINTS = ("alpha",)
+
     def new_state(self) -> dict[str, np.ndarray]:
-        """EAS parameters alpha (nelem, neas), zero in the reference state."""
+        """EAS parameters alpha (nelem, neas), zero in the reference state (a hint: the start of the local
+        EAS solve, whose result depends on u only)."""
         return {"alpha": np.zeros((self.n_elements, self.neas))}
 
     def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:

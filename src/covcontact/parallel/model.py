@@ -188,9 +188,10 @@ class DistributedSystem(System):
             touched[c.ravel()] = True
         self.structure = Structure(self.pattern, touched, self.constrained, self.layout)
 
-    def local_internal(self, u: np.ndarray, state: list[dict], want_K: bool = True):
+    def local_internal(self, u: np.ndarray, committed: list[dict], guess: list[dict], want_K: bool = True):
         """This rank's share of the internal forces (n_dofs,), tangent data (pattern.nnz,) or None, and the
-        trial element history of its elements, started from ``state`` (not changed).
+        trial element history of its elements (history from ``committed``, local iterations started from
+        ``guess``; neither changed).
 
         Raises InvertedElementError on every rank when an element of any rank is inverted.
         """
@@ -198,12 +199,14 @@ class DistributedSystem(System):
         r = np.zeros(self.n_dofs)
         U = u.reshape(-1, 3)
         bad = (len(self.blocks), 0)
-        trial = [{k: v.copy() for k, v in st.items()} for st in state]
-        for k, (blk, st) in enumerate(zip(self.blocks, trial)):
+        trial = []
+        for k, (blk, c, g) in enumerate(zip(self.blocks, committed, guess)):
+            st = blk.solid.kernel_state(c, g)
             e = blk.solid.local.assemble(U[blk.offset: blk.offset + blk.n_nodes], data, r, self.pattern,
                                          node_offset=blk.offset, want_K=want_K, state=st)
             if e >= 0 and bad[0] == len(self.blocks):
                 bad = (k, int(blk.solid.elements[e]))
+            trial.append(blk.solid.trial_of(st))
         bad = min(gather_all(self.comm, bad))
         if bad[0] < len(self.blocks):
             raise InvertedElementError(self.blocks[bad[0]].name, bad[1])
@@ -262,7 +265,7 @@ class DistributedModel(Model):
         trial state of this rank's elements and slaves."""
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
-        r, data, etrial = self.system.local_internal(u, guess.elements, want_K=want_K)
+        r, data, etrial = self.system.local_internal(u, committed.elements, guess.elements, want_K=want_K)
         t1 = time.perf_counter()
         ev, ctrial = self.contact.evaluate(self.positions(u), lam, committed.contact, guess.contact, want_K)
         r += ev.blocks.residual()

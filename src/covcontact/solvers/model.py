@@ -96,7 +96,7 @@ class Model:
         ev, ctrial = self.contact.evaluate(self.positions(u), lam, committed.contact, guess.contact, want_K)
         pattern, triples = self.coupling.covering(ev.blocks) if want_K else (None, [])
         t1 = time.perf_counter()
-        r, K, etrial = self.system.internal(u, guess.elements, want_K, pattern)
+        r, K, etrial = self.system.internal(u, committed.elements, guess.elements, want_K, pattern)
         t2 = time.perf_counter()
         r += ev.blocks.residual()
         if want_K:
