@@ -13,6 +13,7 @@ import numpy as np
 
 from ..io import checkpoint
 from ..io.output import ResultWriter, _jsonable
+from ..io.validate import InputError
 from .model import Model
 from .newton import Newton
 from .signals import Interrupted, StopSignals
@@ -122,6 +123,8 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
     if model.size > 1:
         try:
             return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
+        except InputError:  # a refused checkpoint: raised on every rank alike (exit 2)
+            raise
         except Exception:  # noqa: BLE001  (maybe on one rank only: the others would wait forever)
             traceback.print_exc()
             sys.stderr.flush()
@@ -167,6 +170,14 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         except (KeyError, ValueError) as exc:
             raise checkpoint.CheckpointError(f"{checkpoint.path_for(out, rank, size)}: does not match the "
                                              f"problem ({exc})") from None
+        if size > 1:
+            from ..parallel.comm import gather_all
+
+            steps = gather_all(model.comm, state.step)
+            if len(set(steps)) > 1:
+                raise checkpoint.CheckpointError(f"{out}: the ranks' checkpoints end at different steps "
+                                                 f"{sorted(set(steps))} (a rank stopped while writing); "
+                                                 f"start again without --resume")
         summary = meta["summary"]
         t_before = float(meta.get("wall_time_s", 0.0))
         writer.restore(meta["pvd"], state.step)
