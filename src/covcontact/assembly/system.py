@@ -71,6 +71,11 @@ class System:
 
                 solid = SolidShellBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
                                        **body.options)
+            elif body.formulation == "fbar":
+                from ..elements.fbar import FbarBody
+
+                solid = FbarBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
+                                 **body.options)
             else:
                 solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material)
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))

@@ -173,6 +173,36 @@ class ElementBody:
     def trial_of(kernel_state: dict) -> dict[str, np.ndarray]:
         return {k: v for k, v in kernel_state.items() if not k.endswith("_n")}
 
+    #: whether the element tangent is symmetric (F-bar elements: not in general)
+    symmetric_tangent = True
+
+    def gauss_volumes(self) -> np.ndarray:
+        """(nelem, ngp) reference volume w_g det J0 of every Gauss point (bodies with ``dNdxi``)."""
+        J0 = np.einsum("eai,gak->egik", self.X[self.cells], self.dNdxi)
+        return np.linalg.det(J0) * self.weights[None, :]
+
+    def plastic_fields(self, state: dict) -> dict[str, np.ndarray]:
+        """Cell fields of a plastic material (``equivalent_plastic_strain``: volume average over the Gauss
+        points; ``yield_flag``: 1 where a Gauss point yielded in the last step) from ``state``; empty for
+        materials without plastic history."""
+        from ..materials.plasticity import H_ALPHA, H_FLAG, J2
+
+        hist = state.get("hist")
+        if hist is None or self.material.kind != J2:
+            return {}
+        vol = self.gauss_volumes()
+        return {"equivalent_plastic_strain": (hist[:, :, H_ALPHA] * vol).sum(axis=1) / vol.sum(axis=1),
+                "yield_flag": hist[:, :, H_FLAG].max(axis=1)}
+
+    def plastic_work(self, state: dict) -> float:
+        """Plastic work int w_p dV of the body in ``state`` (0 without plastic history)."""
+        from ..materials.plasticity import H_WP, J2
+
+        hist = state.get("hist")
+        if hist is None or self.material.kind != J2:
+            return 0.0
+        return float((hist[:, :, H_WP] * self.gauss_volumes()).sum())
+
     # -- evaluation -----------------------------------------------------------------------------
     def _u(self, u: np.ndarray) -> np.ndarray:
         u = np.ascontiguousarray(u, dtype=np.float64)

@@ -232,6 +232,8 @@ class SolidShellBody(ElementBody):
 
     def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
                  chunk_bytes: int = 32 * 2**20, **options: Any) -> None:
+        if getattr(material, "n_hist", 0):
+            raise ValueError("solid-shells take hyperelastic materials only (no material history yet)")
         self.options = normalize_options(cell_type, options)
         super().__init__(cell_type, X, cells, material, chunk_bytes)
         msg = mesh_problem(cell_type, self.X, self.cells)

@@ -29,7 +29,7 @@ from ..problem import (
     Steps,
     Traction,
 )
-from .validate import InputError, Section
+from .validate import _REQUIRED, InputError, Section
 
 CELLS = ("hex8", "hex18", "hex27")
 RIGID_SHAPES = ("plane", "cylinder", "sphere", "mesh")
@@ -87,15 +87,46 @@ def build_mesh(sec: Section, base: Path, element: str | None):
         sec.fail(f"generator {name!r}: {exc}")
 
 
+_HARDENING = {"linear": ("modulus",), "swift": ("K", "eps0", "n"), "voce": ("sigma_inf", "delta", "modulus")}
+
+
+def _hardening(sec: Section) -> dict:
+    law = sec.get("law", "str", choices=tuple(_HARDENING))
+    out: dict = {"law": law}
+    for key in _HARDENING[law]:
+        optional = law == "voce" and key == "modulus"
+        value = sec.get(key, "float", 0.0 if optional else _REQUIRED)
+        out[key] = value
+    sec.done()
+    return out
+
+
 def _material(sec: Section):
     from ..materials import material_from_name
 
-    model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke"))
+    model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke", "j2"))
     E = sec.get("E", "float", positive=True)
     nu = sec.get("nu", "float")
-    sec.done()
     if not -1.0 < nu < 0.5:
         sec.fail(f"must lie in (-1, 0.5), got {nu}", "nu")
+    if model == "j2":
+        from ..materials.plasticity import J2Plasticity
+
+        yield_stress = sec.get("yield_stress", "float", None)
+        hardening = _hardening(sec.get("hardening", "table"))
+        kinematic = sec.get("kinematic_modulus", "float", 0.0, nonnegative=True)
+        hill = None
+        if sec.has("hill48"):
+            h = sec.get("hill48", "table")
+            hill = {k: h.get(k, "float") for k in ("r0", "r45", "r90")}
+            h.done()
+        sec.done()
+        try:
+            return J2Plasticity(E=E, nu=nu, yield_stress=yield_stress, hardening=hardening,
+                                kinematic_modulus=kinematic, hill48=hill)
+        except ValueError as exc:
+            sec.fail(str(exc))
+    sec.done()
     try:
         return material_from_name(model, E=E, nu=nu)
     except ValueError as exc:
@@ -206,13 +237,16 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         if any(x.name == bname for x in bodies):
             b.fail(f"duplicate body name {bname!r}", "name")
         element = b.get("element", "str", None, choices=CELLS)
-        formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell"))
+        formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell", "fbar"))
         options = b.get("options", "table", None)
         options = options.rest() if options is not None else {}
         material = _material(b.get("material", "table"))
         mesh = build_mesh(b.get("mesh", "table"), base, element)
         _user_sets(b.get("sets", "table", None), mesh)
         b.done()
+        if formulation == "solid-shell" and getattr(material, "n_hist", 0):
+            b.fail("J2 plasticity is not available for solid-shells yet; use formulation = \"fbar\" (hex8) "
+                   "or \"solid\" (hex27) for a plastic body", "material")
         if formulation == "solid-shell":
             from ..elements.solidshell import check_options
 
@@ -220,8 +254,16 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                 options = check_options(mesh, options)
             except ValueError as exc:
                 b.fail(str(exc), "options")
+        elif formulation == "fbar":
+            if mesh.cell_type != "hex8":
+                b.fail(f"formulation = \"fbar\" needs hex8 elements, got {mesh.cell_type}", "formulation")
+            unknown = sorted(set(options) - {"form"})
+            if unknown:
+                b.fail(f"unknown option {unknown[0]!r} for formulation = \"fbar\" (known: form)", "options")
+            if options.get("form", "spatial") not in ("spatial", "variational"):
+                b.fail(f"form must be \"spatial\" or \"variational\", got {options['form']!r}", "options")
         elif options:
-            b.fail("options are only known for formulation = \"solid-shell\"", "options")
+            b.fail("options are only known for formulation = \"solid-shell\" and \"fbar\"", "options")
         bodies.append(Body(bname, mesh, material, formulation, options))
     if not bodies:
         top.fail("at least one [[bodies]] entry is needed")

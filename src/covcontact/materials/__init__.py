@@ -1,4 +1,5 @@
-"""Materials: St. Venant-Kirchhoff and compressible Neo-Hooke (parameters array + compiled response)."""
+"""Materials: St. Venant-Kirchhoff, compressible Neo-Hooke and finite-strain J2 plasticity (parameters array +
+compiled response)."""
 
 from .hyperelastic import (
     NEO_HOOKE,
@@ -15,9 +16,22 @@ from .hyperelastic import (
     stress_tangent,
     voigt_to_tensor,
 )
+from .plasticity import (
+    J2,
+    NHIST,
+    Hill48,
+    J2Plasticity,
+    LinearHardening,
+    SwiftHardening,
+    VoceHardening,
+    j2_point,
+    j2_response,
+)
+from .update import material_update
 
 __all__ = [
     "NEO_HOOKE", "SVK", "VOIGT", "Material", "NeoHooke", "SaintVenantKirchhoff", "lame",
     "material_energy", "material_from_name", "material_response", "strain_energy", "stress_tangent",
-    "voigt_to_tensor",
+    "voigt_to_tensor", "J2", "NHIST", "Hill48", "J2Plasticity", "LinearHardening", "SwiftHardening",
+    "VoceHardening", "j2_point", "j2_response", "material_update",
 ]

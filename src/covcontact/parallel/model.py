@@ -136,11 +136,27 @@ class PartBody:
                            von_mises=np.ascontiguousarray(full[:, 18]))
 
 
+    def plastic_fields(self, state: dict) -> dict[str, np.ndarray]:
+        """The plastic cell fields of all ranks in global element order (collective)."""
+        mine = self.local.plastic_fields(state)
+        out = {}
+        for key in sorted(mine):
+            full = np.empty(self.n_total)
+            for idx, f in gather_all(self.comm, (self.elements, mine[key])):
+                full[idx] = f
+            out[key] = full
+        return out
+
+
 def _make_body(body, cells: np.ndarray):
     if body.formulation == "solid-shell":
         from ..elements.solidshell import SolidShellBody
 
         return SolidShellBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
+    if body.formulation == "fbar":
+        from ..elements.fbar import FbarBody
+
+        return FbarBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
     return SolidBody(body.mesh.cell_type, body.mesh.points, cells, body.material)
 
 
@@ -249,7 +265,7 @@ class DistributedModel(Model):
         from .contact import DistributedContact
 
         self.contact = DistributedContact(problem, self.system, tangent, comm)
-        self.symmetric = self.contact.symmetric
+        self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
 
     @property
     def is_root(self) -> bool:  # type: ignore[override]
@@ -285,6 +301,11 @@ class DistributedModel(Model):
 
     def eliminate(self, K):
         return self.system.eliminate(K)
+
+    def plastic_work(self, state) -> float | None:
+        """Plastic work of all bodies, summed over the ranks (collective)."""
+        mine = super().plastic_work(state)
+        return None if mine is None else float(sum_all(self.comm, np.array([mine]))[0])
 
     def partition_report(self) -> dict:
         """Elements, owned dofs and contact slaves per rank (collective)."""

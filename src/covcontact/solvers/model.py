@@ -32,7 +32,7 @@ class Model:
         self.system = System(problem)
         self.tangent = tangent
         self.contact = ContactManager(problem, self.system, tangent)
-        self.symmetric = self.contact.symmetric
+        self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
         blocks = [body.mesh.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies)]
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
 
@@ -110,6 +110,14 @@ class Model:
     # queries on a state -----------------------------------------------------------------------
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)
+
+    def plastic_work(self, state: State) -> float | None:
+        """Plastic work of all bodies in ``state``; None when no body has a plastic material."""
+        from ..materials.plasticity import J2
+
+        if not any(b.solid.material.kind == J2 for b in self.system.blocks):
+            return None
+        return sum(b.solid.plastic_work(e) for b, e in zip(self.system.blocks, state.elements))
 
     def partition_report(self) -> dict | None:
         """Elements and dofs per rank of a distributed model; None for a serial one."""

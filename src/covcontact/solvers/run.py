@@ -55,6 +55,7 @@ def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, st
         st = blk.solid.stress(U[sl], est)
         cauchy[sl] = st.cauchy_nodal
         cd = st.cell_data()
+        cd.update(blk.solid.plastic_fields(est))
         cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
         blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
     points = sysm.X.copy()
@@ -210,6 +211,10 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                 if cutbacks:
                     entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
                 if success:
+                    work = model.plastic_work(new)
+                    if work is not None:
+                        entry["plastic_dissipation"] = work - model.plastic_work(state)
+                        entry["plastic_work"] = work
                     state = new
                     state.step = k
                     entry.update(model.step_report(u, lam, state))

@@ -1,0 +1,423 @@
+"""F-bar hexahedron (hex8) for nearly incompressible and plastic solids, total Lagrangian.
+
+de Souza Neto, Peric, Dutko & Owen (1996), "Design of simple low order finite elements for large strain
+analysis of nearly incompressible solids", Int. J. Solids Struct. 33, 3277-3296: at every Gauss point the
+material sees the modified deformation gradient
+
+    F_bar = phi F,   phi = (J_c / J)^(1/3),   J = det F,   J_c = det F_c,
+
+F_c the deformation gradient at the element centre (xi = 0). F_bar has the isochoric part of the local F
+and the volume change of the centre, so the 2 x 2 x 2 rule no longer imposes eight incompressibility
+constraints per element but one. A homogeneous deformation gives F_bar = F (patch test), a rigid rotation
+gives F_bar = R.
+
+Two weak forms (``form``), both with S_bar = S(F_bar) from ``material_update`` (docs/theory.md, section
+"F-bar hexahedra", has the derivation); g_a = F^-T G_a and g0_a = F_c^-T G_a(centre) are the spatial
+gradients of the shape functions at the Gauss point and at the centre, tau_bar = F_bar S_bar F_bar^T:
+
+- ``"spatial"`` (default): the weak form of the paper, int sigma_bar : grad_x eta dv over the current
+  volume, pulled back to the reference configuration: f_a = int (J / J_c) tau_bar g_a dV
+  = int phi^-1 F S_bar G_a dV. It passes the patch test on any mesh; it is not the gradient of a
+  potential and its exact tangent is non-symmetric for every material.
+- ``"variational"``: the virtual work of S_bar on the variation of E_bar = (F_bar^T F_bar - I)/2,
+  f_a = int [tau_bar g_a + tr(tau_bar)/3 (g0_a - g_a)] dV. For a hyperelastic material this is the
+  gradient of int W(F_bar) dV and the exact tangent is symmetric (non-symmetric only where D = dS/dE is).
+  It passes the patch test only where int G_a dV = V G_a(centre) holds (parallelepipeds, meshes extruded
+  from a planar quadrilateral mesh); on a generally distorted hexahedral mesh a homogeneous state leaves
+  out-of-balance forces at interior nodes of the order of the pressure times the distortion.
+
+The exact tangent (all F-bar terms, including the coupling to every node through F_c) is assembled as a
+full element matrix; :attr:`FbarBody.symmetric_tangent` says whether it is symmetric (variational form
+with a symmetric D).
+
+Material history per Gauss point: ``new_state()`` returns {"hist": (nelem, 8, n_hist)}. ``_chunk`` reads the
+committed history from ``state["hist_n"]`` when present (as :meth:`ElementBody.kernel_state` provides it)
+and writes the trial into ``state["hist"]``; without ``hist_n`` the array ``hist`` is both (each point's
+committed values are copied to a scratch array before the trial overwrites them).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import get_num_threads, njit, prange
+
+from ..fem.quadrature import gauss_tensor
+from ..fem.shapes import shape_functions
+from ..materials.hyperelastic import VOIGT, Material, material_energy
+from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
+from ..materials.update import material_update
+from .base import ElementBody, add_cauchy_pk2, block_range, gather
+from .solid import _jacobian, _kinematics
+
+__all__ = ["FBAR_FORMS", "FbarBody", "fbar_chunk", "fbar_gauss_fields"]
+
+#: weak forms by name -> kernel code
+FBAR_FORMS = {"variational": 0, "spatial": 1}
+
+
+# ----------------------------------------------------------------------------- compiled pieces
+
+
+@njit(cache=True, inline="always")
+def _inverse(F, Fi):
+    """Fi = F^-1 (untouched if det F <= 0); returns det F."""
+    c00 = F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]
+    c01 = F[1, 2] * F[2, 0] - F[1, 0] * F[2, 2]
+    c02 = F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]
+    det = F[0, 0] * c00 + F[0, 1] * c01 + F[0, 2] * c02
+    if not (det > 0.0):
+        return det
+    r = 1.0 / det
+    Fi[0, 0] = c00 * r
+    Fi[1, 0] = c01 * r
+    Fi[2, 0] = c02 * r
+    Fi[0, 1] = (F[0, 2] * F[2, 1] - F[0, 1] * F[2, 2]) * r
+    Fi[1, 1] = (F[0, 0] * F[2, 2] - F[0, 2] * F[2, 0]) * r
+    Fi[2, 1] = (F[0, 1] * F[2, 0] - F[0, 0] * F[2, 1]) * r
+    Fi[0, 2] = (F[0, 1] * F[1, 2] - F[0, 2] * F[1, 1]) * r
+    Fi[1, 2] = (F[0, 2] * F[1, 0] - F[0, 0] * F[1, 2]) * r
+    Fi[2, 2] = (F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]) * r
+    return det
+
+
+@njit(cache=True, inline="always")
+def _spatial_gradients(Fi, G, g):
+    """g_a = F^-T G_a, i.e. g[a, i] = sum_j Fi[j, i] G[a, j] (dN_a/dx)."""
+    for a in range(G.shape[0]):
+        for i in range(3):
+            g[a, i] = Fi[0, i] * G[a, 0] + Fi[1, i] * G[a, 1] + Fi[2, i] * G[a, 2]
+
+
+@njit(cache=True, inline="always")
+def _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0):
+    """Deformation gradient at the element centre: returns (det J0, det F_c) and g0_a = F_c^-T G_a(centre)
+    (only when both are positive)."""
+    detc = _jacobian(Xe, dNc, J0, Ji)
+    if not (detc > 0.0):
+        return detc, 0.0
+    _kinematics(dNc, Ji, ue, Gc, Fc)
+    Jc = _inverse(Fc, Fi)
+    if Jc > 0.0:
+        _spatial_gradients(Fi, Gc, g0)
+    return detc, Jc
+
+
+@njit(cache=True)
+def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, hist_n, hist, hn,
+                  J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D, FS, T, A, Q, x, y):
+    """Internal force fe (24,) and exact tangent Ke (24, 24) of one F-bar hex8 (both overwritten).
+
+    hist_n (ngp, nh) committed history (read), hist (ngp, nh) trial (written); hn (nh,) scratch.
+    Returns 0, 1 if det F <= 0 at the centre or at a Gauss point or the material failed, 2 if det J0 <= 0
+    (such points are skipped; at the centre the whole element is).
+    """
+    nen = Xe.shape[0]
+    nd = 3 * nen
+    nh = hn.shape[0]
+    for r in range(nd):
+        fe[r] = 0.0
+    if want_K:
+        for r in range(nd):
+            for s in range(nd):
+                Ke[r, s] = 0.0
+    detc, Jc = _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0)
+    if not (detc > 0.0 and Jc > 0.0):
+        for gp in range(w.size):
+            for k in range(nh):
+                hist[gp, k] = hist_n[gp, k]
+        return 2 if not (detc > 0.0) else 1
+    flag = 0
+    for gp in range(w.size):
+        dNg = dNdxi[gp]
+        det = _jacobian(Xe, dNg, J0, Ji)
+        J = 0.0
+        if not (det > 0.0):
+            flag = 2
+        else:
+            _kinematics(dNg, Ji, ue, G, F)
+            J = _inverse(F, Fi)
+            if not (J > 0.0) and flag == 0:
+                flag = 1
+        if not (det > 0.0 and J > 0.0):
+            for k in range(nh):
+                hist[gp, k] = hist_n[gp, k]
+            continue
+        _spatial_gradients(Fi, G, g)
+        for a in range(nen):
+            for i in range(3):
+                q[a, i] = (g0[a, i] - g[a, i]) / 3.0
+        phi = (Jc / J) ** (1.0 / 3.0)
+        for i in range(3):
+            for j in range(3):
+                Fb[i, j] = phi * F[i, j]
+        for k in range(nh):
+            hn[k] = hist_n[gp, k]
+        if material_update(kind, params, Fb, hn, hist[gp], S, D) != 0 and flag == 0:
+            flag = 1
+        wd = w[gp] * det
+        # FS = F S_bar; f_a += sc FS G_a (+ p q_a), sc = wd phi^2 (variational) or wd / phi (spatial)
+        sc = wd * phi * phi if form == 0 else wd / phi
+        for k in range(3):
+            for j in range(3):
+                FS[k, j] = F[k, 0] * S[VOIGT[0, j]] + F[k, 1] * S[VOIGT[1, j]] + F[k, 2] * S[VOIGT[2, j]]
+        p = 0.0  # tr(tau_bar) wd (variational form)
+        if form == 0:
+            for k in range(3):
+                for j in range(3):
+                    p += sc * FS[k, j] * F[k, j]
+        for a in range(nen):
+            for k in range(3):
+                t = sc * (FS[k, 0] * G[a, 0] + FS[k, 1] * G[a, 1] + FS[k, 2] * G[a, 2])
+                fe[3 * a + k] += t + p * q[a, k]
+                x[a, k] = t  # t_a, used below by the variational form
+        if not want_K:
+            continue
+        # T[k, j, m, n] = sum_i F_ki C_ijmn
+        for k in range(3):
+            for j in range(3):
+                for m in range(3):
+                    for n in range(3):
+                        mn = VOIGT[m, n]
+                        T[k, j, m, n] = (F[k, 0] * D[VOIGT[0, j], mn] + F[k, 1] * D[VOIGT[1, j], mn]
+                                         + F[k, 2] * D[VOIGT[2, j], mn])
+        # A[k, j, l, n] = c1 sum_m T_kjmn F_lm + c2 delta_kl S_jn
+        if form == 0:
+            c1 = wd * phi * phi * phi * phi
+            c2 = wd * phi * phi
+        else:
+            c1 = wd * phi
+            c2 = wd / phi
+        for k in range(3):
+            for j in range(3):
+                for l in range(3):
+                    for n in range(3):
+                        v = c1 * (T[k, j, 0, n] * F[l, 0] + T[k, j, 1, n] * F[l, 1] + T[k, j, 2, n] * F[l, 2])
+                        if k == l:
+                            v += c2 * S[VOIGT[j, n]]
+                        A[k, j, l, n] = v
+        # rank-one F-bar terms:
+        # Ke[ak, bl] += x_ak q_bl + q_ak y_bl + cq q_ak q_bl - pg (g0_bk g0_al - g_bk g_al)
+        cq = 0.0
+        pg = 0.0
+        if form == 0:
+            # x_a = G_a . (A : F) + t_a, y_b = (F : A) . G_b + t_b, cq = F : A : F + p, pg = p / 3
+            for k in range(3):
+                for j in range(3):
+                    r1 = 0.0
+                    r2 = 0.0
+                    for l in range(3):
+                        for n in range(3):
+                            r1 += A[k, j, l, n] * F[l, n]
+                            r2 += F[l, n] * A[l, n, k, j]
+                    Q[0, k, j] = r1  # (A : F)_kj
+                    Q[1, k, j] = r2  # (F : A)_kj
+                    cq += F[k, j] * r1
+            cq += p
+            pg = p / 3.0
+            for a in range(nen):
+                for k in range(3):
+                    t = x[a, k]
+                    x[a, k] = t + G[a, 0] * Q[0, k, 0] + G[a, 1] * Q[0, k, 1] + G[a, 2] * Q[0, k, 2]
+                    y[a, k] = t + G[a, 0] * Q[1, k, 0] + G[a, 1] * Q[1, k, 1] + G[a, 2] * Q[1, k, 2]
+        else:
+            # x_ak = sum_j G_aj (wd phi (T : C)_kj - wd / phi (F S)_kj), C = F^T F; y = 0
+            for k in range(3):
+                for j in range(3):
+                    tc = 0.0
+                    for m in range(3):
+                        for n in range(3):
+                            cmn = F[0, m] * F[0, n] + F[1, m] * F[1, n] + F[2, m] * F[2, n]
+                            tc += T[k, j, m, n] * cmn
+                    Q[0, k, j] = wd * phi * tc - sc * FS[k, j]
+            for a in range(nen):
+                for k in range(3):
+                    x[a, k] = G[a, 0] * Q[0, k, 0] + G[a, 1] * Q[0, k, 1] + G[a, 2] * Q[0, k, 2]
+                    y[a, k] = 0.0
+        for a in range(nen):
+            # Q[k, l, n] = sum_j G_aj A_kjln
+            for k in range(3):
+                for l in range(3):
+                    for n in range(3):
+                        Q[k, l, n] = (G[a, 0] * A[k, 0, l, n] + G[a, 1] * A[k, 1, l, n]
+                                      + G[a, 2] * A[k, 2, l, n])
+            for b in range(nen):
+                Gb0 = G[b, 0]
+                Gb1 = G[b, 1]
+                Gb2 = G[b, 2]
+                for k in range(3):
+                    for l in range(3):
+                        v = Q[k, l, 0] * Gb0 + Q[k, l, 1] * Gb1 + Q[k, l, 2] * Gb2
+                        v += x[a, k] * q[b, l] + q[a, k] * y[b, l] + cq * q[a, k] * q[b, l]
+                        v -= pg * (g0[b, k] * g0[a, l] - g[b, k] * g[a, l])
+                        Ke[3 * a + k, 3 * b + l] += v
+    return flag
+
+
+@njit(cache=True)
+def _work(nen, nh):
+    """Per-block scratch arrays of the F-bar kernels."""
+    return (np.empty(nh), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((nen, 3)),
+            np.empty((nen, 3)), np.empty((nen, 3)), np.empty((nen, 3)), np.empty((nen, 3)), np.empty((3, 3)),
+            np.empty((3, 3)), np.empty((3, 3)), np.empty(6), np.empty((6, 6)))
+
+
+@njit(parallel=True, cache=True)
+def fbar_chunk(kind, params, form, X, u, conn, e0, dNdxi, dNc, w, want_K, Ke, fe, flags, nblocks, hist_n,
+               hist):
+    """Element buffers Ke (nc, 24, 24), fe (nc, 24) and flags (nc,) of elements e0 .. e0 + nc - 1.
+
+    The chunk is split into ``nblocks`` contiguous blocks (the parallel iterations), each with its own
+    scratch arrays. hist_n, hist (nelem, ngp, nh): committed and trial material history (may be the same
+    array: each point's committed values are copied before the update).
+    """
+    nc = fe.shape[0]
+    nen = conn.shape[1]
+    nblk = max(1, min(nblocks, nc))
+    for t in prange(nblk):
+        lo, hi = block_range(t, nc, nblk)
+        Xe = np.empty((nen, 3))
+        ue = np.empty((nen, 3))
+        hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D = _work(nen, hist.shape[2])
+        FS = np.empty((3, 3))
+        T = np.empty((3, 3, 3, 3))
+        A = np.empty((3, 3, 3, 3))
+        Q = np.empty((3, 3, 3))
+        x = np.empty((nen, 3))
+        y = np.empty((nen, 3))
+        Kdummy = np.empty((0, 0))
+        for c in range(lo, hi):
+            gather(X, u, conn, e0 + c, Xe, ue)
+            Kc = Ke[c] if want_K else Kdummy
+            flags[c] = _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Kc, fe[c],
+                                     hist_n[e0 + c], hist[e0 + c], hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb,
+                                     S, D, FS, T, A, Q, x, y)
+
+
+@njit(parallel=True, cache=True)
+def fbar_gauss_fields(kind, params, X, u, conn, dNdxi, dNc, w, mode, out, nthreads, hist_n):
+    """Per-element Gauss-point quantities of F-bar hex8 (serial per block, parallel over blocks).
+
+    mode 0: out (ne, 1) strain energy int W(F_bar) dV (inf where det F or det F_c <= 0);
+    mode 1: out (ne, 1) minimum det J0 over the Gauss points and the centre;
+    mode 2: out (ne, 18) volume averages of the Cauchy stress sigma(F_bar), S(F_bar) and
+    E_bar = (F_bar^T F_bar - I) / 2 (Voigt), with hist_n (ne, ngp, nh) as the committed history.
+    """
+    ne = conn.shape[0]
+    nen = conn.shape[1]
+    nblk = max(1, min(nthreads, ne))
+    for t in prange(nblk):
+        lo, hi = block_range(t, ne, nblk)
+        Xe = np.empty((nen, 3))
+        ue = np.empty((nen, 3))
+        hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D = _work(nen, hist_n.shape[2])
+        hscr = np.empty(hist_n.shape[2])
+        for e in range(lo, hi):
+            gather(X, u, conn, e, Xe, ue)
+            for r in range(out.shape[1]):
+                out[e, r] = 0.0
+            detc, Jc = _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0)
+            if mode == 1:
+                out[e, 0] = detc
+                for gp in range(w.size):
+                    out[e, 0] = min(out[e, 0], _jacobian(Xe, dNdxi[gp], J0, Ji))
+                continue
+            if not (detc > 0.0):
+                continue
+            vol = 0.0
+            for gp in range(w.size):
+                det = _jacobian(Xe, dNdxi[gp], J0, Ji)
+                if not (det > 0.0):
+                    continue
+                _kinematics(dNdxi[gp], Ji, ue, G, F)
+                wd = w[gp] * det
+                vol += wd
+                J = _inverse(F, Fi)
+                if not (J > 0.0 and Jc > 0.0):
+                    if mode == 0:
+                        out[e, 0] = np.inf
+                    continue
+                phi = (Jc / J) ** (1.0 / 3.0)
+                for i in range(3):
+                    for j in range(3):
+                        Fb[i, j] = phi * F[i, j]
+                if mode == 0:
+                    out[e, 0] += wd * material_energy(kind, params, Fb)
+                    continue
+                for k in range(hn.shape[0]):
+                    hn[k] = hist_n[e, gp, k]
+                material_update(kind, params, Fb, hn, hscr, S, D)
+                add_cauchy_pk2(Fb, S, wd, out[e])
+                for I in range(6):
+                    i = _PAIRS[I, 0]
+                    j = _PAIRS[I, 1]
+                    c = Fb[0, i] * Fb[0, j] + Fb[1, i] * Fb[1, j] + Fb[2, i] * Fb[2, j]
+                    out[e, 12 + I] += wd * 0.5 * (c - (1.0 if i == j else 0.0))
+            if mode == 2 and vol > 0.0:
+                for r in range(18):
+                    out[e, r] /= vol
+
+
+# ----------------------------------------------------------------------------- body
+
+
+class FbarBody(ElementBody):
+    """A total-Lagrangian F-bar hex8 body (2 x 2 x 2 Gauss points, F_bar from the centre's volume change).
+
+    Args:
+        cell_type: "hex8" (the only cell type; the argument keeps the signature of the other bodies).
+        X: (nnode, 3) reference coordinates.
+        cells: (nelem, 8) connectivity (local node ids).
+        material: a :mod:`covcontact.materials` material; its ``n_hist`` (0 if absent) is the history length
+            per Gauss point.
+        form: "spatial" (default): the weak form of de Souza Neto et al. (1996), int sigma(F_bar) : grad_x eta
+            dv; passes the patch test on any mesh, non-symmetric tangent. "variational": the virtual work of
+            S(F_bar) on the variation of E(F_bar), the gradient of int W(F_bar) dV for hyperelastic materials
+            with a symmetric tangent, but the patch test holds only on parallelepiped or extruded meshes.
+        chunk_bytes: size of the per-chunk element tangent buffer.
+
+    State: ``new_state()`` = {"hist": zeros((nelem, 8, n_hist))}. An assembly reads the committed history from
+    ``state["hist_n"]`` if given (read only), else from ``state["hist"]``, and writes the trial into
+    ``state["hist"]``. :meth:`energy` is int W(F_bar) dV (the potential of the residual only for the
+    variational form); :meth:`stress` averages sigma(F_bar), S(F_bar) and E(F_bar) over each element.
+    """
+
+    def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
+                 form: str = "spatial", chunk_bytes: int = 32 * 2**20) -> None:
+        if cell_type != "hex8":
+            raise ValueError(f"F-bar elements are hex8 only, got cell type {cell_type!r}")
+        if form not in FBAR_FORMS:
+            raise ValueError(f"unknown F-bar form {form!r}; known: {', '.join(FBAR_FORMS)}")
+        super().__init__(cell_type, X, cells, material, chunk_bytes)
+        self.form = form
+        self.points, self.weights = gauss_tensor((2, 2, 2))
+        self.dNdxi = np.ascontiguousarray(shape_functions("hex8", self.points)[1])
+        self.dNc = np.ascontiguousarray(shape_functions("hex8", np.zeros((1, 3)))[1][0])
+
+    @property
+    def n_hist(self) -> int:
+        """Material history length per Gauss point."""
+        return int(getattr(self.material, "n_hist", 0))
+
+    @property
+    def symmetric_tangent(self) -> bool:
+        """Whether the element tangent is symmetric: the variational form with a material whose D = dS/dE
+        is symmetric (hyperelastic, associative plasticity); never for the spatial form."""
+        return self.form == "variational"
+
+    def new_state(self) -> dict[str, np.ndarray]:
+        """Material history per Gauss point, ``hist`` (nelem, 8, n_hist); n_hist = 0 for hyperelastic
+        materials."""
+        return {"hist": np.zeros((self.n_elements, self.weights.size, self.n_hist))}
+
+    def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:
+        # committed history: hist_n when the caller passes it (kernel_state), else hist itself (the kernel
+        # copies each point's committed values before overwriting them with the trial)
+        hist = state["hist"]
+        hist_n = state.get("hist_n", hist)
+        fbar_chunk(self.material.kind, self.material.params, FBAR_FORMS[self.form], self.X, u, self.cells, e0,
+                   self.dNdxi, self.dNc, self.weights, want_K, Ke, fe, flags, nblocks, hist_n, hist)
+
+    def _gauss_fields(self, u, mode, out, state) -> None:
+        fbar_gauss_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.dNdxi,
+                          self.dNc, self.weights, mode, out, get_num_threads(), state["hist"])
+
