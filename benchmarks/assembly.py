@@ -7,6 +7,10 @@ size and the resident peak memory of that process. Output: JSON on stdout or to 
 
     python benchmarks/assembly.py --quick
     python benchmarks/assembly.py --out assembly.json --max-gib 12
+    python benchmarks/assembly.py --cells hex8 --material j2 --formulation fbar   # plastic F-bar hex8
+
+With ``--material j2`` the body is stretched 1 % (beyond yield) from the virgin state, so every Gauss point
+runs the return mapping; the time includes the copy of the history arrays that an evaluation makes.
 """
 
 from __future__ import annotations
@@ -60,12 +64,13 @@ def timed(fn, repeats: int) -> tuple[float, float]:
     return float(np.median(wall)), float(np.median(cpu))
 
 
-def run_single(cell: str, n: int, repeats: int) -> dict:
+def run_single(cell: str, n: int, repeats: int, material: str = "svk", formulation: str = "solid") -> dict:
     import numba
 
     from covcontact.assembly import Pattern
     from covcontact.elements import SolidBody
-    from covcontact.materials import SaintVenantKirchhoff
+    from covcontact.elements.fbar import FbarBody
+    from covcontact.materials import J2Plasticity, SaintVenantKirchhoff
 
     t0 = time.perf_counter()
     X, cells = cube(cell, n)
@@ -73,28 +78,33 @@ def run_single(cell: str, n: int, repeats: int) -> dict:
     t0 = time.perf_counter()
     P = Pattern(X.shape[0], [cells])
     t_pattern = time.perf_counter() - t0
-    body = SolidBody(cell, X, cells, SaintVenantKirchhoff(E=210e3, nu=0.3))
+    mat = (J2Plasticity(E=210e3, nu=0.3, yield_stress=250.0, hardening={"law": "linear", "modulus": 1000.0})
+           if material == "j2" else SaintVenantKirchhoff(E=210e3, nu=0.3))
+    body = (FbarBody if formulation == "fbar" else SolidBody)(cell, X, cells, mat)
+    state = body.new_state()
     t0 = time.perf_counter()
     body.ranks(P)
     t_ranks = time.perf_counter() - t0
     u = 1e-3 * np.random.default_rng(0).standard_normal(X.shape)
+    if material == "j2":  # 1 % stretch along x (beyond yield everywhere, 250 / 210e3 = 0.12 %) plus noise
+        u = 1e-2 * X * [1.0, 0.0, 0.0] + 1e-4 * u / n
     data = P.zeros()
     rhs = np.zeros(P.n_dofs)
 
     def full() -> None:
         data[:] = 0.0
         rhs[:] = 0.0
-        assert body.assemble(u, data, rhs, P) == -1
+        assert body.assemble(u, data, rhs, P, state=body.kernel_state(state, state)) == -1
 
     def residual() -> None:
         rhs[:] = 0.0
-        assert body.assemble(u, data, rhs, P, want_K=False) == -1
+        assert body.assemble(u, data, rhs, P, want_K=False, state=body.kernel_state(state, state)) == -1
 
     w_full, c_full = timed(full, repeats)
     w_res, _ = timed(residual, repeats)
     ne = cells.shape[0]
     return {
-        "cell": cell, "material": "svk", "n": n, "n_elements": ne, "n_nodes": int(X.shape[0]),
+        "cell": cell, "material": material, "formulation": formulation, "n": n, "n_elements": ne, "n_nodes": int(X.shape[0]),
         "n_dofs": P.n_dofs, "nnz": P.nnz, "chunk": body.chunk, "threads": numba.get_num_threads(),
         "mesh_s": round(t_mesh, 4), "pattern_s": round(t_pattern, 4), "ranks_s": round(t_ranks, 4),
         "assemble_s": round(w_full, 4), "assemble_cpu_s": round(c_full, 4),
@@ -112,10 +122,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cells", default="hex8,hex27", help="comma separated cell types")
     ap.add_argument("--max-gib", type=float, default=12.0, help="skip meshes estimated above this memory")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--material", default="svk", choices=("svk", "j2"),
+                    help="j2: J2 plasticity in a plastic state (return mapping included)")
+    ap.add_argument("--formulation", default="solid", choices=("solid", "fbar"))
     ap.add_argument("--single", nargs=2, metavar=("CELL", "N"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.single:
-        print(json.dumps(run_single(args.single[0], int(args.single[1]), args.repeats)))
+        print(json.dumps(run_single(args.single[0], int(args.single[1]), args.repeats, args.material,
+                                    args.formulation)))
         return 0
     sizes = QUICK if args.quick else SIZES
     records = []
@@ -126,7 +140,8 @@ def main(argv: list[str] | None = None) -> int:
                 records.append({"cell": cell, "n": n, "n_elements": n**3, "skipped":
                                 f"estimated {est:.1f} GiB > --max-gib {args.max_gib}"})
                 continue
-            cmd = [sys.executable, __file__, "--single", cell, str(n), "--repeats", str(args.repeats)]
+            cmd = [sys.executable, __file__, "--single", cell, str(n), "--repeats", str(args.repeats),
+                   "--material", args.material, "--formulation", args.formulation]
             res = subprocess.run(cmd, check=False, capture_output=True, text=True)
             if res.returncode != 0:
                 records.append({"cell": cell, "n": n, "n_elements": n**3, "error": res.stderr[-2000:]})

@@ -1,13 +1,13 @@
 """J2 plasticity through the whole program: problem file, Newton, state, output.
 
 Uniaxial tension of a block under symmetry conditions is a homogeneous state, so every element sees the
-material-point closed form in logarithmic strain (docs/theory.md, "Elastoplasticity (J2) at finite
-strain"): for a stretch lambda, eps = ln lambda; with linear hardening the Kirchhoff stress is tau = E eps
-below yield and tau = E (sigma_y0 + H eps) / (E + H) on monotonic loading beyond it, alpha = eps - tau / E.
-(Elastic unloading is checked at the material point, tests/unit/test_plasticity.py: load factors only
-increase within a stage.) The reaction on the loaded face is
-A0 tau / lambda (first Piola-Kirchhoff stress P11 = tau / lambda). The plastic work of the backward-Euler
-update is the sum over the steps of tau_(n+1) (alpha_(n+1) - alpha_n) per unit reference volume.
+material-point closed form in logarithmic strain (docs/theory.md section 12): for a stretch lambda,
+eps = ln lambda; with linear hardening the Kirchhoff stress is tau = E eps below yield and
+tau = E (sigma_y0 + H eps) / (E + H) on monotonic loading beyond it, alpha = eps - tau / E. (Elastic
+unloading is checked at the material point, tests/unit/test_plasticity.py: load factors only increase
+within a stage.) The reaction on the loaded face is A0 tau / lambda (first Piola-Kirchhoff stress
+P11 = tau / lambda). The plastic work of the backward-Euler update is the sum over the steps of
+tau_(n+1) (alpha_(n+1) - alpha_n) per unit reference volume.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Spectral tools of the matrix logarithm: a 3 x 3 symmetric eigensolver (cyclic Jacobi) and the first and
 second divided differences of f(x) = 1/2 ln x with their Taylor limits for (nearly) equal arguments
-(docs/theory.md, section "Elastoplasticity (J2) at finite strain")."""
+(docs/theory.md, section 12)."""
 
 from __future__ import annotations
 

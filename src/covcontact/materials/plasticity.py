@@ -1,6 +1,6 @@
 """Finite-strain J2 (von Mises or Hill 1948) elastoplasticity in the logarithmic strain space.
 
-Formulation (docs/theory.md, section "Elastoplasticity (J2) at finite strain"): the total-Lagrangian
+Formulation (docs/theory.md, section 12): the total-Lagrangian
 logarithmic strain E_log = 1/2 ln C (spectral decomposition of C = F^T F) is split additively,
 E_log = E_e + E_p, with the plastic log strain E_p as history. The stress T conjugate to E_log follows
 from Hencky elasticity, T = lambda tr(E_e) I + 2 mu E_e, and a small-strain-like return mapping is done

@@ -1,7 +1,7 @@
 """Compiled J2 return mapping in the logarithmic strain space: constants, hardening, ``j2_response``.
 
 The formulation, the params and history layouts: :mod:`covcontact.materials.plasticity` and docs/theory.md,
-section "Elastoplasticity (J2) at finite strain".
+section 12.
 """
 
 from __future__ import annotations
