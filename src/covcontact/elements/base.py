@@ -31,6 +31,28 @@ def block_range(t, n, nblk):
 
 
 @njit(cache=True, inline="always")
+def inverse3(A, Ai):
+    """Ai = A^-1 of a 3 x 3 matrix by cofactors; returns det A (Ai untouched unless det A > 0)."""
+    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
+    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
+    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
+    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
+    if not (det > 0.0):
+        return det
+    r = 1.0 / det
+    Ai[0, 0] = c00 * r
+    Ai[1, 0] = c01 * r
+    Ai[2, 0] = c02 * r
+    Ai[0, 1] = (A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]) * r
+    Ai[1, 1] = (A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]) * r
+    Ai[2, 1] = (A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]) * r
+    Ai[0, 2] = (A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]) * r
+    Ai[1, 2] = (A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]) * r
+    Ai[2, 2] = (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]) * r
+    return det
+
+
+@njit(cache=True, inline="always")
 def gather(X, u, conn, e, Xe, ue):
     """Reference coordinates Xe (nen, 3) and displacements ue (nen, 3) of the nodes of element e."""
     for a in range(conn.shape[1]):

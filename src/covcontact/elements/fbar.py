@@ -46,7 +46,7 @@ from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
 from ..materials.update import material_update
-from .base import ElementBody, add_cauchy_pk2, block_range, gather
+from .base import ElementBody, add_cauchy_pk2, block_range, gather, inverse3
 from .solid import _jacobian, _kinematics
 
 __all__ = ["FBAR_FORMS", "FbarBody", "fbar_chunk", "fbar_gauss_fields"]
@@ -56,28 +56,6 @@ FBAR_FORMS = {"variational": 0, "spatial": 1}
 
 
 # ----------------------------------------------------------------------------- compiled pieces
-
-
-@njit(cache=True, inline="always")
-def _inverse(F, Fi):
-    """Fi = F^-1 (untouched if det F <= 0); returns det F."""
-    c00 = F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1]
-    c01 = F[1, 2] * F[2, 0] - F[1, 0] * F[2, 2]
-    c02 = F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]
-    det = F[0, 0] * c00 + F[0, 1] * c01 + F[0, 2] * c02
-    if not (det > 0.0):
-        return det
-    r = 1.0 / det
-    Fi[0, 0] = c00 * r
-    Fi[1, 0] = c01 * r
-    Fi[2, 0] = c02 * r
-    Fi[0, 1] = (F[0, 2] * F[2, 1] - F[0, 1] * F[2, 2]) * r
-    Fi[1, 1] = (F[0, 0] * F[2, 2] - F[0, 2] * F[2, 0]) * r
-    Fi[2, 1] = (F[0, 1] * F[2, 0] - F[0, 0] * F[2, 1]) * r
-    Fi[0, 2] = (F[0, 1] * F[1, 2] - F[0, 2] * F[1, 1]) * r
-    Fi[1, 2] = (F[0, 2] * F[1, 0] - F[0, 0] * F[1, 2]) * r
-    Fi[2, 2] = (F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]) * r
-    return det
 
 
 @njit(cache=True, inline="always")
@@ -96,7 +74,7 @@ def _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0):
     if not (detc > 0.0):
         return detc, 0.0
     _kinematics(dNc, Ji, ue, Gc, Fc)
-    Jc = _inverse(Fc, Fi)
+    Jc = inverse3(Fc, Fi)
     if Jc > 0.0:
         _spatial_gradients(Fi, Gc, g0)
     return detc, Jc
@@ -135,7 +113,7 @@ def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, his
             flag = 2
         else:
             _kinematics(dNg, Ji, ue, G, F)
-            J = _inverse(F, Fi)
+            J = inverse3(F, Fi)
             if not (J > 0.0) and flag == 0:
                 flag = 1
         if not (det > 0.0 and J > 0.0):
@@ -331,7 +309,7 @@ def fbar_gauss_fields(kind, params, X, u, conn, dNdxi, dNc, w, mode, out, nthrea
                 _kinematics(dNdxi[gp], Ji, ue, G, F)
                 wd = w[gp] * det
                 vol += wd
-                J = _inverse(F, Fi)
+                J = inverse3(F, Fi)
                 if not (J > 0.0 and Jc > 0.0):
                     if mode == 0:
                         out[e, 0] = np.inf

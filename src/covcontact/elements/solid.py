@@ -19,7 +19,7 @@ from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
 from ..materials.update import material_update
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
-from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather
+from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather, inverse3
 
 __all__ = ["BLOCKS_PER_THREAD", "SOLID_CELLS", "SolidBody", "SolidStress", "solid_chunk", "solid_gauss_fields"]
 
@@ -36,24 +36,7 @@ def _jacobian(Xe, dNg, J0, Ji):
             for a in range(nen):
                 s += Xe[a, i] * dNg[a, k]
             J0[i, k] = s
-    c00 = J0[1, 1] * J0[2, 2] - J0[1, 2] * J0[2, 1]
-    c01 = J0[1, 2] * J0[2, 0] - J0[1, 0] * J0[2, 2]
-    c02 = J0[1, 0] * J0[2, 1] - J0[1, 1] * J0[2, 0]
-    det = J0[0, 0] * c00 + J0[0, 1] * c01 + J0[0, 2] * c02
-    if det <= 0.0:
-        return det
-    r = 1.0 / det
-    # Ji = J0^-1, Ji[k, i] = dxi_k / dX_i
-    Ji[0, 0] = c00 * r
-    Ji[1, 0] = c01 * r
-    Ji[2, 0] = c02 * r
-    Ji[0, 1] = (J0[0, 2] * J0[2, 1] - J0[0, 1] * J0[2, 2]) * r
-    Ji[1, 1] = (J0[0, 0] * J0[2, 2] - J0[0, 2] * J0[2, 0]) * r
-    Ji[2, 1] = (J0[0, 1] * J0[2, 0] - J0[0, 0] * J0[2, 1]) * r
-    Ji[0, 2] = (J0[0, 1] * J0[1, 2] - J0[0, 2] * J0[1, 1]) * r
-    Ji[1, 2] = (J0[0, 2] * J0[1, 0] - J0[0, 0] * J0[1, 2]) * r
-    Ji[2, 2] = (J0[0, 0] * J0[1, 1] - J0[0, 1] * J0[1, 0]) * r
-    return det
+    return inverse3(J0, Ji)
 
 
 @njit(cache=True, inline="always")

@@ -42,15 +42,11 @@ def _check(E: float, nu: float) -> None:
         raise ValueError(f"Poisson's ratio nu must satisfy -1 < nu < 0.5, got nu={nu}")
 
 
-@dataclass(frozen=True)
-class _Isotropic:
+class LameConstants:
+    """lambda and mu from the attributes E and nu (isotropic elasticity of every material)."""
+
     E: float
     nu: float
-    kind: int = field(init=False, default=-1)
-    name: str = field(init=False, default="")
-
-    def __post_init__(self) -> None:
-        _check(float(self.E), float(self.nu))
 
     @property
     def lam(self) -> float:
@@ -61,6 +57,17 @@ class _Isotropic:
     def mu(self) -> float:
         """Shear modulus mu."""
         return lame(self.E, self.nu)[1]
+
+
+@dataclass(frozen=True)
+class _Isotropic(LameConstants):
+    E: float
+    nu: float
+    kind: int = field(init=False, default=-1)
+    name: str = field(init=False, default="")
+
+    def __post_init__(self) -> None:
+        _check(float(self.E), float(self.nu))
 
     @property
     def params(self) -> np.ndarray:

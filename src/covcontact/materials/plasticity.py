@@ -65,7 +65,7 @@ from typing import Any
 
 import numpy as np
 
-from .hyperelastic import lame
+from .hyperelastic import LameConstants, lame
 from .logstrain import _dd1, _dd2  # noqa: F401  (re-exported for tests)
 from .plasticity_kernels import (  # noqa: F401  (the layout constants belong to this module's interface)
     H_ALPHA, H_BETA, H_EP, H_FLAG, H_WP, J2, LAW_LINEAR, LAW_SWIFT, LAW_VOCE, NHIST, NPARAMS, P_BULK, P_E,
@@ -226,7 +226,7 @@ def _as_hill(h) -> Hill48 | None:
 
 
 @dataclass(frozen=True)
-class J2Plasticity:
+class J2Plasticity(LameConstants):
     """Finite-strain J2 plasticity (log-strain space, Hencky elasticity, isotropic + kinematic hardening,
     optional Hill 1948 anisotropy).
 
@@ -280,16 +280,6 @@ class J2Plasticity:
             raise ValueError(f"kinematic_modulus must be >= 0, got {self.kinematic_modulus}")
         object.__setattr__(self, "hill48", _as_hill(self.hill48))
         object.__setattr__(self, "_params", self._build_params())
-
-    @property
-    def lam(self) -> float:
-        """First Lame constant lambda."""
-        return lame(self.E, self.nu)[0]
-
-    @property
-    def mu(self) -> float:
-        """Shear modulus mu."""
-        return lame(self.E, self.nu)[1]
 
     @property
     def n_hist(self) -> int:
