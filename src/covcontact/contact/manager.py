@@ -11,7 +11,7 @@ than a quarter of the search margin and emptied by :meth:`begin_step`.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -38,7 +38,6 @@ class ContactEvaluation:
 
     blocks: ElementBlocks
     parts: list[ElementBlocks] | None = None
-    timing: dict = field(default_factory=dict)
 
 
 @dataclass

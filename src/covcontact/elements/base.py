@@ -31,6 +31,19 @@ def block_range(t, n, nblk):
 
 
 @njit(cache=True, inline="always")
+def f_times_d(F, D, T):
+    """T[k, j, m, n] = sum_i F_ki C_ijmn for the material tangent D (Voigt, 6 x 6) of the elements'
+    first elasticity tensor."""
+    for k in range(3):
+        for j in range(3):
+            for m in range(3):
+                for n in range(3):
+                    mn = VOIGT[m, n]
+                    T[k, j, m, n] = (F[k, 0] * D[VOIGT[0, j], mn] + F[k, 1] * D[VOIGT[1, j], mn]
+                                     + F[k, 2] * D[VOIGT[2, j], mn])
+
+
+@njit(cache=True, inline="always")
 def inverse3(A, Ai):
     """Ai = A^-1 of a 3 x 3 matrix by cofactors; returns det A (Ai untouched unless det A > 0)."""
     c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
@@ -199,9 +212,12 @@ class ElementBody:
     symmetric_tangent = True
 
     def gauss_volumes(self) -> np.ndarray:
-        """(nelem, ngp) reference volume w_g det J0 of every Gauss point (bodies with ``dNdxi``)."""
-        J0 = np.einsum("eai,gak->egik", self.X[self.cells], self.dNdxi)
-        return np.linalg.det(J0) * self.weights[None, :]
+        """(nelem, ngp) reference volume w_g det J0 of every Gauss point (bodies with ``dNdxi``; computed
+        once)."""
+        if getattr(self, "_gauss_volumes", None) is None:
+            J0 = np.einsum("eai,gak->egik", self.X[self.cells], self.dNdxi)
+            self._gauss_volumes = np.linalg.det(J0) * self.weights[None, :]
+        return self._gauss_volumes
 
     def plastic_fields(self, state: dict) -> dict[str, np.ndarray]:
         """Cell fields of a plastic material (``equivalent_plastic_strain``: volume average over the Gauss

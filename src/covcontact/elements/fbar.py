@@ -46,7 +46,7 @@ from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
 from ..materials.update import material_update
-from .base import ElementBody, add_cauchy_pk2, block_range, gather, inverse3
+from .base import ElementBody, add_cauchy_pk2, block_range, f_times_d, gather, inverse3
 from .solid import _jacobian, _kinematics
 
 __all__ = ["FBAR_FORMS", "FbarBody", "fbar_chunk", "fbar_gauss_fields"]
@@ -150,14 +150,7 @@ def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, his
                 x[a, k] = t  # t_a, used below by the variational form
         if not want_K:
             continue
-        # T[k, j, m, n] = sum_i F_ki C_ijmn
-        for k in range(3):
-            for j in range(3):
-                for m in range(3):
-                    for n in range(3):
-                        mn = VOIGT[m, n]
-                        T[k, j, m, n] = (F[k, 0] * D[VOIGT[0, j], mn] + F[k, 1] * D[VOIGT[1, j], mn]
-                                         + F[k, 2] * D[VOIGT[2, j], mn])
+        f_times_d(F, D, T)  # T[k, j, m, n] = sum_i F_ki C_ijmn
         # A[k, j, l, n] = c1 sum_m T_kjmn F_lm + c2 delta_kl S_jn
         if form == 0:
             c1 = wd * phi * phi * phi * phi

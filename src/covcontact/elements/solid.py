@@ -19,7 +19,7 @@ from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
 from ..materials.update import material_update
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
-from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather, inverse3
+from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, f_times_d, gather, inverse3
 
 __all__ = ["BLOCKS_PER_THREAD", "SOLID_CELLS", "SolidBody", "SolidStress", "solid_chunk", "solid_gauss_fields"]
 
@@ -89,14 +89,7 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D,
                 fe[3 * a + k] += P[k, 0] * G[a, 0] + P[k, 1] * G[a, 1] + P[k, 2] * G[a, 2]
         if not want_K:
             continue
-        # T[k, j, m, n] = sum_i F_ki C_ijmn
-        for k in range(3):
-            for j in range(3):
-                for m in range(3):
-                    for n in range(3):
-                        mn = VOIGT[m, n]
-                        T[k, j, m, n] = (F[k, 0] * D[VOIGT[0, j], mn] + F[k, 1] * D[VOIGT[1, j], mn]
-                                         + F[k, 2] * D[VOIGT[2, j], mn])
+        f_times_d(F, D, T)  # T[k, j, m, n] = sum_i F_ki C_ijmn
         # A[k, j, l, n] = wd (sum_m T_kjmn F_lm + delta_kl S_jn)
         for k in range(3):
             for j in range(3):

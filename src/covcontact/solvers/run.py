@@ -190,6 +190,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
     nsteps = len(problem.steps.factors)
     status = "completed"
     code = 0
+    work_before = model.plastic_work(state)  # plastic work of the committed state (collective)
     with StopSignals(enabled=size == 1) as stops:
         try:
             for k in range(state.step + 1, nsteps + 1):
@@ -213,8 +214,8 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                 if success:
                     work = model.plastic_work(new)
                     if work is not None:
-                        entry["plastic_dissipation"] = work - model.plastic_work(state)
-                        entry["plastic_work"] = work
+                        entry["plastic_dissipation"] = work - work_before
+                        entry["plastic_work"] = work_before = work
                     state = new
                     state.step = k
                     entry.update(model.step_report(u, lam, state))
