@@ -1,8 +1,9 @@
-"""Prescribed rigid-body motion of an analytic surface, scaled by a load factor.
+"""Prescribed rigid-body motion (of a rigid body or a node set), scaled by a load factor.
 
     x(lam) = c + R(lam theta) (X - c) + lam T
 
-with R the rotation by the rotation vector lam theta (Rodrigues' formula) about the centre c.
+with R the rotation by the rotation vector lam theta (Rodrigues' formula) about the centre c. In a later
+stage of an analysis a motion continues from the pose the earlier stages left (:class:`StagedMotion`).
 """
 
 from __future__ import annotations
@@ -83,6 +84,55 @@ class RigidMotion:
         """Directions (..., 3) rotated to load factor ``lam`` (no translation)."""
         V = np.asarray(V, dtype=np.float64)
         return V @ self.matrix(lam).T
+
+    def pose(self, lam: float) -> tuple[np.ndarray, np.ndarray]:
+        """(Q, b): the motion at load factor ``lam`` as the affine map X -> Q X + b."""
+        return self.matrix(lam), self.apply(np.zeros(3), lam)
+
+
+class StagedMotion:
+    """A stage's motion continuing from the pose the earlier stages left.
+
+    The pose at the start of the stage is the affine map X -> Q X + b (a rotation Q and a translation b);
+    the stage's own ``RigidMotion`` then acts on the current positions, about the centre the earlier stages
+    carried along (the motion's ``center`` names a point of the body in its reference configuration):
+
+        x(lam) = c + R(lam theta) (Q X + b - c) + T(lam),    c = Q center + b.
+
+    Same interface as ``RigidMotion`` (``apply``, ``rotate``, ``matrix``).
+    """
+
+    def __init__(self, motion: RigidMotion, Q: np.ndarray | None = None, b: np.ndarray | None = None):
+        self.motion = motion
+        self.Q = np.eye(3) if Q is None else np.asarray(Q, dtype=np.float64)
+        self.b = np.zeros(3) if b is None else np.asarray(b, dtype=np.float64)
+        self.center = self.Q @ motion.center + self.b
+
+    def start(self, X) -> np.ndarray:
+        """Positions (..., 3) at the start of the stage."""
+        return np.asarray(X, dtype=np.float64) @ self.Q.T + self.b
+
+    def matrix(self, lam: float = 1.0) -> np.ndarray:
+        return self.motion.matrix(lam) @ self.Q
+
+    def apply(self, X, lam: float = 1.0) -> np.ndarray:
+        X = np.asarray(X, dtype=np.float64)
+        if X.shape[-1] != 3:
+            raise ValueError(f"points must have 3 coordinates in the last axis, got shape {X.shape}")
+        c = self.center
+        return c + (self.start(X) - c) @ self.motion.matrix(lam).T + self.motion.offset(lam)
+
+    def rotate(self, V, lam: float = 1.0) -> np.ndarray:
+        return np.asarray(V, dtype=np.float64) @ self.matrix(lam).T
+
+    def pose(self, lam: float) -> tuple[np.ndarray, np.ndarray]:
+        """(Q, b) of the pose reached at load factor ``lam`` (where the next stage starts)."""
+        return self.matrix(lam), self.apply(np.zeros(3), lam)
+
+    @classmethod
+    def hold(cls, Q: np.ndarray, b: np.ndarray) -> "StagedMotion":
+        """Standing still at the pose (Q, b)."""
+        return cls(RigidMotion(), Q, b)
 
 
 def unit_vector(v, what: str) -> np.ndarray:

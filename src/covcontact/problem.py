@@ -48,12 +48,18 @@ class RigidBody:
 
 @dataclass
 class Dirichlet:
-    """Prescribed displacement u_i = lam * value_i on the nodes of ``body``'s node set ``set``."""
+    """Prescribed displacement u_i = lam * value_i on the nodes of ``body``'s node set ``set``.
+
+    With ``motion`` the node set moves rigidly instead, u = motion(X, lam) - X on the given components
+    (``values`` unused). ``name`` lets later stages give new targets or release the condition.
+    """
 
     body: str
     set: str
     components: tuple[int, ...]
     values: tuple[float, ...]
+    name: str = ""
+    motion: RigidMotion | None = None
 
 
 @dataclass
@@ -64,6 +70,7 @@ class NodalForce:
     set: str
     value: tuple[float, float, float]
     distribution: str = "per_node"
+    name: str = ""
 
 
 @dataclass
@@ -73,6 +80,7 @@ class Pressure:
     body: str
     set: str
     value: float
+    name: str = ""
 
 
 @dataclass
@@ -82,6 +90,7 @@ class Traction:
     body: str
     set: str
     value: tuple[float, float, float]
+    name: str = ""
 
 
 @dataclass
@@ -113,6 +122,7 @@ class ContactPair:
     gap_tolerance_relative: float | None = None
     max_augmentations: int = 20
     auto_factor: float = 10.0
+    enabled: bool = True               # off: the pair does nothing until a stage switches it on
 
 
 @dataclass
@@ -124,6 +134,32 @@ class Steps:
     @classmethod
     def equal(cls, n: int, final: float = 1.0) -> "Steps":
         return cls(tuple(float(final) * (k + 1) / n for k in range(n)))
+
+
+@dataclass
+class Stage:
+    """A later stage of the analysis: it continues from the end state of the stage before.
+
+    In every stage a quantity goes linearly in the stage's load factor lam from its value at the start of
+    the stage (lam = 0) to its target (lam = 1); what a stage does not mention holds its value.
+
+    release: names of Dirichlet conditions whose dofs become free; the reactions they carried at the start
+        of the stage are applied as forces ramped to zero, (1 - lam) r, clipped at 0 beyond lam = 1.
+    targets: new values of named Dirichlet conditions (tuple, one per component) and named loads (force or
+        traction: 3-vector; pressure: a number).
+    remove: names of loads ramped to zero.
+    motions: new motions of named rigid bodies and of Dirichlet conditions with a motion, continuing from
+        the pose the earlier stages left (``covcontact.motion.StagedMotion``).
+    contacts: pair name -> True (switched on) or False (switched off) at the start of the stage.
+    """
+
+    name: str
+    steps: Steps
+    release: tuple[str, ...] = ()
+    targets: dict = field(default_factory=dict)
+    remove: tuple[str, ...] = ()
+    motions: dict = field(default_factory=dict)
+    contacts: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -169,6 +205,12 @@ class Problem:
     output: OutputOptions = field(default_factory=OutputOptions)
     description: str = ""
     source: Path | None = None
+    stages: list[Stage] = field(default_factory=list)  # the stages after the first (this object's own)
+    stage_name: str = "stage1"                           # the name of the first stage
+
+    def stage_list(self) -> list[tuple[str, Steps]]:
+        """(name, steps) of every stage, the first included."""
+        return [(self.stage_name, self.steps)] + [(s.name, s.steps) for s in self.stages]
 
     def body(self, name: str) -> Body:
         for b in self.bodies:

@@ -102,48 +102,47 @@ class System:
         return mesh.node_sets[set_name] + self.offset(body)
 
     # -- loads ----------------------------------------------------------------------------------
-    def _build_loads(self) -> None:
+    def load_vector(self, load, value=None) -> np.ndarray:
+        """External force vector (n_dofs,) of one load (NodalForce, Pressure or Traction) with its value
+        replaced by ``value`` (default: its own)."""
+        from ..problem import NodalForce, Pressure
+
+        value = np.asarray(load.value if value is None else value, dtype=float)
         f = np.zeros((self.n_nodes, 3))
-        for load in self.problem.forces:
+        if isinstance(load, NodalForce):
             nodes = self.global_nodes(load.body, load.set)
-            value = np.asarray(load.value, dtype=float)
             if load.distribution == "total":
                 value = value / len(nodes)
             np.add.at(f, nodes, value[None, :])
-        for pr in self.problem.pressures:
-            mesh = self.problem.body(pr.body).mesh
-            faces = mesh.face_sets[pr.set]
-            off = self.offset(pr.body)
-            f[off: off + mesh.n_nodes] -= pr.value * face_load_vector(mesh.points, faces)
-        for tr in self.problem.tractions:
-            mesh = self.problem.body(tr.body).mesh
-            faces = mesh.face_sets[tr.set]
-            off = self.offset(tr.body)
-            f[off: off + mesh.n_nodes] += face_load_vector(mesh.points, faces, area_only=True) \
-                * np.asarray(tr.value, dtype=float)[None, :]
-        self.f_ext = f.ravel()
+            return f.ravel()
+        mesh = self.problem.body(load.body).mesh
+        faces = mesh.face_sets[load.set]
+        off = self.offset(load.body)
+        if isinstance(load, Pressure):
+            f[off: off + mesh.n_nodes] -= float(value.reshape(-1)[0]) * face_load_vector(mesh.points, faces)
+        else:
+            f[off: off + mesh.n_nodes] += face_load_vector(mesh.points, faces, area_only=True) * value[None, :]
+        return f.ravel()
+
+    def _build_loads(self) -> None:
+        f = np.zeros(self.n_dofs)
+        for load in [*self.problem.forces, *self.problem.pressures, *self.problem.tractions]:
+            f += self.load_vector(load)
+        self.f_ext = f
 
     # -- Dirichlet ------------------------------------------------------------------------------
     def _build_dirichlet(self) -> None:
-        value = {}
+        """The dofs of the first stage's Dirichlet conditions (their values: ``covcontact.solvers.stages``)."""
+        constrained = np.zeros(self.n_dofs, dtype=bool)
         for bc in self.problem.dirichlet:
             nodes = self.global_nodes(bc.body, bc.set)
-            for comp, val in zip(bc.components, bc.values):
-                for dof in 3 * nodes + comp:
-                    value[int(dof)] = float(val)
-        dofs = np.array(sorted(value), dtype=np.int64)
-        self.bc_dofs = dofs
-        self.bc_values = np.array([value[int(d)] for d in dofs], dtype=float)
-        self.constrained = np.zeros(self.n_dofs, dtype=bool)
-        self.constrained[dofs] = True
-        self.free = ~self.constrained
-        self._mask_cache: tuple | None = None
+            constrained[(3 * nodes[:, None] + np.asarray(bc.components)[None, :]).ravel()] = True
+        self.set_constraints(constrained)
 
-    def prescribed(self, lam: float) -> np.ndarray:
-        """Displacement vector that is zero on free dofs and lam * value on constrained ones."""
-        u = np.zeros(self.n_dofs)
-        u[self.bc_dofs] = lam * self.bc_values
-        return u
+    def set_constraints(self, constrained: np.ndarray) -> None:
+        """The dofs whose values are prescribed (a stage may free some)."""
+        self.constrained = np.asarray(constrained, dtype=bool).copy()
+        self.free = ~self.constrained
 
     # -- evaluation -----------------------------------------------------------------------------
     def new_state(self) -> list[dict[str, np.ndarray]]:

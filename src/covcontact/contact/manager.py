@@ -60,6 +60,7 @@ class ContactManager:
         self.timing = {"search": 0.0, "projection": 0.0}
         self._cache: list[_SearchCache | None] = [None] * len(self.passes)
         self._rigid: tuple[float, np.ndarray] | None = None
+        self.enabled = [True] * len(self.passes)  # pairs switched on (stages may switch them)
 
     # -- state ------------------------------------------------------------------------------------
     def initial_state(self) -> ContactState:
@@ -68,6 +69,25 @@ class ContactManager:
     def begin_step(self) -> None:
         """A new load step: search every pass from scratch at its first evaluation."""
         self._cache = [None] * len(self.passes)
+
+    def set_stage(self, motions: dict, pairs: dict[str, bool]) -> None:
+        """The rigid bodies' motions and the pairs switched on in the current stage."""
+        self.num.motions = dict(motions)
+        for p in self.passes:
+            if p.analytic is not None:
+                p.analytic.motion = motions[p.rigid]
+        self.enabled = [pairs.get(p.pair, True) for p in self.passes]
+        self._rigid = None
+        self.begin_step()
+
+    def switch(self, state: ContactState) -> ContactState:
+        """``state`` with the history of the passes switched off cleared (a pair switched on again starts
+        afresh)."""
+        out = state.copy()
+        for k, p in enumerate(self.passes):
+            if not self.enabled[k]:
+                out.passes[k] = PassState.empty(p.ns)
+        return out
 
     # -- positions --------------------------------------------------------------------------------
     def extended(self, x: np.ndarray, lam: float) -> np.ndarray:
@@ -94,6 +114,9 @@ class ContactManager:
         for k, p in enumerate(self.passes):
             c, g0 = committed.passes[k], guess.passes[k]
             t = PassState.empty(p.ns)
+            if not self.enabled[k]:
+                trial.passes.append(t)
+                continue
             t.multiplier = g0.multiplier.copy()
             t.n_aug = g0.n_aug
             pcase = p.case if case is None else case

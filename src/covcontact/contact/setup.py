@@ -36,6 +36,8 @@ class Pass:
     gap_tol: float = 0.0               # largest accepted penetration of the augmented method
     max_aug: int = 20
     global_index: np.ndarray | None = None  # distributed runs: positions of these slaves in the whole pass
+    pair: str = ""                     # the contact pair this pass belongs to
+    rigid: str = ""                    # the rigid body of an analytic master surface
 
     @property
     def ns(self) -> int:
@@ -62,6 +64,7 @@ class Numbering:
         self.N = system.n_nodes
         self.rigid_offset: dict[str, int] = {}
         self.rigid_meshes = []
+        self.motions = {rb.name: rb.motion for rb in problem.rigid}  # a stage replaces them
         n = self.N
         for rb in problem.rigid:
             if rb.mesh is not None:
@@ -84,8 +87,12 @@ class Numbering:
     def reference(self) -> np.ndarray:
         return np.vstack([self.system.X, self.X_rigid])
 
+    def motion(self, name: str):
+        """The motion of rigid body ``name`` in the current stage."""
+        return self.motions[name]
+
     def rigid_positions(self, lam: float) -> np.ndarray:
-        parts = [rb.motion.apply(rb.mesh.points, lam) for rb in self.rigid_meshes]
+        parts = [self.motions[rb.name].apply(rb.mesh.points, lam) for rb in self.rigid_meshes]
         return np.vstack(parts) if parts else np.zeros((0, 3))
 
     def material_E(self, body: str) -> float | None:
@@ -127,13 +134,13 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         eps = np.full(len(slaves), float(penalty))
     ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
     kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
-          "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations}
+          "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name}
     mmesh, moff = num.mesh_of(master[0])
     if mmesh is None:
         rb = next(r for r in num.problem.rigid if r.name == master[0])
         h = float(np.mean(facet_sizes(X, smesh.face_sets[slave[1]] + soff))) if slave[1] in smesh.face_sets \
             else 1.0
-        p = Pass(name, slaves, eps, area, analytic=analytic_surface(rb), **kw)
+        p = Pass(name, slaves, eps, area, analytic=analytic_surface(rb), rigid=rb.name, **kw)
     else:
         faces = mmesh.face_sets[master[1]] + moff
         h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)

@@ -209,6 +209,126 @@ def _split_ref(sec: Section, key: str, value: str) -> tuple[str, str]:
     return value, ""
 
 
+def _dirichlet_values(sec: Section, key: str, n: int) -> tuple:
+    """A Dirichlet value: one number for every component, or an array of one per component."""
+    if sec.has(key) and isinstance(sec.data[key], list):
+        return tuple(sec.get(key, "floats", length=n))
+    return (sec.get(key, "float", 0.0),) * n
+
+
+def _strs(sec: Section, key: str) -> tuple[str, ...]:
+    raw = sec.get(key, "any", [])
+    if not isinstance(raw, list) or not all(isinstance(v, str) for v in raw):
+        sec.fail("must be an array of names (strings)", key)
+    return tuple(raw)
+
+
+def _steps(sec: Section | None) -> Steps:
+    if sec is None:
+        return Steps.equal(1)
+    if sec.has("factors"):
+        factors = sec.get("factors", "floats")
+        sec.done()
+        if not factors or any(b <= a for a, b in zip((0.0,) + factors, factors)):
+            sec.fail("must be a non-empty, strictly increasing list of positive load factors", "factors")
+        return Steps(factors)
+    n = sec.get("count", "int", 1, positive=True)
+    final = sec.get("final", "float", 1.0, positive=True)
+    sec.done()
+    return Steps.equal(n, final)
+
+
+def _named(top: Section, dirichlet, forces, pressures, tractions) -> dict:
+    """Name -> (kind, object) of the named Dirichlet conditions and loads (one namespace)."""
+    named: dict = {}
+    for kind, items in (("dirichlet", dirichlet), ("force", forces), ("pressure", pressures),
+                        ("traction", tractions)):
+        for i, obj in enumerate(items):
+            if not obj.name:
+                continue
+            if obj.name in named:
+                top.fail(f"the name {obj.name!r} is used twice (by a {named[obj.name][0]} and a {kind}); names of "
+                         f"Dirichlet conditions and loads must differ", f"{kind}[{i}].name")
+            named[obj.name] = (kind, obj)
+    return named
+
+
+def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, first: str):
+    """One ``[[stages]]`` entry, checked against the conditions, loads, bodies and pairs it names."""
+    from ..problem import Stage
+
+    name = st.get("name", "str")
+    if name == first or any(x.name == name for x in earlier):
+        st.fail(f"duplicate stage name {name!r}", "name")
+    steps = _steps(st.get("steps", "table", None))
+    released_before = {n: x.name for x in earlier for n in x.release}
+
+    def check_name(sec: Section, key: str, value: str, kinds: tuple[str, ...], what: str) -> tuple[str, object]:
+        if value not in named or named[value][0] not in kinds:
+            known = sorted(n for n, (k, _) in named.items() if k in kinds)
+            sec.fail(f"no {what} named {value!r} (named ones: {', '.join(known) or 'none'})", key)
+        if value in released_before:
+            sec.fail(f"{value!r} was released in stage {released_before[value]!r}; a released condition "
+                     f"stays free", key)
+        return named[value]
+
+    release = _strs(st, "release")
+    for n in release:
+        check_name(st, "release", n, ("dirichlet",), "Dirichlet condition")
+    if len(set(release)) != len(release):
+        st.fail("names a condition twice", "release")
+    remove = _strs(st, "remove")
+    for n in remove:
+        check_name(st, "remove", n, ("force", "pressure", "traction"), "load")
+    targets = {}
+    tsec = st.get("targets", "table", None)
+    if tsec is not None:
+        for n in list(tsec.data):
+            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction"),
+                                   "Dirichlet condition or load")
+            if n in release or n in remove:
+                tsec.fail(f"{n!r} is {'released' if n in release else 'removed'} and given a target in the "
+                          f"same stage", n)
+            if kind == "dirichlet":
+                if obj.motion is not None:
+                    tsec.fail(f"{n!r} prescribes a motion; give it a new one in 'motions'", n)
+                targets[n] = _dirichlet_values(tsec, n, len(obj.components))
+            elif kind == "pressure":
+                targets[n] = tsec.get(n, "float")
+            else:
+                targets[n] = tsec.get(n, "vector")
+        tsec.done()
+    motions = {}
+    msec = st.get("motions", "table", None)
+    if msec is not None:
+        movable = {r.name for r in rigid} | {n for n, (k, o) in named.items() if k == "dirichlet"
+                                              and o.motion is not None}
+        for n in list(msec.data):
+            if n not in movable:
+                msec.fail(f"no rigid body or Dirichlet condition with a motion named {n!r} (known: "
+                          f"{', '.join(sorted(movable)) or 'none'})", n)
+            if n in named and n in {r.name for r in rigid}:
+                msec.fail(f"{n!r} names both a rigid body and a Dirichlet condition; rename one", n)
+            if n in release:
+                msec.fail(f"{n!r} is released and given a motion in the same stage", n)
+            if n in released_before:
+                msec.fail(f"{n!r} was released in stage {released_before[n]!r}; a released condition stays "
+                          f"free", n)
+            motions[n] = _motion(msec.get(n, "table"))
+        msec.done()
+    switch = {}
+    csec = st.get("contacts", "table", None)
+    if csec is not None:
+        pairs = {c.name for c in contacts}
+        for n in list(csec.data):
+            if n not in pairs:
+                csec.fail(f"no contact pair named {n!r} (known: {', '.join(sorted(pairs)) or 'none'})", n)
+            switch[n] = csec.get(n, "bool")
+        csec.done()
+    st.done()
+    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch)
+
+
 def load_problem(path: str | Path) -> Problem:
     """Parse and validate a problem file; raise InputError with a one-line message on any problem."""
     path = Path(path)
@@ -229,6 +349,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     meta = top.get("problem", "table")
     name = meta.get("name", "str")
     description = meta.get("description", "str", "")
+    meta_stage = meta.get("stage", "str", "stage1")
     meta.done()
 
     bodies: list[Body] = []
@@ -324,12 +445,18 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         comps = d.get("components", "str", "xyz")
         if not comps or any(c not in COMPONENTS for c in comps) or len(set(comps)) != len(comps):
             d.fail(f"must be a non-empty combination of x, y, z, got {comps!r}", "components")
-        if d.has("value") and isinstance(d.data["value"], list):
-            values = d.get("value", "floats", length=len(comps))
+        dname = d.get("name", "str", "")
+        motion = None
+        if d.has("motion"):
+            if d.has("value"):
+                d.fail("give either 'value' or 'motion', not both", "motion")
+            motion = _motion(d.get("motion", "table"))
+            values = (0.0,) * len(comps)
         else:
-            values = (d.get("value", "float", 0.0),) * len(comps)
+            values = _dirichlet_values(d, "value", len(comps))
         d.done()
-        dirichlet.append(Dirichlet(bname, sname, tuple(COMPONENTS[c] for c in comps), tuple(values)))
+        dirichlet.append(Dirichlet(bname, sname, tuple(COMPONENTS[c] for c in comps), tuple(values), dname,
+                                   motion))
 
     forces = []
     for f in top.get("force", "array", []):
@@ -337,24 +464,27 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         deformable(f, "set", bname)
         value = f.get("value", "vector")
         dist = f.get("distribution", "str", "per_node", choices=("per_node", "total"))
+        fname = f.get("name", "str", "")
         f.done()
-        forces.append(NodalForce(bname, sname, value, dist))
+        forces.append(NodalForce(bname, sname, value, dist, fname))
 
     pressures = []
     for p in top.get("pressure", "array", []):
         bname, sname = body_set(p, "set", "face")
         deformable(p, "set", bname)
         value = p.get("value", "float")
+        pname = p.get("name", "str", "")
         p.done()
-        pressures.append(Pressure(bname, sname, value))
+        pressures.append(Pressure(bname, sname, value, pname))
 
     tractions = []
     for t in top.get("traction", "array", []):
         bname, sname = body_set(t, "set", "face")
         deformable(t, "set", bname)
         value = t.get("value", "vector")
+        tname = t.get("name", "str", "")
         t.done()
-        tractions.append(Traction(bname, sname, value))
+        tractions.append(Traction(bname, sname, value, tname))
 
     contacts = []
     for i, c in enumerate(top.get("contact", "array", [])):
@@ -390,26 +520,21 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         two_pass = c.get("two_pass", "bool", False)
         mu = c.get("friction", "float", 0.0, nonnegative=True)
         eps_t = c.get("tangential_penalty", "float", None, positive=True)
+        enabled = c.get("enabled", "bool", True)
         c.done()
+        if any(x.name == cname for x in contacts):
+            c.fail(f"duplicate contact name {cname!r}", "name")
         contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass,
                                     friction=mu, tangential_penalty=eps_t, method=method, gap_tolerance=gap_tol,
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
-                                    auto_factor=auto_factor))
+                                    auto_factor=auto_factor, enabled=enabled))
 
-    steps_sec = top.get("steps", "table", None)
-    if steps_sec is None:
-        steps = Steps.equal(1)
-    elif steps_sec.has("factors"):
-        factors = steps_sec.get("factors", "floats")
-        steps_sec.done()
-        if not factors or any(b <= a for a, b in zip((0.0,) + factors, factors)):
-            steps_sec.fail("must be a non-empty, strictly increasing list of positive load factors", "factors")
-        steps = Steps(factors)
-    else:
-        n = steps_sec.get("count", "int", 1, positive=True)
-        final = steps_sec.get("final", "float", 1.0, positive=True)
-        steps_sec.done()
-        steps = Steps.equal(n, final)
+    steps = _steps(top.get("steps", "table", None))
+    named = _named(top, dirichlet, forces, pressures, tractions)
+    stage_name = meta_stage
+    stages = []
+    for st in top.get("stages", "array", []):
+        stages.append(_stage(st, named, dirichlet, rigid, contacts, stages, stage_name))
 
     s = top.get("solver", "table", None)
     solver = SolverOptions()
@@ -436,4 +561,4 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     top.done()
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
-                   output=output, source=path)
+                   output=output, source=path, stages=stages, stage_name=stage_name)

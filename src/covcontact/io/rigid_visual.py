@@ -68,7 +68,7 @@ def rigid_visual(manager, lam: float, fields) -> tuple:
     body_id = len(manager.problem.bodies)
     for rb in manager.problem.rigid:
         if rb.mesh is not None:
-            p = rb.motion.apply(rb.mesh.points, lam)
+            p = manager.num.motion(rb.name).apply(rb.mesh.points, lam)
             off = manager.num.rigid_offset[rb.name]
             sl = slice(off, off + rb.mesh.n_nodes)
             gaps.append(gap[sl])
@@ -85,7 +85,7 @@ def rigid_visual(manager, lam: float, fields) -> tuple:
             press.append(np.zeros(m))
             stats.append(np.full(m, -1.0))
             blocks.append(("quad4", quads + n, {"body_id": np.full(len(quads), body_id, dtype=float)}))
-            disp.append(rb.motion.apply(p, lam) - p)
+            disp.append(manager.num.motion(rb.name).apply(p, lam) - p)
         pts.append(p)
         n += len(p)
         body_id += 1

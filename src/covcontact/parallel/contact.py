@@ -38,6 +38,7 @@ class DistributedContact(ContactManager):
             local.append(dataclasses.replace(p, slaves=s[keep], eps=p.eps[keep], area=p.area[keep],
                                              eps_t=p.eps_t[keep], global_index=keep))
         self.passes = local
+        self.enabled = [True] * len(self.passes)
         self._cache = [None] * len(self.passes)
 
     # -- collective counterparts of the serial methods ------------------------------------------

@@ -10,6 +10,7 @@ residual is summed over the ranks into a replicated vector; the tangent stays di
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -19,6 +20,7 @@ from ..assembly.system import BodyBlock, InvertedElementError, System
 from ..elements.base import SolidStress
 from ..elements.solid import SolidBody
 from ..solvers.model import Model
+from ..solvers.stages import StagePlan
 from ..solvers.state import State
 from .comm import gather_all, share_cores, sum_all
 from .partition import DofLayout, node_owners, rcb
@@ -199,10 +201,15 @@ class DistributedSystem(System):
         self.layout = DofLayout.from_owners(self.owner, rank, size, self.X)
         self._build_loads()
         self._build_dirichlet()
-        touched = np.zeros(self.n_nodes, dtype=bool)
+        self._touched = np.zeros(self.n_nodes, dtype=bool)
         for c in local_cells:
-            touched[c.ravel()] = True
-        self.structure = Structure(self.pattern, touched, self.constrained, self.layout)
+            self._touched[c.ravel()] = True
+        self.structure = Structure(self.pattern, self._touched, self.constrained, self.layout)
+
+    def set_constraints(self, constrained: np.ndarray) -> None:
+        super().set_constraints(constrained)
+        if hasattr(self, "structure"):  # a later stage freed dofs: the elimination structure follows
+            self.structure = Structure(self.pattern, self._touched, self.constrained, self.layout)
 
     def local_internal(self, u: np.ndarray, committed: list[dict], guess: list[dict], want_K: bool = True):
         """This rank's share of the internal forces (n_dofs,), tangent data (pattern.nnz,) or None, and the
@@ -266,6 +273,8 @@ class DistributedModel(Model):
 
         self.contact = DistributedContact(problem, self.system, tangent, comm)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
+        self.stages = StagePlan(problem, self.system)
+        self.set_stage(State([], None))
 
     @property
     def is_root(self) -> bool:  # type: ignore[override]
@@ -297,7 +306,7 @@ class DistributedModel(Model):
         if want_K:
             sysm = self.system
             K = DistMatrix(self.comm, sysm.structure, sysm.pattern.csr(data), Kc, sysm.constrained)
-        return r - lam * self.f_ext, K, State(etrial, ctrial, committed.stage, committed.step, lam)
+        return r - self.external(lam), K, replace(committed, elements=etrial, contact=ctrial, lam=lam)
 
     def eliminate(self, K):
         return self.system.eliminate(K)

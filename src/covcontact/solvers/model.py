@@ -13,6 +13,7 @@ import numpy as np
 from ..assembly.system import System
 from ..contact.assembly import CouplingPattern
 from ..contact.manager import ContactManager
+from .stages import Loading, StagePlan
 from .state import State
 
 
@@ -35,6 +36,31 @@ class Model:
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
         blocks = [body.mesh.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies)]
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
+        self.stages = StagePlan(problem, self.system)
+        self.set_stage(State([], None))
+
+    # stages -----------------------------------------------------------------------------------
+    def set_stage(self, state: State) -> None:
+        """Prescribe what ``state``'s stage prescribes (after a stage change or a resume)."""
+        spec = self.stages[state.stage]
+        self.loading = Loading(spec, self.system.X, state.forces.get("release"), state.forces.get("held"))
+        self.system.set_constraints(spec.constrained)
+        self.contact.set_stage(spec.motions, spec.contacts)
+
+    def enter_stage(self, u: np.ndarray, committed: State) -> State:
+        """The committed state at the start of the next stage, which is then prescribed: the reactions of
+        the conditions it releases become forces, pairs switched off lose their history."""
+        spec = self.stages[committed.stage + 1]
+        forces = {}
+        held = self.loading.left_over()
+        if spec.released.size or np.any(held):
+            R, _, _ = self.evaluate(u, committed.lam, committed, want_K=False)
+            release = np.zeros(self.n_dofs)
+            release[spec.released] = R[spec.released]
+            forces = {"release": release, "held": held}
+        new = committed.but(stage=committed.stage + 1, lam=0.0, forces=forces)
+        self.set_stage(new)
+        return new.but(contact=self.contact.switch(new.contact))
 
     # delegation -------------------------------------------------------------------------------
     @property
@@ -50,7 +76,12 @@ class Model:
         return self.system.n_dofs
 
     def prescribed(self, lam: float) -> np.ndarray:
-        return self.system.prescribed(lam)
+        """Displacements on the constrained dofs at load factor lam of the current stage (0 elsewhere)."""
+        return self.loading.prescribed(lam)
+
+    def external(self, lam: float) -> np.ndarray:
+        """External forces at load factor lam of the current stage."""
+        return self.loading.external(lam)
 
     def eliminate(self, K):
         return self.system.eliminate(K)
@@ -75,18 +106,17 @@ class Model:
     def start_step(self, committed: State) -> State:
         """The trial a new load step starts from."""
         self.begin_step()
-        return State(committed.elements, self.contact.start_step(committed.contact), committed.stage,
-                     committed.step, committed.lam)
+        return committed.but(contact=self.contact.start_step(committed.contact))
 
     def augment(self, trial: State) -> State | None:
         """One Uzawa update of the augmented-Lagrangian pairs: the new trial, or None when none is needed."""
         c = self.contact.augment(trial.contact)
-        return None if c is None else State(trial.elements, c, trial.stage, trial.step, trial.lam)
+        return None if c is None else trial.but(contact=c)
 
     # evaluation -------------------------------------------------------------------------------
     def evaluate(self, u: np.ndarray, lam: float, committed: State, guess: State | None = None,
                  want_K: bool = True, timing: dict | None = None):
-        """Residual R = f_int + f_contact - lam f_ext, its tangent (CSR or None) and the trial state.
+        """Residual R = f_int + f_contact - f_ext(lam), its tangent (CSR or None) and the trial state.
 
         ``committed`` gives the history, ``guess`` (default ``committed``) the starting point of the local
         iterations (EAS parameters, contact points, Uzawa multipliers). Neither is changed.
@@ -105,7 +135,7 @@ class Model:
         if timing is not None:
             timing["assembly"] += t2 - t1
             timing["contact"] += (t1 - t0) + (t3 - t2)
-        return r - lam * self.f_ext, K, State(etrial, ctrial, committed.stage, committed.step, lam)
+        return r - self.external(lam), K, committed.but(elements=etrial, contact=ctrial, lam=lam)
 
     # queries on a state -----------------------------------------------------------------------
     def active_count(self, state: State) -> int:

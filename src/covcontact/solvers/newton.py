@@ -123,7 +123,7 @@ class Newton:
         K = m.eliminate(K)
         self.timing["bc"] += time.perf_counter() - t0
         r0 = float(np.linalg.norm(rhs))
-        scale = max(float(np.linalg.norm(lam_b * m.f_ext)), float(np.linalg.norm(R)), r0, 1e-300)
+        scale = max(float(np.linalg.norm(m.external(lam_b))), float(np.linalg.norm(R)), r0, 1e-300)
         out.residual_norms.append(r0)
         out.records.append(IterationRecord(0, r0, 0.0, m.active_count(trial)))
         if r0 <= opt.atol * scale and not np.any(du_d):

@@ -33,9 +33,13 @@ class Result:
 
 
 def _reactions(model: Model, u: np.ndarray, lam: float, state) -> dict:
+    """The resultant reaction of every Dirichlet condition in force (released ones are left out)."""
     R, _, _ = model.evaluate(u, lam, state, want_K=False)
     out = {}
-    for bc in model.problem.dirichlet:
+    held = {c.name for c in model.loading.spec.conditions}
+    for i, bc in enumerate(model.problem.dirichlet):
+        if (bc.name or f"#{i}") not in held:
+            continue
         nodes = model.system.global_nodes(bc.body, bc.set)
         total = R.reshape(-1, 3)[nodes].sum(axis=0)
         comp = np.zeros(3, dtype=bool)
@@ -44,7 +48,8 @@ def _reactions(model: Model, u: np.ndarray, lam: float, state) -> dict:
     return out
 
 
-def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, step: int, state) -> None:
+def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, step: int, state,
+               time_value: float | None = None) -> None:
     sysm = model.system
     U = u.reshape(-1, 3)
     n = sysm.n_nodes
@@ -71,7 +76,7 @@ def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, st
             pdata[key] = np.concatenate([arr, pad])
         for ctype, conn, cd in extra_blocks:
             blocks.append((ctype, conn + n, cd))
-    writer.write_vtu(step, lam, points, blocks, pdata)
+    writer.write_vtu(step, lam if time_value is None else time_value, points, blocks, pdata)
 
 
 class _NoWriter:
@@ -187,72 +192,116 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         t0 = time.perf_counter()
         _write_vtu(writer, model, u, 0.0, 0, state)
         t_out += time.perf_counter() - t0
-    nsteps = len(problem.steps.factors)
+    plan = model.stages
+    nsteps = sum(len(spec.factors) for spec in plan.stages)
+    staged = len(plan) > 1
+    if resume:
+        model.set_stage(state)
     status = "completed"
     code = 0
     work_before = model.plastic_work(state)  # plastic work of the committed state (collective)
     with StopSignals(enabled=size == 1) as stops:
         try:
-            for k in range(state.step + 1, nsteps + 1):
-                lam = problem.steps.factors[k - 1]
-                success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
-                conv = [o for o in outcomes if o.converged]
-                iters = sum(o.iterations for o in outcomes)
-                entry = {
-                    "step": k,
-                    "load_factor": lam,
-                    "converged": success,
-                    "iterations": iters,
-                    "residual_norms": [r / max(o.residual_norms[0], 1e-300) for o in conv[-1:]
-                                       for r in o.residual_norms] if conv else [],
-                    "cutbacks": cutbacks,
-                }
-                if any(c.method == "augmented" for c in problem.contacts):
-                    entry["uzawa_iterations"] = sum(1 for o in outcomes if o.augmentation > 0)
-                if cutbacks:
-                    entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
-                if success:
-                    work = model.plastic_work(new)
-                    if work is not None:
-                        entry["plastic_dissipation"] = work - work_before
-                        entry["plastic_work"] = work_before = work
-                    state = new
-                    state.step = k
-                    entry.update(model.step_report(u, lam, state))
-                    entry["reactions"] = _reactions(model, u, lam, state)
-                else:
-                    entry["failure"] = why
-                with stops.critical():
-                    summary["steps"].append(entry)
-                    summary["total_iterations"] += iters
-                    writer.add_iterations(k, [r for o in outcomes for r in o.records])
+            for si in range(state.stage, len(plan)):
+                spec = plan[si]
+                before = sum(len(q.factors) for q in plan.stages[:si])  # steps of the earlier stages
+                t_stage = sum(q.lam_end for q in plan.stages[:si])    # their total pseudo-time
+                if si > state.stage:
+                    state = model.enter_stage(u, state)
+                    newton.linear.set_near_null_space(model.near_null_space())
                     if not quiet:
-                        rn = conv[-1].residual_norms[-1] if conv else float("nan")
-                        msg = (f"step {k:4d}/{nsteps}  lambda {lam:.4g}  iterations {iters:3d}  residual {rn:.2e}"
-                               f"  active {model.active_count(state):5d}"
-                               + (f"  cutbacks {cutbacks}" if cutbacks else ""))
-                        say(msg + (f"  FAILED: {why}" if not success else ""))
-                    if not success:
-                        status, code = "failed", 1
-                        break
-                    if problem.output.vtu and (k % problem.output.every == 0 or k == nsteps):
-                        t0 = time.perf_counter()
-                        _write_vtu(writer, model, u, lam, k, state)
-                        t_out += time.perf_counter() - t0
-                    summary["wall_time_s"] = t_before + time.perf_counter() - t_start
-                    writer.write_summary(summary)
-                    if k % problem.output.checkpoint_every == 0 or k == nsteps:
-                        checkpoint.save(out, u, state.arrays(),
-                                        {"problem_hash": problem_hash, "summary": json.loads(
-                                            json.dumps(summary, default=_jsonable)),
-                                         "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"]},
-                                        rank, size)
+                        say(f"stage {si + 1}/{len(plan)} {spec.name!r}"
+                            + (f": releasing {', '.join(spec.release_names)}" if spec.release_names else ""))
+                if staged:
+                    _stage_entry(summary, spec)
+                for k in range(state.step + 1, before + len(spec.factors) + 1):
+                    lam = spec.factors[k - before - 1]
+                    success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
+                    conv = [o for o in outcomes if o.converged]
+                    iters = sum(o.iterations for o in outcomes)
+                    entry = {
+                        "step": k,
+                        "load_factor": lam,
+                        "converged": success,
+                        "iterations": iters,
+                        "residual_norms": [r / max(o.residual_norms[0], 1e-300) for o in conv[-1:]
+                                           for r in o.residual_norms] if conv else [],
+                        "cutbacks": cutbacks,
+                    }
+                    if staged:
+                        entry["stage"] = spec.name
+                        entry["time"] = t_stage + lam
+                    if any(c.method == "augmented" for c in problem.contacts):
+                        entry["uzawa_iterations"] = sum(1 for o in outcomes if o.augmentation > 0)
+                    if cutbacks:
+                        entry["cutback_reasons"] = [o.reason for o in outcomes if not o.converged]
+                    if success:
+                        work = model.plastic_work(new)
+                        if work is not None:
+                            entry["plastic_dissipation"] = work - work_before
+                            entry["plastic_work"] = work_before = work
+                        state = new
+                        state.step = k
+                        entry.update(model.step_report(u, lam, state))
+                        entry["reactions"] = _reactions(model, u, lam, state)
+                    else:
+                        entry["failure"] = why
+                    with stops.critical():
+                        summary["steps"].append(entry)
+                        summary["total_iterations"] += iters
+                        if staged:
+                            _stage_add(summary, entry)
+                        writer.add_iterations(k, [r for o in outcomes for r in o.records])
+                        if not quiet:
+                            rn = conv[-1].residual_norms[-1] if conv else float("nan")
+                            msg = ((f"stage {spec.name}  " if staged else "")
+                                   + f"step {k:4d}/{nsteps}  lambda {lam:.4g}  iterations {iters:3d}  "
+                                   f"residual {rn:.2e}  active {model.active_count(state):5d}"
+                                   + (f"  cutbacks {cutbacks}" if cutbacks else ""))
+                            say(msg + (f"  FAILED: {why}" if not success else ""))
+                        if not success:
+                            status, code = "failed", 1
+                            break
+                        last = k == before + len(spec.factors)
+                        if problem.output.vtu and (k % problem.output.every == 0 or k == nsteps or last):
+                            t0 = time.perf_counter()
+                            _write_vtu(writer, model, u, lam, k, state, t_stage + lam)
+                            t_out += time.perf_counter() - t0
+                        summary["wall_time_s"] = t_before + time.perf_counter() - t_start
+                        writer.write_summary(summary)
+                        if k % problem.output.checkpoint_every == 0 or k == nsteps or last:
+                            checkpoint.save(out, u, state.arrays(),
+                                            {"problem_hash": problem_hash, "summary": json.loads(
+                                                json.dumps(summary, default=_jsonable)),
+                                             "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"]},
+                                            rank, size)
+                if status == "failed":
+                    break
         except Interrupted as stop:
             status, code = "interrupted", stop.exit_code
             say(f"{stop}: the step in flight is dropped; resume with --resume")
         with stops.critical():
             _finish(problem, model, newton, summary, status, t_before, t_start, t_out, writer, root, quiet, say, out)
     return Result(summary=summary, u=u, out=out, exit_code=code, model=model, state=state)
+
+
+def _stage_entry(summary: dict, spec) -> None:
+    """The totals of stage ``spec`` in the summary (created when the stage starts; kept on a resume)."""
+    stages = summary.setdefault("stages", [])
+    if not any(st["name"] == spec.name for st in stages):
+        stages.append({"name": spec.name, "index": spec.index, "steps": 0, "iterations": 0, "cutbacks": 0,
+                       "converged": False, "released": list(spec.release_names)})
+
+
+def _stage_add(summary: dict, entry: dict) -> None:
+    st = next(s for s in summary["stages"] if s["name"] == entry["stage"])
+    st["steps"] += 1 if entry["converged"] else 0
+    st["iterations"] += entry["iterations"]
+    st["cutbacks"] += entry["cutbacks"]
+    st["converged"] = entry["converged"]
+    for key in ("plastic_dissipation",):
+        if key in entry:
+            st[key] = st.get(key, 0.0) + entry[key]
 
 
 def _finish(problem, model, newton, summary, status, t_before, t_start, t_out, writer, root, quiet, say, out):

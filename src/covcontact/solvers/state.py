@@ -6,7 +6,7 @@ others are *trials* (what an evaluation produced). See docs/theory.md section 10
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -16,18 +16,25 @@ from ..contact.state import ContactState
 @dataclass
 class State:
     """elements: per body, named arrays (solid-shells: ``alpha``, the EAS parameters per element);
-    contact: the contact state of every pass; stage, step, lam: the stage and the step (1-based, 0 before
-    the first) that the state closes and its load factor."""
+    contact: the contact state of every pass; stage (0-based), step, lam: the stage, the step (1-based over
+    the whole analysis, 0 before the first) that the state closes and its load factor within the stage;
+    forces: the stage's released reactions ``release`` and the forces ``held`` from earlier stages, (n_dofs,)
+    each, absent before a stage released anything (``covcontact.solvers.stages``)."""
 
     elements: list[dict[str, np.ndarray]]
     contact: ContactState
     stage: int = 0
     step: int = 0
     lam: float = 0.0
+    forces: dict[str, np.ndarray] = field(default_factory=dict)
 
     def copy(self) -> State:
         return State([{k: v.copy() for k, v in e.items()} for e in self.elements], self.contact.copy(),
-                     self.stage, self.step, self.lam)
+                     self.stage, self.step, self.lam, {k: v.copy() for k, v in self.forces.items()})
+
+    def but(self, **changes) -> State:
+        """This state with some fields replaced (the arrays of the others shared, not copied)."""
+        return replace(self, **changes)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Every array of the state under a flat name (for checkpoints)."""
@@ -36,6 +43,7 @@ class State:
         out["step.stage"] = np.array(self.stage)
         out["step.step"] = np.array(self.step)
         out["step.lam"] = np.array(self.lam)
+        out.update({f"forces.{k}": v for k, v in self.forces.items()})
         return out
 
     @classmethod
@@ -52,4 +60,6 @@ class State:
         for p, q in zip(contact.passes, like.contact.passes):
             if p.gap.shape != q.gap.shape:
                 raise ValueError("the contact state does not match the problem's slave sets")
-        return cls(elements, contact, int(data["step.stage"]), int(data["step.step"]), float(data["step.lam"]))
+        forces = {k[len("forces."):]: np.array(data[k]) for k in data if k.startswith("forces.")}
+        return cls(elements, contact, int(data["step.stage"]), int(data["step.step"]), float(data["step.lam"]),
+                   forces)

@@ -1,0 +1,206 @@
+"""What each stage of an analysis prescribes: Dirichlet values and motions, loads, rigid motions, pairs.
+
+The first stage is the problem itself (every quantity goes from 0 at lam = 0 to its value at lam = 1,
+rigid motions as given); each later ``covcontact.problem.Stage`` starts where the one before ended and
+changes what it names (docs/theory.md section 13):
+
+- a Dirichlet condition with a value goes linearly from its value at the start of the stage to its target;
+  one with a motion follows the stage's motion from the pose the earlier stages left; a condition the stage
+  does not mention holds its value (or pose);
+- a released condition frees its dofs; the reaction r it carried at the start of the stage is applied as
+  the force max(0, 1 - lam) r (the support is withdrawn gradually); what is left of it at the end of the
+  stage (a stage ending before lam = 1) is held as a constant force in the stages after;
+- a load goes linearly from its start value to its target (``remove``: 0);
+- a rigid body follows its new motion from its pose at the start of the stage, or stands still;
+- contact pairs are on or off for the whole stage.
+
+Everything here is a function of the problem and the stage index, except the released reactions, which
+belong to the solution and travel in the committed state (``State.forces``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..motion import RigidMotion, StagedMotion
+
+
+@dataclass
+class _Condition:
+    """One Dirichlet condition in one stage: its dofs and how they move."""
+
+    name: str
+    nodes: np.ndarray            # global node numbers
+    components: tuple[int, ...]
+    start: np.ndarray | None     # (ncomp,) value at lam = 0 (value conditions)
+    target: np.ndarray | None    # (ncomp,) value at lam = 1
+    motion: object = None        # RigidMotion / StagedMotion (motion conditions)
+
+    @property
+    def dofs(self) -> np.ndarray:
+        return (3 * self.nodes[:, None] + np.asarray(self.components)[None, :]).ravel()
+
+    def values(self, X: np.ndarray, lam: float) -> np.ndarray:
+        """Prescribed displacement of ``dofs`` at lam (X: reference positions of all nodes)."""
+        if self.motion is None:
+            v = self.start + lam * (self.target - self.start)
+            return np.tile(v, len(self.nodes))
+        Xn = X[self.nodes]
+        return (self.motion.apply(Xn, lam) - Xn)[:, list(self.components)].ravel()
+
+    def end(self, lam_end: float) -> tuple:
+        """(start value, pose) this condition leaves for the next stage."""
+        if self.motion is None:
+            return self.start + lam_end * (self.target - self.start), None
+        return None, self.motion.pose(lam_end)
+
+
+@dataclass
+class StageSpec:
+    """Stage ``index`` (0: the problem's own first stage) resolved against the problem."""
+
+    index: int
+    name: str
+    factors: tuple[float, ...]
+    conditions: list[_Condition]
+    released: np.ndarray                   # dofs freed at the start of this stage
+    load_start: np.ndarray                 # (n_dofs,) external load at lam = 0
+    load_target: np.ndarray                # (n_dofs,) at lam = 1
+    motions: dict[str, object]             # rigid body name -> motion in this stage
+    contacts: dict[str, bool]              # pair name -> on
+    release_names: tuple[str, ...] = ()
+    constrained: np.ndarray = field(default=None, repr=False)
+
+    @property
+    def lam_end(self) -> float:
+        return self.factors[-1]
+
+
+class StagePlan:
+    """Every stage of a problem, resolved once (docs/theory.md section 13)."""
+
+    def __init__(self, problem, system):
+        self.problem = problem
+        self.system = system
+        n_dofs = system.n_dofs
+        loads = {}   # name -> (vector of the load at value 1 per component: a function value -> (n_dofs,))
+        values = {}  # load name -> current value (np.ndarray)
+        all_loads = [("force", f) for f in problem.forces] + [("pressure", p) for p in problem.pressures] \
+            + [("traction", t) for t in problem.tractions]
+        for i, (kind, load) in enumerate(all_loads):
+            key = load.name or f"#{i}"
+            loads[key] = load
+            values[key] = np.zeros_like(np.atleast_1d(np.asarray(load.value, dtype=float)))
+        targets = {k: np.atleast_1d(np.asarray(ld.value, dtype=float)) for k, ld in loads.items()}
+
+        conds: list[_Condition] = []
+        for i, bc in enumerate(problem.dirichlet):
+            nodes = system.global_nodes(bc.body, bc.set)
+            if bc.motion is not None:
+                conds.append(_Condition(bc.name or f"#{i}", nodes, bc.components, None, None, bc.motion))
+            else:
+                zero = np.zeros(len(bc.components))
+                conds.append(_Condition(bc.name or f"#{i}", nodes, bc.components, zero,
+                                        np.asarray(bc.values, dtype=float)))
+        motions = {rb.name: rb.motion for rb in problem.rigid}
+        contacts = {c.name: bool(c.enabled) for c in problem.contacts}
+        self.stages: list[StageSpec] = []
+        self.stages.append(self._spec(0, problem.stage_name, problem.steps.factors, conds, np.zeros(0, np.int64),
+                                      loads, values, targets, motions, contacts, ()))
+        for k, st in enumerate(problem.stages, start=1):
+            prev = self.stages[-1]
+            lam_end = prev.lam_end
+            # what the stage before left
+            new_conds = []
+            released = []
+            for c in prev.conditions:
+                if c.name in st.release:
+                    released.append(c.dofs)
+                    continue
+                start, pose = c.end(lam_end)
+                if c.motion is None:
+                    target = np.asarray(st.targets.get(c.name, start), dtype=float)
+                    if target.shape != start.shape:
+                        target = np.broadcast_to(target, start.shape).astype(float)
+                    new_conds.append(_Condition(c.name, c.nodes, c.components, start, target))
+                else:
+                    m = st.motions.get(c.name)
+                    nm = StagedMotion(m, *pose) if m is not None else StagedMotion.hold(*pose)
+                    new_conds.append(_Condition(c.name, c.nodes, c.components, None, None, nm))
+            values = {key: values[key] + lam_end * (targets[key] - values[key]) for key in loads}
+            targets = dict(values)
+            for key in loads:
+                if key in st.remove:
+                    targets[key] = np.zeros_like(values[key])
+                elif key in st.targets:
+                    targets[key] = np.broadcast_to(np.asarray(st.targets[key], dtype=float),
+                                                   values[key].shape).astype(float)
+            new_motions = {}
+            for name, m in prev.motions.items():
+                pose = m.pose(lam_end)
+                nm = st.motions.get(name)
+                new_motions[name] = StagedMotion(nm, *pose) if nm is not None else StagedMotion.hold(*pose)
+            new_contacts = dict(prev.contacts)
+            new_contacts.update({k2: bool(v) for k2, v in st.contacts.items()})
+            rel = np.unique(np.concatenate(released)) if released else np.zeros(0, np.int64)
+            self.stages.append(self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
+                                          new_motions, new_contacts, tuple(st.release)))
+        self.n_dofs = n_dofs
+
+    def _spec(self, index, name, factors, conds, released, loads, start, target, motions, contacts, names):
+        sysm = self.system
+        f0 = np.zeros(sysm.n_dofs)
+        f1 = np.zeros(sysm.n_dofs)
+        for key, load in loads.items():
+            f0 += sysm.load_vector(load, start[key])
+            f1 += sysm.load_vector(load, target[key])
+        constrained = np.zeros(sysm.n_dofs, dtype=bool)
+        for c in conds:
+            constrained[c.dofs] = True
+        released = released[~constrained[released]] if released.size else released
+        return StageSpec(index, name, tuple(factors), conds, released, f0, f1, motions, contacts, names,
+                         constrained)
+
+    def __len__(self) -> int:
+        return len(self.stages)
+
+    def __getitem__(self, k: int) -> StageSpec:
+        return self.stages[k]
+
+
+class Loading:
+    """The prescribed displacements and external forces of one stage as functions of its load factor."""
+
+    def __init__(self, spec: StageSpec, X: np.ndarray, release: np.ndarray | None = None,
+                 held: np.ndarray | None = None):
+        self.spec = spec
+        self.X = X
+        n = len(spec.load_start)
+        self.release = np.zeros(n) if release is None else release
+        self.held = np.zeros(n) if held is None else held
+        self.constrained = spec.constrained
+        self.free = ~spec.constrained
+        self._dofs = [c.dofs for c in spec.conditions]
+        self._has_motion = any(c.motion is not None for c in spec.conditions)
+
+    def prescribed(self, lam: float) -> np.ndarray:
+        """Displacement vector: zero on free dofs, the conditions' values on constrained ones (later
+        conditions win where sets overlap)."""
+        u = np.zeros(len(self.constrained))
+        for c, dofs in zip(self.spec.conditions, self._dofs):
+            u[dofs] = c.values(self.X, lam)
+        return u
+
+    def external(self, lam: float) -> np.ndarray:
+        """External force vector at lam: loads, the released reactions' ramp, the held forces."""
+        s = self.spec
+        f = s.load_start + lam * (s.load_target - s.load_start)
+        if s.released.size or np.any(self.held):
+            f = f + max(0.0, 1.0 - lam) * self.release + self.held
+        return f
+
+    def left_over(self) -> np.ndarray:
+        """The held force the stages after this one inherit: what the ramp has not removed at its end."""
+        return self.held + max(0.0, 1.0 - self.spec.lam_end) * self.release
