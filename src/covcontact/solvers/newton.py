@@ -7,7 +7,8 @@ remaining iterations are plain Newton with homogeneous Dirichlet conditions. Con
 
 - ``"residual"`` (default): ||R_k|| <= max(rtol * max(||R_0||, ||R_1||), atol * F), with R_0 the
   predictor's right-hand side (for a load step: the load increment), R_1 the out-of-balance after the
-  predictor and F a force scale of the step (loads, reactions);
+  predictor and F a force scale of the step (loads, reactions) or, when larger, the largest of the
+  steps before (a body unloaded by a later stage has no forces of its own to measure round-off against);
 - ``"energy"``: |du_k . R_(k-1)| <= etol * |du_1 . R_0| (the energy norm of FEAP-like codes; it measures
   the residual of the previous iteration, so it needs one iteration more than the residual test);
 - ``"both"``: both.
@@ -64,6 +65,7 @@ class Newton:
         self.opt = options
         self.linear = make_solver(linear or options.linear, symmetric=model.symmetric)
         self.linear.set_near_null_space(model.near_null_space())  # rigid-body modes (AMG only)
+        self.scale_seen = 0.0  # the largest force scale of the converged steps so far
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0}
 
     # ------------------------------------------------------------------------------------------
@@ -123,7 +125,8 @@ class Newton:
         K = m.eliminate(K)
         self.timing["bc"] += time.perf_counter() - t0
         r0 = float(np.linalg.norm(rhs))
-        scale = max(float(np.linalg.norm(m.external(lam_b))), float(np.linalg.norm(R)), r0, 1e-300)
+        scale = max(float(np.linalg.norm(m.external(lam_b))), float(np.linalg.norm(R)), r0, self.scale_seen,
+                    1e-300)
         out.residual_norms.append(r0)
         out.records.append(IterationRecord(0, r0, 0.0, m.active_count(trial)))
         if r0 <= opt.atol * scale and not np.any(du_d):
@@ -164,6 +167,7 @@ class Newton:
             conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
             if conv or floor:
                 out.converged = True
+                self.scale_seen = max(self.scale_seen, scale_k)
                 return out, trial
         out.reason = f"no convergence in {opt.max_iterations} iterations"
         return out, trial

@@ -186,6 +186,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                                                  f"start again without --resume")
         summary = meta["summary"]
         t_before = float(meta.get("wall_time_s", 0.0))
+        newton.scale_seen = float(meta.get("force_scale", 0.0))
         writer.restore(meta["pvd"], state.step)
         say(f"resuming {problem.name} after step {state.step} (load factor {state.lam:.4g})")
     elif problem.output.vtu:
@@ -273,7 +274,8 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                             checkpoint.save(out, u, state.arrays(),
                                             {"problem_hash": problem_hash, "summary": json.loads(
                                                 json.dumps(summary, default=_jsonable)),
-                                             "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"]},
+                                             "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"],
+                                             "force_scale": newton.scale_seen},
                                             rank, size)
                 if status == "failed":
                     break

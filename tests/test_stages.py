@@ -1,0 +1,370 @@
+"""Staged analyses (docs/theory.md section 13): each stage continues from the end of the one before.
+
+Closed forms used here:
+- a released Dirichlet condition hands its reaction r to a force (1 - lam) r: on an elastic body the
+  reaction of the remaining supports falls linearly to zero and the body returns to its reference shape;
+- uniaxial tension in logarithmic strain with linear hardening (as in
+  tests/verification/test_plasticity_problems.py): loaded to eps = ln(1 + s), the equivalent plastic strain
+  is alpha = eps - tau / E with tau = E (sigma_y0 + H eps) / (E + H); released, the elastic stretch goes
+  back to 1 (the unloading is elastic), so the bar keeps the length exp(alpha) and the cross-section
+  stretch exp(-alpha / 2) (isochoric plastic flow);
+- a node set moved by a rigid motion lands where the motion puts it.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from covcontact.io.loader import load_problem
+from covcontact.io.validate import InputError
+from covcontact.solvers import run as run_module
+from covcontact.solvers.signals import Interrupted
+
+E, NU, SY0, H = 200.0, 0.3, 0.4, 2.0
+S = 0.2  # end displacement of the unit-length bar
+
+BAR = """
+[problem]
+name = "bar"
+stage = "pull"
+
+[[bodies]]
+name = "bar"
+formulation = "FORM"
+material = MATERIAL
+mesh = {{ generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 1, nz = 1 }}
+
+[[dirichlet]]
+name = "left"
+set = "bar.xmin"
+components = "x"
+
+[[dirichlet]]
+set = "bar.ymin"
+components = "y"
+
+[[dirichlet]]
+set = "bar.zmin"
+components = "z"
+
+[[dirichlet]]
+name = "pull"
+set = "bar.xmax"
+components = "x"
+value = {s}
+
+[solver]
+rtol = 1.0e-12
+
+[steps]
+count = 4
+"""
+
+J2 = f'{{ model = "j2", E = {E}, nu = {NU}, yield_stress = {SY0}, hardening = {{ law = "linear", modulus = {H} }} }}'
+SVK = f'{{ model = "neo-hooke", E = {E}, nu = {NU} }}'
+
+
+def _problem(tmp_path: Path, stages: str, material: str = J2, form: str = "fbar", s: float = S, name="p"):
+    text = BAR.format(s=s).replace("MATERIAL", material).replace("FORM", form) + stages
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text)
+    return load_problem(path)
+
+
+def _final_points(out: Path) -> tuple[np.ndarray, np.ndarray]:
+    vtus = sorted(out.glob("step_*.vtu"))
+    m = meshio.read(vtus[-1])
+    return m.points + m.point_data["displacement"], m.points
+
+
+RELEASE = """
+[[stages]]
+name = "release"
+steps = { count = 3 }
+release = ["pull"]
+"""
+
+
+def test_release_of_an_elastic_bar_ramps_the_reaction_to_zero(tmp_path):
+    problem = _problem(tmp_path, RELEASE, SVK, "solid")
+    res = problem.run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    assert [s["stage"] for s in steps] == ["pull"] * 4 + ["release"] * 3
+    r0 = steps[3]["reactions"]["bar.xmin"][0]
+    assert r0 < 0.0
+    for k, lam in zip((4, 5, 6), (1 / 3, 2 / 3, 1.0)):
+        assert "bar.xmax" not in steps[k]["reactions"]  # released: no reaction any more
+        assert steps[k]["reactions"]["bar.xmin"][0] == pytest.approx((1.0 - lam) * r0, rel=1e-9, abs=1e-11)
+    x, X = _final_points(tmp_path / "out")
+    np.testing.assert_allclose(x, X, atol=1e-10)  # elastic: back to the reference shape
+    st = {s["name"]: s for s in res.summary["stages"]}
+    assert st["pull"]["steps"] == 4 and st["release"]["steps"] == 3 and st["release"]["released"] == ["pull"]
+    # output numbering continues across stages and the PVD times increase
+    assert len(list((tmp_path / "out").glob("step_*.vtu"))) == 8
+    times = [s["time"] for s in steps]
+    assert times == sorted(times) and times[-1] == pytest.approx(2.0)
+
+
+def test_springback_of_a_plastic_bar_keeps_the_plastic_stretch(tmp_path):
+    problem = _problem(tmp_path, RELEASE)
+    res = problem.run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    eps = np.log(1.0 + S)
+    tau = E * (SY0 + H * eps) / (E + H)
+    alpha = eps - tau / E
+    assert tau > SY0  # the bar yielded
+    x, X = _final_points(tmp_path / "out")
+    end = np.isclose(X[:, 0], 1.0)
+    np.testing.assert_allclose(x[end, 0], np.exp(alpha), rtol=1e-8)
+    top = np.isclose(X[:, 1], 1.0)
+    np.testing.assert_allclose(x[top, 1], np.exp(-alpha / 2.0), rtol=1e-8)
+    m = meshio.read(sorted((tmp_path / "out").glob("step_*.vtu"))[-1])
+    eq = np.concatenate([np.ravel(a) for a in m.cell_data["equivalent_plastic_strain"]])
+    np.testing.assert_allclose(eq, alpha, rtol=1e-8)
+    # unloading is elastic: no dissipation in the release stage
+    st = {s["name"]: s for s in res.summary["stages"]}
+    assert st["pull"]["plastic_dissipation"] > 0.0
+    assert abs(st["release"]["plastic_dissipation"]) < 1e-12 * st["pull"]["plastic_dissipation"]
+
+
+def test_new_target_and_hold(tmp_path):
+    stages = """
+[[stages]]
+name = "back"
+steps = { count = 2 }
+targets = { pull = 0.05 }
+
+[[stages]]
+name = "hold"
+steps = { count = 1 }
+"""
+    problem = _problem(tmp_path, stages, SVK, "solid")
+    res = problem.run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    x, X = _final_points(tmp_path / "out")
+    end = np.isclose(X[:, 0], 1.0)
+    np.testing.assert_allclose(x[end, 0] - X[end, 0], 0.05, rtol=1e-12)
+    # the hold stage changes nothing: the same reaction as at the end of "back"
+    steps = res.summary["steps"]
+    assert steps[-1]["stage"] == "hold" and steps[-1]["iterations"] <= 1
+    np.testing.assert_allclose(steps[-1]["reactions"]["bar.xmin"], steps[-2]["reactions"]["bar.xmin"],
+                               rtol=1e-9)
+
+
+def test_motion_of_a_node_set_turns_the_clamp(tmp_path):
+    """A clamped end turned by 30 degrees about the z axis through its centre, then translated."""
+    path = tmp_path / "turn.toml"
+    path.write_text("""
+[problem]
+name = "turn"
+[[bodies]]
+name = "bar"
+material = { model = "neo-hooke", E = 100.0, nu = 0.3 }
+mesh = { generator = "block", lx = 4.0, ly = 1.0, lz = 1.0, nx = 4, ny = 1, nz = 1 }
+[[dirichlet]]
+set = "bar.xmin"
+[[dirichlet]]
+name = "clamp"
+set = "bar.xmax"
+motion = { rotation = [0.0, 0.0, 0.5235987755982988], center = [4.0, 0.5, 0.5] }
+[steps]
+count = 3
+[[stages]]
+name = "shift"
+steps = { count = 2 }
+motions = { clamp = { translation = [0.0, 0.3, 0.0], rotation = [0.0, 0.0, -0.2], center = [4.0, 0.5, 0.5] } }
+""")
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    x, X = _final_points(tmp_path / "out")
+    end = np.isclose(X[:, 0], 4.0)
+    c = np.array([4.0, 0.5, 0.5])
+
+    def rot(t):
+        return np.array([[np.cos(t), -np.sin(t), 0.0], [np.sin(t), np.cos(t), 0.0], [0.0, 0.0, 1.0]])
+
+    first = c + (X[end] - c) @ rot(np.pi / 6).T  # stage 1: about the centre
+    c2 = c  # the centre is a point of the clamp: it did not move in stage 1
+    expected = c2 + (first - c2) @ rot(-0.2).T + np.array([0.0, 0.3, 0.0])
+    np.testing.assert_allclose(x[end], expected, atol=1e-12)
+
+
+def test_rigid_body_motion_continues_and_pair_switches_off(tmp_path):
+    """A plane presses a block, then lifts beyond it (stage 2), or the pair is switched off (stage 2')."""
+    base = """
+[problem]
+name = "press"
+[[bodies]]
+name = "block"
+material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2 }
+[[rigid]]
+name = "plate"
+shape = "plane"
+point = [0.0, 0.0, 1.0]
+normal = [0.0, 0.0, -1.0]
+motion = { translation = [0.0, 0.0, -0.02] }
+[[contact]]
+name = "touch"
+slave = "block.zmax"
+master = "plate"
+penalty = 1.0e6
+[[dirichlet]]
+set = "block.zmin"
+components = "z"
+[[dirichlet]]
+set = "block.xmin"
+components = "x"
+[[dirichlet]]
+set = "block.ymin"
+components = "y"
+[steps]
+count = 2
+"""
+    lift = base + """
+[[stages]]
+name = "lift"
+steps = { count = 2 }
+motions = { plate = { translation = [0.0, 0.0, 0.05] } }
+"""
+    off = base + """
+[[stages]]
+name = "off"
+steps = { count = 1 }
+contacts = { touch = false }
+"""
+    for name, text in (("lift", lift), ("off", off)):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        res = load_problem(path).run(out=tmp_path / name)
+        assert res.exit_code == 0, name
+        steps = res.summary["steps"]
+        assert steps[1]["reactions"]["block.zmin"][2] > 10.0  # pressed: about E * 0.02 * area = 20
+        assert steps[-1]["active_contacts"] == 0
+        if name == "lift":  # the plate 0.03 above the block's (unloaded) top
+            assert steps[-1]["min_gap"] == pytest.approx(0.03, rel=1e-9)
+        assert abs(steps[-1]["reactions"]["block.zmin"][2]) < 1e-9
+        x, X = _final_points(tmp_path / name)
+        np.testing.assert_allclose(x[:27], X[:27], atol=1e-9)  # the block (27 nodes) is unloaded
+    # where the plate went: stage 1 moved it by -0.02, stage 2 by +0.05 from there
+    m = meshio.read(sorted((tmp_path / "lift").glob("step_*.vtu"))[-1])
+    plate = m.point_data["displacement"][27:]  # after the block's 27 nodes: the drawn plane
+    assert len(plate) > 0
+    np.testing.assert_allclose(plate, np.tile([0.0, 0.0, 0.03], (len(plate), 1)), atol=1e-14)
+
+
+def test_loads_take_new_targets_and_are_removed(tmp_path):
+    path = tmp_path / "loads.toml"
+    path.write_text("""
+[problem]
+name = "loads"
+[[bodies]]
+name = "bar"
+material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 1, ny = 1, nz = 1 }
+[[dirichlet]]
+set = "bar.xmin"
+[[force]]
+name = "push"
+set = "bar.xmax"
+value = [0.0, 1.0, 0.0]
+distribution = "total"
+[[pressure]]
+name = "p"
+set = "bar.xmax"
+value = 1.0
+[steps]
+count = 1
+[[stages]]
+name = "double"
+targets = { push = [0.0, 2.0, 0.0], p = 3.0 }
+[[stages]]
+name = "remove"
+remove = ["push", "p"]
+""")
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    # the support carries the applied forces: y exactly, x by the dead pressure on the unit face
+    np.testing.assert_allclose(steps[0]["reactions"]["bar.xmin"][:2], [1.0, -1.0], rtol=1e-9)
+    np.testing.assert_allclose(steps[1]["reactions"]["bar.xmin"][:2], [3.0, -2.0], rtol=1e-9)
+    np.testing.assert_allclose(steps[2]["reactions"]["bar.xmin"], 0.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("stop_at", [5, 6])
+def test_resume_across_stages_is_exact(tmp_path, monkeypatch, stop_at):
+    """Stopped at the first step of the release stage (checkpoint: the end of the pull stage) or at its
+    second (checkpoint inside the stage, with the released reactions in the state): resumed, the run
+    ends exactly where the run that was never stopped ends."""
+    problem = _problem(tmp_path, RELEASE)
+    ref = problem.run(out=tmp_path / "ref")
+    advance = run_module.Newton.advance
+    calls = {"n": 0}
+
+    def stopping(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == stop_at:
+            raise Interrupted(15)
+        return advance(self, *args, **kwargs)
+
+    monkeypatch.setattr(run_module.Newton, "advance", stopping)
+    stopped = problem.run(out=tmp_path / "cut")
+    assert stopped.exit_code == 143 and stopped.summary["status"] == "interrupted"
+    monkeypatch.setattr(run_module.Newton, "advance", advance)
+    resumed = problem.run(out=tmp_path / "cut", resume=True)
+    assert resumed.exit_code == 0
+    # the same steps from the same committed state; the direct solver's fresh analysis after the restart
+    # may order its pivots differently, hence round-off, not bitwise equality
+    np.testing.assert_allclose(resumed.u, ref.u, rtol=1e-10, atol=1e-14)
+    a = json.loads((tmp_path / "ref" / "summary.json").read_text())
+    b = json.loads((tmp_path / "cut" / "summary.json").read_text())
+    assert [s["iterations"] for s in a["steps"]] == [s["iterations"] for s in b["steps"]]
+    assert [s["stage"] for s in a["steps"]] == [s["stage"] for s in b["steps"]]
+    assert a["stages"] == b["stages"]
+
+
+@pytest.mark.parametrize("stages, message", [
+    ('[[stages]]\nname = "a"\nrelease = ["nope"]\n', "no Dirichlet condition named 'nope'"),
+    ('[[stages]]\nname = "a"\nrelease = ["pull"]\n[[stages]]\nname = "b"\nrelease = ["pull"]\n',
+     "'pull' was released in stage 'a'"),
+    ('[[stages]]\nname = "a"\nrelease = ["pull", "pull"]\n', "names a condition twice"),
+    ('[[stages]]\nname = "a"\nrelease = ["pull"]\n[[stages]]\nname = "b"\ntargets = { pull = 0.1 }\n',
+     "'pull' was released in stage 'a'"),
+    ('[[stages]]\nname = "a"\nrelease = ["pull"]\ntargets = { pull = 0.1 }\n', "released and given a target"),
+    ('[[stages]]\nname = "a"\ntargets = { pul = 0.1 }\n', "no Dirichlet condition or load named 'pul'"),
+    ('[[stages]]\nname = "a"\nmotions = { pull = { translation = [1.0, 0.0, 0.0] } }\n',
+     "no rigid body or Dirichlet condition with a motion named 'pull'"),
+    ('[[stages]]\nname = "pull"\n', "duplicate stage name 'pull'"),
+    ('[[stages]]\nname = "a"\ncontacts = { c = false }\n', "no contact pair named 'c'"),
+    ('[[stages]]\nname = "a"\nrelase = ["pull"]\n', "unknown key"),
+    ('[[stages]]\nname = "a"\ntargets = { pull = [0.1, 0.2] }\n', "must have 1 entries"),
+])
+def test_bad_stage_input(tmp_path, stages, message):
+    with pytest.raises(InputError) as err:
+        _problem(tmp_path, stages)
+    assert message in str(err.value) and "\n" not in str(err.value)
+    assert "p.toml" in str(err.value)
+
+
+def test_value_and_motion_together_is_refused(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text("""
+[problem]
+name = "bad"
+[[bodies]]
+name = "bar"
+material = { model = "neo-hooke", E = 100.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 1, ny = 1, nz = 1 }
+[[dirichlet]]
+set = "bar.xmin"
+value = 0.1
+motion = { translation = [0.1, 0.0, 0.0] }
+""")
+    with pytest.raises(InputError, match="either 'value' or 'motion'"):
+        load_problem(path)
