@@ -37,6 +37,10 @@ class RigidBody:
     ``shape`` "plane" (``params`` point, normal), "cylinder" (center, axis, radius, outside) or "sphere"
     (center, radius, outside) for an analytic surface; or ``mesh``, a Mesh whose nodes carry no unknowns
     (slave nodes and/or master faces of contact pairs), with ``shape`` "mesh".
+
+    With ``free`` components the body gets a reference node (six unknowns: translation and rotation vector
+    about ``reference``): the free components follow equilibrium under ``force`` / ``moment`` (ramped over
+    the first stage, then held) and the contact forces, the others follow ``motion``.
     """
 
     name: str
@@ -44,6 +48,17 @@ class RigidBody:
     mesh: Mesh | None = None
     shape: str = ""
     params: dict = field(default_factory=dict)
+    free: tuple[int, ...] = ()          # components left to equilibrium: 0..5 = x, y, z, rx, ry, rz
+    force: tuple = (0.0, 0.0, 0.0)      # applied force (at load factor 1 of the first stage)
+    moment: tuple = (0.0, 0.0, 0.0)     # applied moment about the reference point
+    reference: tuple | None = None      # reference point (default: centre, point, or the mesh's centroid)
+
+    def reference_point(self) -> np.ndarray:
+        if self.reference is not None:
+            return np.asarray(self.reference, dtype=float)
+        if self.mesh is not None:
+            return self.mesh.points.mean(axis=0)
+        return np.asarray(self.params.get("center", self.params.get("point")), dtype=float)
 
 
 @dataclass

@@ -80,15 +80,34 @@ class System:
                 solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material)
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
             offset += body.mesh.n_nodes
-        self.n_nodes = offset
-        self.n_dofs = 3 * offset
+        self.n_deformable = offset
+        self.reference = self._reference_nodes(problem, offset)
+        self.n_nodes = offset + 2 * len(self.reference)
+        self.n_dofs = 3 * self.n_nodes
         self.X = np.zeros((self.n_nodes, 3))
         for blk, body in zip(self.blocks, problem.bodies):
             self.X[blk.offset: blk.offset + blk.n_nodes] = body.mesh.points
+        for ref in self.reference:
+            self.X[ref.A] = ref.origin
+        pairs = [np.array([[ref.A, ref.B] for ref in self.reference], dtype=np.int64)] if self.reference else []
         self.pattern = Pattern(self.n_nodes, [body.mesh.cells + blk.offset
-                                              for blk, body in zip(self.blocks, problem.bodies)])
+                                              for blk, body in zip(self.blocks, problem.bodies)] + pairs)
         self._build_loads()
         self._build_dirichlet()
+
+    @staticmethod
+    def _reference_nodes(problem, offset: int) -> list:
+        """The reference-node pairs (A: translation, B: rotation vector) of rigid bodies with free components,
+        numbered after the deformable nodes."""
+        from ..contact.reference import ReferenceBody
+
+        out = []
+        for rb in problem.rigid:
+            if rb.free:
+                A = offset + 2 * len(out)
+                out.append(ReferenceBody(rb.name, A, A + 1, rb.reference_point(), tuple(rb.free),
+                                         np.asarray(rb.force, dtype=float), np.asarray(rb.moment, dtype=float)))
+        return out
 
     # -- numbering ------------------------------------------------------------------------------
     def offset(self, body: str) -> int:

@@ -23,6 +23,7 @@ from .element import CASE_A, CASES
 from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, transfer_history
 from .kernels import contact_batch
 from .laws import is_active, uzawa_update
+from .reference import map_analytic, map_rigid_nodes
 from .search import candidates
 from .setup import Numbering, Pass, make_passes
 from .state import ContactState, PassState
@@ -61,6 +62,16 @@ class ContactManager:
         self._cache: list[_SearchCache | None] = [None] * len(self.passes)
         self._rigid: tuple[float, np.ndarray] | None = None
         self.enabled = [True] * len(self.passes)  # pairs switched on (stages may switch them)
+        # rigid bodies with a reference node: their nodes' rows and columns are mapped onto the node pair
+        self.reference = list(getattr(system, "reference", []))
+        self.owner = np.full(self.num.n_ext, -1, dtype=np.int64)
+        index = {ref.name: i for i, ref in enumerate(self.reference)}
+        for rb in self.num.rigid_meshes:
+            if rb.name in index:
+                off = self.num.rigid_offset[rb.name]
+                self.owner[off: off + rb.mesh.n_nodes] = index[rb.name]
+        self._ref_of_pass = [index.get(p.rigid, -1) if p.analytic is not None else -1 for p in self.passes]
+        self._poses = []
 
     # -- state ------------------------------------------------------------------------------------
     def initial_state(self) -> ContactState:
@@ -94,6 +105,9 @@ class ContactManager:
         """Deformable positions x (N, 3) followed by the rigid-mesh nodes at load factor lam."""
         if not self.num.rigid_meshes:
             return np.ascontiguousarray(x)
+        if self.reference:  # the reference bodies' poses come from x: no cache
+            self._set_poses(x)
+            return np.ascontiguousarray(np.vstack([x, self.num.rigid_positions(lam)]))
         if self._rigid is None or self._rigid[0] != lam:
             self._rigid = (lam, self.num.rigid_positions(lam))
         return np.ascontiguousarray(np.vstack([x, self._rigid[1]]))
@@ -107,6 +121,8 @@ class ContactManager:
         frictionless element, for the contribution norms).
         """
         guess = committed if guess is None else guess
+        if self.reference:
+            self._set_poses(x)
         xe = self.extended(x, lam)
         ev = ContactEvaluation(ElementBlocks(self.N), [ElementBlocks(self.N) for _ in range(4)] if want_parts
                                else None)
@@ -184,7 +200,7 @@ class ContactManager:
                         ev.parts[j].add(conn, np.zeros_like(R), P[:, j])
             t.gap[idx] = g
             t.force[idx] = -R[:, -3:]
-            ev.blocks.add(conn, R, K if want_K else None)
+            self._add(ev.blocks, conn, R, K if want_K else None, xe)
         # edge and vertex points: the distance to the closest point of the facet boundary (frictionless)
         idx = np.flatnonzero(active & ((res.kind == EDGE) | (res.kind == VERTEX)))
         if idx.size:
@@ -196,9 +212,26 @@ class ContactManager:
                     xe[conn[j, :nen]], res.xi[s], xe[p.slaves[s]], 1.0 if res.g[s] >= 0.0 else -1.0,
                     float(p.eps[s]), float(t.multiplier[s]), vertex=bool(res.kind[s] == VERTEX))
             t.force[idx] = -R[:, -3:]
-            ev.blocks.add(conn, R, K if want_K else None)
+            self._add(ev.blocks, conn, R, K if want_K else None, xe)
             if want_parts:
                 ev.parts[0].add(conn, np.zeros_like(R), K)
+
+    def _set_poses(self, x: np.ndarray) -> None:
+        """The reference bodies' poses at the system positions x: rigid nodes and analytic surfaces follow."""
+        self._poses = [ref.pose(x) for ref in self.reference]
+        for ref, pose in zip(self.reference, self._poses):
+            self.num.motions[ref.name] = pose
+        for k, p in enumerate(self.passes):
+            if self._ref_of_pass[k] >= 0:
+                p.analytic.motion = self._poses[self._ref_of_pass[k]]
+
+    def _add(self, blocks: ElementBlocks, conn, R, K, xe) -> None:
+        """Add element blocks, their rows and columns of reference bodies' nodes mapped onto the node pairs."""
+        if not self.reference:
+            blocks.add(conn, R, K)
+            return
+        for c, r, k in map_rigid_nodes(conn, R, K, self.owner, self.reference, self._poses, xe):
+            blocks.add(c, r, k)
 
     @staticmethod
     def _facet_history(p: Pass, c: PassState, idx, facets, xi, x_commit) -> np.ndarray:
@@ -240,7 +273,12 @@ class ContactManager:
         if idx.size == 0:
             return
         conn = p.slaves[idx][:, None]
-        ev.blocks.add(conn, R[idx], K[idx] if want_K else None)
+        b = self._ref_of_pass[next(i for i, q in enumerate(self.passes) if q is p)] if self.reference else -1
+        if b >= 0:
+            ev.blocks.add(*map_analytic(p.slaves[idx], xs[idx], R[idx], K[idx] if want_K else None,
+                                        self.reference[b], self._poses[b]))
+        else:
+            ev.blocks.add(conn, R[idx], K[idx] if want_K else None)
         if want_parts:
             tan = {name: p.analytic.evaluate(xs, p.eps, parts=name, lam=lam, multiplier=mult).tangent[idx]
                    for name in ("d", "c", "exact")}

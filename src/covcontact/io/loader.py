@@ -216,6 +216,20 @@ def _dirichlet_values(sec: Section, key: str, n: int) -> tuple:
     return (sec.get(key, "float", 0.0),) * n
 
 
+_COMPONENT_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def _free_components(sec: Section) -> tuple[int, ...]:
+    """``free = ["z", "rx", ...]``: the rigid body's components left to equilibrium."""
+    names = _strs(sec, "free")
+    for n in names:
+        if n not in _COMPONENT_NAMES:
+            sec.fail(f"{n!r} is not a component (x, y, z, rx, ry, rz)", "free")
+    if len(set(names)) != len(names):
+        sec.fail("names a component twice", "free")
+    return tuple(sorted(_COMPONENT_NAMES.index(n) for n in names))
+
+
 def _strs(sec: Section, key: str) -> tuple[str, ...]:
     raw = sec.get(key, "any", [])
     if not isinstance(raw, list) or not all(isinstance(v, str) for v in raw):
@@ -365,9 +379,6 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         mesh = build_mesh(b.get("mesh", "table"), base, element)
         _user_sets(b.get("sets", "table", None), mesh)
         b.done()
-        if formulation == "solid-shell" and getattr(material, "n_hist", 0):
-            b.fail("J2 plasticity is not available for solid-shells yet; use formulation = \"fbar\" (hex8) "
-                   "or \"solid\" (hex27) for a plastic body", "material")
         if formulation == "solid-shell":
             from ..elements.solidshell import check_options
 
@@ -415,8 +426,19 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             mesh = build_mesh(r.get("mesh", "table"), base, element)
             _user_sets(r.get("sets", "table", None), mesh)
         motion = _motion(r.get("motion", "table", None))
+        free = _free_components(r)
+        force = r.get("force", "vector", (0.0, 0.0, 0.0))
+        moment = r.get("moment", "vector", (0.0, 0.0, 0.0))
+        reference = r.get("reference", "vector", None)
+        for key, vec, base in (("force", force, 0), ("moment", moment, 3)):
+            bad = [i for i in range(3) if vec[i] != 0.0 and base + i not in free]
+            if bad:
+                r.fail(f"{'xyz'[bad[0]]} component given, but that component follows the motion; add "
+                       f"{_COMPONENT_NAMES[base + bad[0]]!r} to 'free' (a component is either moved or loaded)",
+                       key)
         r.done()
-        rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params))
+        rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params, free=free,
+                               force=force, moment=moment, reference=reference))
 
     def body_set(sec: Section, key: str, kind: str) -> tuple[str, str]:
         ref = sec.get(key, "str")
@@ -529,6 +551,10 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
                                     auto_factor=auto_factor, enabled=enabled))
 
+    for i, r in enumerate(rigid):
+        if r.free and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
+            top.fail(f"rigid body {r.name!r} has free components but no contact pair: nothing would restrain "
+                     f"it; add a [[contact]] with it or drop 'free'", f"rigid[{i}].free")
     steps = _steps(top.get("steps", "table", None))
     named = _named(top, dirichlet, forces, pressures, tractions)
     stage_name = meta_stage

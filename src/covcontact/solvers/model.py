@@ -123,7 +123,10 @@ class Model:
         """
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
-        ev, ctrial = self.contact.evaluate(self.positions(u), lam, committed.contact, guess.contact, want_K)
+        x = self.positions(u)
+        ev, ctrial = self.contact.evaluate(x, lam, committed.contact, guess.contact, want_K)
+        if self.system.reference:
+            self._rigid_loads(ev.blocks, x, lam, want_K)
         pattern, triples = self.coupling.covering(ev.blocks) if want_K else (None, [])
         t1 = time.perf_counter()
         r, K, etrial = self.system.internal(u, committed.elements, guess.elements, want_K, pattern)
@@ -132,10 +135,60 @@ class Model:
         if want_K:
             CouplingPattern.scatter(K.data, pattern, triples)
         t3 = time.perf_counter()
+        if want_K and self.system.reference:
+            self._check_restrained(K)
         if timing is not None:
             timing["assembly"] += t2 - t1
             timing["contact"] += (t1 - t0) + (t3 - t2)
         return r - self.external(lam), K, committed.but(elements=etrial, contact=ctrial, lam=lam)
+
+    # rigid bodies with a reference node ------------------------------------------------------------
+    def _rigid_loads(self, blocks, x: np.ndarray, lam: float, want_K: bool) -> None:
+        from ..contact.reference import load_block
+
+        scale = self.loading.rigid_scale(lam)
+        for ref in self.system.reference:
+            if np.any(ref.force) or np.any(ref.moment):
+                blocks.add(*load_block(ref, ref.pose(x), scale * ref.force, scale * ref.moment, want_K))
+
+    def _check_restrained(self, K) -> None:
+        """A free component of a reference body with no stiffness at all: a clear message (and a cutback)
+        instead of a singular matrix."""
+        from .linear import SingularMatrixError
+
+        diag = K.diagonal()
+        names = ("x", "y", "z", "rx", "ry", "rz")
+        for ref in self.system.reference:
+            for c in ref.free:
+                dof = 3 * (ref.A if c < 3 else ref.B) + c % 3
+                if diag[dof] == 0.0:
+                    raise SingularMatrixError(
+                        f"rigid body {ref.name!r} is free in {names[c]} but nothing restrains it there (no "
+                        f"active contact); start it touching its partner or prescribe that component until "
+                        f"it touches")
+
+    def rigid_report(self, u: np.ndarray, lam: float, state: State) -> dict:
+        """Per reference body: displacement, rotation vector, applied force and moment, and the contact
+        resultant (force and moment about the reference point) acting on it."""
+        if not self.system.reference:
+            return {}
+        from ..contact.reference import tangent_map
+
+        x = self.positions(u)
+        ev, _ = self.contact.evaluate(x, lam, state.contact, want_K=False)
+        r = ev.blocks.residual().reshape(-1, 3)
+        scale = self.loading.rigid_scale(lam)
+        out = {}
+        for ref in self.system.reference:
+            theta = x[ref.B]
+            # the contact residual on (A, B) is -(force, T^T moment) on the body
+            moment = -np.linalg.solve(tangent_map(theta).T, r[ref.B])
+            out[ref.name] = {"displacement": (x[ref.A] - ref.origin).tolist(),
+                             "rotation": theta.tolist(),
+                             "applied_force": (scale * ref.force).tolist(),
+                             "applied_moment": (scale * ref.moment).tolist(),
+                             "contact_force": (-r[ref.A]).tolist(), "contact_moment": moment.tolist()}
+        return out
 
     # queries on a state -----------------------------------------------------------------------
     def active_count(self, state: State) -> int:

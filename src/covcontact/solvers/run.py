@@ -51,8 +51,8 @@ def _reactions(model: Model, u: np.ndarray, lam: float, state) -> dict:
 def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, step: int, state,
                time_value: float | None = None) -> None:
     sysm = model.system
-    U = u.reshape(-1, 3)
-    n = sysm.n_nodes
+    n = getattr(sysm, "n_deformable", sysm.n_nodes)  # not the reference nodes of rigid bodies
+    U = u.reshape(-1, 3)[:n]
     cauchy = np.zeros((n, 6))
     blocks = []
     for blk, body, est in zip(sysm.blocks, model.problem.bodies, state.elements):
@@ -63,7 +63,7 @@ def _write_vtu(writer: ResultWriter, model: Model, u: np.ndarray, lam: float, st
         cd.update(blk.solid.plastic_fields(est))
         cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
         blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
-    points = sysm.X.copy()
+    points = sysm.X[:n].copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
     extra_pts, extra_blocks, extra_pdata = model.contact.visual(lam, state.contact)
     pdata.update(model.contact.point_data(n, state.contact) if model.contact.passes else {})
@@ -103,6 +103,10 @@ def _make_model(problem, tangent: str | None, linear: str | None) -> Model:
 
     name = (linear or problem.solver.linear or "auto").lower().strip()
     if name in REGISTRY and getattr(backend_class(name), "distributed", False):
+        if any(rb.free for rb in problem.rigid):
+            raise InputError(f"{problem.source or problem.name}: rigid bodies with free components (reference "
+                             f"nodes) are not available with the distributed solver {name!r} yet; use a serial "
+                             f"solver")
         from ..parallel.model import DistributedModel
 
         return DistributedModel(problem, tangent=tangent)
@@ -245,6 +249,9 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                         state.step = k
                         entry.update(model.step_report(u, lam, state))
                         entry["reactions"] = _reactions(model, u, lam, state)
+                        rigid = model.rigid_report(u, lam, state)
+                        if rigid:
+                            entry["rigid_bodies"] = rigid
                     else:
                         entry["failure"] = why
                     with stops.critical():

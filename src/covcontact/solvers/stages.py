@@ -37,13 +37,23 @@ class _Condition:
     start: np.ndarray | None     # (ncomp,) value at lam = 0 (value conditions)
     target: np.ndarray | None    # (ncomp,) value at lam = 1
     motion: object = None        # RigidMotion / StagedMotion (motion conditions)
+    rigid: object = None         # the ReferenceBody of a rigid body's prescribed components
 
     @property
     def dofs(self) -> np.ndarray:
+        if self.rigid is not None:  # components 0..5 of the pair (A, B)
+            node = np.where(np.asarray(self.components) < 3, self.rigid.A, self.rigid.B)
+            return 3 * node + np.asarray(self.components) % 3
         return (3 * self.nodes[:, None] + np.asarray(self.components)[None, :]).ravel()
 
     def values(self, X: np.ndarray, lam: float) -> np.ndarray:
         """Prescribed displacement of ``dofs`` at lam (X: reference positions of all nodes)."""
+        if self.rigid is not None:  # a reference node pair: translation and rotation vector of the motion
+            from ..contact.reference import rotation_vector
+
+            t = self.motion.apply(self.rigid.origin, lam) - self.rigid.origin
+            q = np.concatenate([t, rotation_vector(self.motion.matrix(lam))])
+            return q[list(self.components)]
         if self.motion is None:
             v = self.start + lam * (self.target - self.start)
             return np.tile(v, len(self.nodes))
@@ -72,6 +82,7 @@ class StageSpec:
     contacts: dict[str, bool]              # pair name -> on
     release_names: tuple[str, ...] = ()
     constrained: np.ndarray = field(default=None, repr=False)
+    rigid_load: tuple[float, float] = (0.0, 1.0)  # scale of the reference bodies' force and moment at 0, 1
 
     @property
     def lam_end(self) -> float:
@@ -116,6 +127,8 @@ class StagePlan:
             new_conds = []
             released = []
             for c in prev.conditions:
+                if c.rigid is not None:  # rebuilt from the stage's motions
+                    continue
                 if c.name in st.release:
                     released.append(c.dofs)
                     continue
@@ -145,8 +158,11 @@ class StagePlan:
             new_contacts = dict(prev.contacts)
             new_contacts.update({k2: bool(v) for k2, v in st.contacts.items()})
             rel = np.unique(np.concatenate(released)) if released else np.zeros(0, np.int64)
-            self.stages.append(self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
-                                          new_motions, new_contacts, tuple(st.release)))
+            spec = self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
+                              new_motions, new_contacts, tuple(st.release))
+            a, b = prev.rigid_load
+            spec.rigid_load = (a + lam_end * (b - a),) * 2  # held after the first stage
+            self.stages.append(spec)
         self.n_dofs = n_dofs
 
     def _spec(self, index, name, factors, conds, released, loads, start, target, motions, contacts, names):
@@ -156,6 +172,12 @@ class StagePlan:
         for key, load in loads.items():
             f0 += sysm.load_vector(load, start[key])
             f1 += sysm.load_vector(load, target[key])
+        conds = list(conds)
+        for ref in getattr(sysm, "reference", []):
+            comps = tuple(c for c in range(6) if c not in ref.free)
+            if comps:
+                conds.append(_Condition(f"rigid:{ref.name}", np.array([ref.A]), comps, None, None,
+                                        motions[ref.name], ref))
         constrained = np.zeros(sysm.n_dofs, dtype=bool)
         for c in conds:
             constrained[c.dofs] = True
@@ -200,6 +222,11 @@ class Loading:
         if s.released.size or np.any(self.held):
             f = f + max(0.0, 1.0 - lam) * self.release + self.held
         return f
+
+    def rigid_scale(self, lam: float) -> float:
+        """The factor of the reference bodies' applied force and moment at lam."""
+        a, b = self.spec.rigid_load
+        return a + lam * (b - a)
 
     def left_over(self) -> np.ndarray:
         """The held force the stages after this one inherit: what the ramp has not removed at its end."""
