@@ -9,7 +9,7 @@ from covcontact.cli import main
 from covcontact.io.loader import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = sorted(p for sub in ("solid", "contact", "verification", "plasticity")
+EXAMPLES = sorted(p for sub in ("solid", "contact", "verification", "plasticity", "forming")
                   for p in (ROOT / "examples" / sub).glob("*.toml"))
 
 

@@ -1,7 +1,8 @@
 """Pictures of a result folder: the initial and the final state, like the figures of a paper.
 
 ``render_pictures(out)`` reads ``step_0000.vtu`` and the last ``step_NNNN.vtu`` of a result folder and writes
-``initial.png`` and ``final.png``: the deformable bodies coloured by the displacement magnitude, the rigid
+``initial.png`` and ``final.png`` (and, for a staged run, ``<stage>.png`` at the end of every stage but the
+last): the deformable bodies coloured by the displacement magnitude, the rigid
 bodies in translucent grey, drawn at the current position (points + displacement) with equal axis scaling
 and a colour bar. Only matplotlib (off-screen, Agg) and meshio are needed.
 
@@ -174,9 +175,34 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
     written = []
     lam = _load_factor(out_dir, last.name)
     step = int(last.stem.split("_")[1])
-    final = f"final state: step {step}" + (f", load factor {lam:.3g}" if lam is not None else "")
+    ends = _stage_ends(out_dir)
+    if ends:  # a staged run: the pvd time is not a load factor
+        final = f"final state: step {step}, end of stage {ends[-1][0]!r}"
+    else:
+        final = f"final state: step {step}" + (f", load factor {lam:.3g}" if lam is not None else "")
     for state, name, label in ((s0, "initial.png", "initial state"), (s1, "final.png", final)):
         path = out_dir / name
         _draw(path, state, lo, hi, vmax, label, view)
         written.append(path)
+    for name, k in _stage_ends(out_dir)[:-1]:  # a staged run: the end of every stage but the last
+        f = out_dir / f"step_{k:04d}.vtu"
+        if f.exists():
+            path = out_dir / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png"
+            _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view)
+            written.append(path)
     return written
+
+
+def _stage_ends(out_dir: Path) -> list[tuple[str, int]]:
+    """(stage name, its last converged step) of a staged run's summary.json; [] for a single stage."""
+    import json
+
+    try:
+        summary = json.loads((out_dir / "summary.json").read_text())
+    except (OSError, ValueError):
+        return []
+    ends: dict[str, int] = {}
+    for entry in summary.get("steps", []):
+        if entry.get("converged") and "stage" in entry:
+            ends[entry["stage"]] = int(entry["step"])
+    return list(ends.items())
