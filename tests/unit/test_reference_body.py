@@ -163,3 +163,32 @@ def test_free_body_without_partner_is_refused(tmp_path):
                          "free": ["z"], "force": [0.0, 0.0, -1.0]})
     with pytest.raises(InputError, match="'ball' has free components but no contact pair"):
         problem_from_dict(raw, tmp_path / "p.toml")
+
+
+def test_stage_targets_and_removes_the_force_of_a_rigid_body(tmp_path):
+    """The force of a free rigid body is a load: a later stage gives it a new target or removes it; the
+    contact force follows (equilibrium) and the plate goes back to where the force first put it."""
+    raw = _problem({"name": "plate", "shape": "plane", "point": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, -1.0],
+                    "free": ["z"], "force": [0.0, 0.0, -10.0]},
+                   {"slave": "block.zmax", "master": "plate", "penalty": 1e5, "weighting": "area"})
+    raw["stages"] = [{"name": "more", "targets": {"plate": [0.0, 0.0, -20.0]}},
+                     {"name": "less", "targets": {"plate": [0.0, 0.0, -10.0]}},
+                     {"name": "off", "steps": {"count": 2}, "remove": ["plate"]}]
+    res = _run(raw, tmp_path)
+    assert res.exit_code == 0
+    rows = [(e["stage"], e["rigid_bodies"]["plate"]) for e in res.summary["steps"]]
+    expected = {"stage1": 10.0, "more": 20.0, "less": 10.0}
+    for stage, rb in rows[:3]:
+        assert rb["contact_force"][2] == pytest.approx(expected[stage], rel=1e-9)
+        assert rb["applied_force"][2] == pytest.approx(-expected[stage], rel=1e-12)
+    assert rows[2][1]["displacement"][2] == pytest.approx(rows[0][1]["displacement"][2], rel=1e-9)  # elastic
+    assert rows[-1][1]["contact_force"][2] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_target_on_a_moved_component_is_refused(tmp_path):
+    raw = _problem({"name": "plate", "shape": "plane", "point": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, -1.0],
+                    "free": ["z"], "force": [0.0, 0.0, -10.0]},
+                   {"slave": "block.zmax", "master": "plate", "penalty": 1e5})
+    raw["stages"] = [{"name": "bad", "targets": {"plate": [1.0, 0.0, -10.0]}}]
+    with pytest.raises(InputError, match="rigid body 'plate' is moved in x"):
+        problem_from_dict(raw, tmp_path / "p.toml")

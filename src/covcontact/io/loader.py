@@ -293,12 +293,12 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
         st.fail("names a condition twice", "release")
     remove = _strs(st, "remove")
     for n in remove:
-        check_name(st, "remove", n, ("force", "pressure", "traction"), "load")
+        check_name(st, "remove", n, ("force", "pressure", "traction", "rigid"), "load")
     targets = {}
     tsec = st.get("targets", "table", None)
     if tsec is not None:
         for n in list(tsec.data):
-            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction"),
+            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction", "rigid"),
                                    "Dirichlet condition or load")
             if n in release or n in remove:
                 tsec.fail(f"{n!r} is {'released' if n in release else 'removed'} and given a target in the "
@@ -309,6 +309,12 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
                 targets[n] = _dirichlet_values(tsec, n, len(obj.components))
             elif kind == "pressure":
                 targets[n] = tsec.get(n, "float")
+            elif kind == "rigid":  # the force of a rigid body with free components
+                targets[n] = tsec.get(n, "vector")
+                bad = [i for i in range(3) if targets[n][i] != 0.0 and i not in obj.free]
+                if bad:
+                    tsec.fail(f"{'xyz'[bad[0]]} component given, but rigid body {n!r} is moved in "
+                              f"{'xyz'[bad[0]]}", n)
             else:
                 targets[n] = tsec.get(n, "vector")
         tsec.done()
@@ -557,6 +563,9 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                      f"it; add a [[contact]] with it or drop 'free'", f"rigid[{i}].free")
     steps = _steps(top.get("steps", "table", None))
     named = _named(top, dirichlet, forces, pressures, tractions)
+    for r in rigid:  # rigid bodies with free components: their force is a load later stages may change
+        if r.free and r.name not in named:
+            named[r.name] = ("rigid", r)
     stage_name = meta_stage
     stages = []
     for st in top.get("stages", "array", []):

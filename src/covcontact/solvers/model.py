@@ -146,10 +146,10 @@ class Model:
     def _rigid_loads(self, blocks, x: np.ndarray, lam: float, want_K: bool) -> None:
         from ..contact.reference import load_block
 
-        scale = self.loading.rigid_scale(lam)
         for ref in self.system.reference:
-            if np.any(ref.force) or np.any(ref.moment):
-                blocks.add(*load_block(ref, ref.pose(x), scale * ref.force, scale * ref.moment, want_K))
+            force, moment = self.loading.rigid_load(ref.name, lam)
+            if np.any(force) or np.any(moment):
+                blocks.add(*load_block(ref, ref.pose(x), force, moment, want_K))
 
     def _check_restrained(self, K) -> None:
         """A free component of a reference body with no stiffness at all: a clear message (and a cutback)
@@ -177,16 +177,15 @@ class Model:
         x = self.positions(u)
         ev, _ = self.contact.evaluate(x, lam, state.contact, want_K=False)
         r = ev.blocks.residual().reshape(-1, 3)
-        scale = self.loading.rigid_scale(lam)
         out = {}
         for ref in self.system.reference:
+            force, moment = self.loading.rigid_load(ref.name, lam)
             theta = x[ref.B]
             # the contact residual on (A, B) is -(force, T^T moment) on the body
             moment = -np.linalg.solve(tangent_map(theta).T, r[ref.B])
             out[ref.name] = {"displacement": (x[ref.A] - ref.origin).tolist(),
                              "rotation": theta.tolist(),
-                             "applied_force": (scale * ref.force).tolist(),
-                             "applied_moment": (scale * ref.moment).tolist(),
+                             "applied_force": force.tolist(), "applied_moment": moment.tolist(),
                              "contact_force": (-r[ref.A]).tolist(), "contact_moment": moment.tolist()}
         return out
 

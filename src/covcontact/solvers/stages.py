@@ -82,7 +82,7 @@ class StageSpec:
     contacts: dict[str, bool]              # pair name -> on
     release_names: tuple[str, ...] = ()
     constrained: np.ndarray = field(default=None, repr=False)
-    rigid_load: tuple[float, float] = (0.0, 1.0)  # scale of the reference bodies' force and moment at 0, 1
+    rigid_loads: dict = field(default_factory=dict)  # reference body -> (force, moment) at lam = 0 and at 1
 
     @property
     def lam_end(self) -> float:
@@ -120,6 +120,9 @@ class StagePlan:
         self.stages: list[StageSpec] = []
         self.stages.append(self._spec(0, problem.stage_name, problem.steps.factors, conds, np.zeros(0, np.int64),
                                       loads, values, targets, motions, contacts, ()))
+        zero = np.zeros(3)
+        self.stages[0].rigid_loads = {ref.name: (zero, ref.force, zero, ref.moment)
+                                      for ref in getattr(system, "reference", [])}
         for k, st in enumerate(problem.stages, start=1):
             prev = self.stages[-1]
             lam_end = prev.lam_end
@@ -160,8 +163,14 @@ class StagePlan:
             rel = np.unique(np.concatenate(released)) if released else np.zeros(0, np.int64)
             spec = self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
                               new_motions, new_contacts, tuple(st.release))
-            a, b = prev.rigid_load
-            spec.rigid_load = (a + lam_end * (b - a),) * 2  # held after the first stage
+            for name, (f0, f1, m0, m1) in prev.rigid_loads.items():
+                f, m = f0 + lam_end * (f1 - f0), m0 + lam_end * (m1 - m0)
+                if name in st.remove:
+                    spec.rigid_loads[name] = (f, 0.0 * f, m, 0.0 * m)
+                elif name in st.targets:
+                    spec.rigid_loads[name] = (f, np.asarray(st.targets[name], dtype=float), m, m)
+                else:
+                    spec.rigid_loads[name] = (f, f, m, m)
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
@@ -223,10 +232,10 @@ class Loading:
             f = f + max(0.0, 1.0 - lam) * self.release + self.held
         return f
 
-    def rigid_scale(self, lam: float) -> float:
-        """The factor of the reference bodies' applied force and moment at lam."""
-        a, b = self.spec.rigid_load
-        return a + lam * (b - a)
+    def rigid_load(self, name: str, lam: float) -> tuple[np.ndarray, np.ndarray]:
+        """The applied force and moment of reference body ``name`` at lam."""
+        f0, f1, m0, m1 = self.spec.rigid_loads[name]
+        return f0 + lam * (f1 - f0), m0 + lam * (m1 - m0)
 
     def left_over(self) -> np.ndarray:
         """The held force the stages after this one inherit: what the ramp has not removed at its end."""
