@@ -178,6 +178,8 @@ class DistributedSystem(System):
             offsets.append(offset)
             offset += body.mesh.n_nodes
         self.n_nodes = offset
+        self.n_deformable = offset
+        self.reference = []  # rigid bodies with reference nodes are refused in distributed runs
         self.n_dofs = 3 * offset
         self.X = np.zeros((self.n_nodes, 3))
         for off, body in zip(offsets, problem.bodies):
