@@ -89,3 +89,38 @@ def visual(manager, lam: float, state: ContactState):
     from ..io.rigid_visual import rigid_visual
 
     return rigid_visual(manager, lam, node_fields(manager, manager.num.n_ext, state))
+
+
+def start_warnings(manager, x: np.ndarray, state: ContactState, names: dict[str, str]) -> list[str]:
+    """Warnings about a set-up that is legal but almost certainly wrong: most slave nodes of a pass start
+    inside the master (deeper than 1 % of their typical spacing: touching is fine), as an analytic surface
+    turned inside out, master faces whose normals point into their body, or a body misplaced or in other
+    units would make them.
+
+    ``x`` the positions at the start, ``names`` pass name -> a description of its master for the message.
+    """
+    ev, trial = manager.evaluate(x, 0.0, state, want_K=False)
+    out = []
+    for k, p in enumerate(manager.passes):
+        if not manager.enabled[k] or p.ns == 0:
+            continue
+        g = trial.passes[k].gap
+        xs = manager.extended(x, 0.0)[p.slaves]
+        spacing = _spacing(xs, p)
+        deep = np.isfinite(g) & (g < -0.01 * spacing)
+        if deep.sum() > 0.5 * p.ns:
+            master = names.get(p.name, "its master")
+            out.append(f"contact {p.name!r}: {int(deep.sum())} of {p.ns} slave nodes start inside {master} (gap "
+                       f"down to {float(g[deep].min()):.3g} against a node spacing of {spacing:.3g}); likely an "
+                       f"analytic surface with the wrong 'outside', a master face set whose normals point into "
+                       f"its body, or a body misplaced or in other units")
+    return out
+
+
+def _spacing(xs: np.ndarray, p) -> float:
+    """A typical distance between neighbouring slave nodes: sqrt of the mean tributary area, else the
+    bounding box over the number of nodes."""
+    if np.any(p.area != 1.0):
+        return float(np.sqrt(np.mean(p.area)))
+    span = float(np.linalg.norm(xs.max(axis=0) - xs.min(axis=0))) if len(xs) > 1 else 1.0
+    return span / max(np.sqrt(len(xs)), 1.0)

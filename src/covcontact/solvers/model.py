@@ -189,6 +189,22 @@ class Model:
                              "contact_force": (-r[ref.A]).tolist(), "contact_moment": moment.tolist()}
         return out
 
+    def start_warnings(self, u: np.ndarray, state: State) -> list[str]:
+        """Warnings about the start of a run that is legal but almost certainly wrong (contact/report.py)."""
+        if not self.contact.passes or self.size > 1:
+            return []
+        from ..contact.report import start_warnings
+
+        names = {}
+        for pair in self.problem.contacts:
+            rb = next((r for r in self.problem.rigid if r.name == pair.master[0] and r.mesh is None), None)
+            if rb is not None:
+                extra = f" (outside = {str(rb.params['outside']).lower()})" if "outside" in rb.params else ""
+                names[pair.name] = f"the analytic {rb.shape} {rb.name!r}{extra}"
+            else:
+                names[pair.name] = f"the faces {pair.master[0]}.{pair.master[1]}"
+        return start_warnings(self.contact, self.positions(u), state.contact, names)
+
     # queries on a state -----------------------------------------------------------------------
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)

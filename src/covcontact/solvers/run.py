@@ -193,10 +193,16 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         newton.scale_seen = float(meta.get("force_scale", 0.0))
         writer.restore(meta["pvd"], state.step)
         say(f"resuming {problem.name} after step {state.step} (load factor {state.lam:.4g})")
-    elif problem.output.vtu:
-        t0 = time.perf_counter()
-        _write_vtu(writer, model, u, 0.0, 0, state)
-        t_out += time.perf_counter() - t0
+    else:
+        warnings = model.start_warnings(u, state)
+        if warnings:
+            summary["warnings"] = warnings
+            for w in warnings:
+                say(f"warning: {w}")
+        if problem.output.vtu:
+            t0 = time.perf_counter()
+            _write_vtu(writer, model, u, 0.0, 0, state)
+            t_out += time.perf_counter() - t0
     plan = model.stages
     nsteps = sum(len(spec.factors) for spec in plan.stages)
     staged = len(plan) > 1
