@@ -114,7 +114,6 @@ def test_plastic_input_errors(tmp_path):
     bad = {
         'yield_stress = 0.4': 'yield_stress = -1.0',
         'law = "linear", modulus = 2.0': 'law = "swift", K = 1.0, eps0 = 0.01, n = 1.5',
-        'formulation = "solid"': 'formulation = "solid-shell"',
     }
     base = PROBLEM.replace("FORMULATION", "solid")
     for old, new in bad.items():

@@ -14,6 +14,17 @@ Green-Lagrange strain:
   with the centre Jacobian (Simo-Rifai), alpha condensed per element after a local Newton solve.
 - hex18 only, optional: MITC9-like membrane tying (E_rr like E_rt, E_ss like E_st, E_rs at (-+a, -+a)).
 
+Materials: hyperelastic ones (no history) and J2 plasticity (``n_hist`` values per Gauss point, state key
+``hist``). The material sees the enhanced strain E = E_ANS + Gamma alpha through C = I + 2 E (an F with
+F^T F = C); with plasticity the return mapping runs from the committed history at every iterate of the
+local EAS Newton, so the history, S and the consistent tangent D that condenses alpha are those of the
+final alpha (docs/theory.md, "Plastic solid-shells"). Thickness integration: option ``thickness_points``
+(2..9) and ``thickness_rule`` ("gauss" or "lobatto"); default 2 Gauss points for materials without
+history (the original rule) and 5 Gauss points for plastic ones. Option ``eas_thickness`` (default on for
+plastic materials) adds the EAS modes E_tt P_k(t), k = 2 .. points - 1, so that the thickness strain is
+free at every thickness level (plastic incompressibility at finite strain asks for a thickness strain
+that is not linear in t; without them plastic bending locks).
+
 Kernels: :mod:`covcontact.elements.solidshell_kernels` (element routines) and
 :mod:`covcontact.elements.solidshell_loops` (parallel loops over elements).
 """
@@ -26,7 +37,7 @@ from typing import Any
 import numpy as np
 from numba import get_num_threads
 
-from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
+from ..fem.quadrature import DEFAULT_RULE, gauss_1d, gauss_tensor
 from ..fem.shapes import NODES, shape_functions
 from ..materials.hyperelastic import Material
 from .base import ElementBody
@@ -63,11 +74,26 @@ DEFAULTS: dict[str, dict[str, Any]] = {
     "hex8": {"eas": 7, "ans_shear": True, "ans_thickness": True, "ans_membrane": False},
     "hex18": {"eas": 4, "ans_shear": True, "ans_thickness": True, "ans_membrane": True},
 }
-OPTION_KEYS = ("eas", "ans_shear", "ans_thickness", "ans_membrane")
+OPTION_KEYS = ("eas", "ans_shear", "ans_thickness", "ans_membrane", "thickness_points", "thickness_rule",
+               "eas_thickness")
+#: the boolean options
+_BOOL_KEYS = ("ans_shear", "ans_thickness", "ans_membrane", "eas_thickness")
+#: rules through the thickness and their admissible point counts (Lobatto with 2 points, t = -1 and 1,
+#: integrates the bending stiffness three times too large)
+THICKNESS_RULES = {"gauss": (2, 9), "lobatto": (3, 9)}
+#: default number of thickness points: materials without history keep the original 2-point Gauss rule
+#: (results unchanged); materials with history (plasticity) get 5, enough for the elastoplastic stress
+#: profile of bending (docs/theory.md "Plastic solid-shells")
+THICKNESS_DEFAULT_ELASTIC = {"gauss": 2, "lobatto": 3}
+THICKNESS_DEFAULT_PLASTIC = 5
 
 
 def normalize_options(cell_type: str, options: dict | None) -> dict:
-    """Validated options with defaults filled in; ValueError with a one-line message otherwise."""
+    """Validated options with defaults filled in; ValueError with a one-line message otherwise.
+
+    The thickness integration keys (``thickness_points`` 2..9, Lobatto 3..9; ``thickness_rule`` "gauss" or
+    "lobatto"; ``eas_thickness`` true/false) are kept only when given: their defaults depend on the
+    material (:func:`resolve_thickness`)."""
     if cell_type not in SHELL_CELLS:
         raise ValueError(f"solid-shell elements need cell type hex8 or hex18, got {cell_type!r}")
     options = dict(options or {})
@@ -81,7 +107,7 @@ def normalize_options(cell_type: str, options: dict | None) -> dict:
         if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or not 0 <= n <= nmax:
             raise ValueError(f"solid-shell option eas must be an integer 0..{nmax} for {cell_type}, got {n!r}")
         out["eas"] = int(n)
-    for key in OPTION_KEYS[1:]:
+    for key in _BOOL_KEYS:
         if key in options:
             v = options[key]
             if not isinstance(v, (bool, np.bool_)):
@@ -89,7 +115,90 @@ def normalize_options(cell_type: str, options: dict | None) -> dict:
             out[key] = bool(v)
     if cell_type == "hex8" and out["ans_membrane"]:
         raise ValueError("solid-shell option ans_membrane applies to hex18 only")
+    # thickness integration: only the keys given are kept (the default depends on the material,
+    # resolved by resolve_thickness())
+    rule = options.get("thickness_rule", "gauss")
+    if "thickness_rule" in options:
+        if not isinstance(rule, str) or rule not in THICKNESS_RULES:
+            raise ValueError(f"solid-shell option thickness_rule must be \"gauss\" or \"lobatto\", "
+                             f"got {rule!r}")
+        out["thickness_rule"] = rule
+    if "thickness_points" in options:
+        n = options["thickness_points"]
+        lo, hi = THICKNESS_RULES[rule]
+        if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or not 2 <= n <= 9:
+            raise ValueError(f"solid-shell option thickness_points must be an integer 2..9, got {n!r}")
+        if not lo <= n <= hi:
+            raise ValueError(f"solid-shell option thickness_points must be {lo}..{hi} for the {rule} rule "
+                             f"(2 Lobatto points under-integrate bending), got {n}")
+        out["thickness_points"] = int(n)
+    if out.get("eas_thickness") and out.get("thickness_points", 3) < 3:
+        raise ValueError("solid-shell option eas_thickness needs thickness_points >= 3")
     return out
+
+
+def lobatto_1d(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n-point Gauss-Lobatto rule on [-1, 1] (end points included; exact for degree 2n - 3), n >= 2."""
+    if n < 2:
+        raise ValueError("a Lobatto rule needs at least two points")
+    P = np.polynomial.legendre.Legendre.basis(n - 1)
+    inner = np.sort(np.real(P.deriv().roots())) if n > 2 else np.zeros(0)
+    x = np.concatenate([[-1.0], inner, [1.0]])
+    w = 2.0 / (n * (n - 1) * P(x) ** 2)
+    x = 0.5 * (x - x[::-1])  # exactly symmetric
+    w = 0.5 * (w + w[::-1])
+    if n % 2:
+        x[n // 2] = 0.0
+    return x, w
+
+
+def resolve_thickness(options: dict, n_hist: int = 0) -> tuple[str, int, int]:
+    """(rule, points, extra EAS thickness modes) through the thickness for normalised ``options`` and a
+    material with ``n_hist`` history values per point.
+
+    Defaults: :data:`THICKNESS_DEFAULT_PLASTIC` points for materials with history or with
+    ``eas_thickness = true``, else :data:`THICKNESS_DEFAULT_ELASTIC`; the thickness modes E_tt P_k(t),
+    k = 2 .. points - 1 (:func:`thickness_modes`, option ``eas_thickness``) on for materials with history,
+    off otherwise."""
+    rule = options.get("thickness_rule", "gauss")
+    on = options.get("eas_thickness")
+    n = options.get("thickness_points")
+    if n is None:
+        n = THICKNESS_DEFAULT_PLASTIC if n_hist or on else THICKNESS_DEFAULT_ELASTIC[rule]
+    if on is None:
+        on = bool(n_hist)
+    elif on and n < 3:
+        raise ValueError("solid-shell option eas_thickness needs thickness_points >= 3")
+    return rule, int(n), (int(n) - 2 if on else 0)
+
+
+def thickness_modes(count: int) -> list[tuple[int, Any]]:
+    """EAS modes E_tt P_k(t), k = 2 .. count + 1 (Legendre polynomials, zero mean through the thickness).
+
+    With n thickness points and count = n - 2 they make, together with the compatible (constant in t) and
+    the enhanced linear part, the thickness strain free at every thickness level: the thickness stress of
+    each level vanishes on average over the element (no spurious pressure when plastic incompressibility
+    asks for a thickness strain nonlinear in t, e.g. E_33 = ((1 + kappa z)^-2 - 1)/2 in bending)."""
+    modes: list[tuple[int, Any]] = []
+    for k in range(2, count + 2):
+        Pk = np.polynomial.legendre.Legendre.basis(k)
+        modes.append((2, lambda r, s, t, Pk=Pk: float(Pk(t))))
+    return modes
+
+
+def gauss_rule(cell_type: str, rule: str = "gauss", nt: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """In-plane Gauss points (2 x 2 hex8, 3 x 3 hex18) times ``nt`` points of ``rule`` in t (r fastest).
+
+    ``nt = None`` or the Gauss rule with 2 points is the original rule of the element
+    (:data:`covcontact.fem.quadrature.DEFAULT_RULE`), bit for bit."""
+    order = DEFAULT_RULE[cell_type]
+    if rule == "gauss":
+        return gauss_tensor((order[0], order[1], order[2] if nt is None else int(nt)))
+    xr, wr = gauss_1d(order[0])
+    xt, wt = lobatto_1d(int(nt))
+    pts = np.array([(r, s, t) for t in xt for s in xr for r in xr], dtype=np.float64)
+    w = np.array([a * b * c for c in wt for b in wr for a in wr], dtype=np.float64)
+    return np.ascontiguousarray(pts), w
 
 
 def mesh_problem(cell_type: str, X: np.ndarray, cells: np.ndarray) -> str | None:
@@ -160,14 +269,17 @@ def _lagrange(nodes: tuple[float, ...], x: float) -> list[float]:
     return out
 
 
-def tying_tables(cell_type: str, ans_shear: bool, ans_thickness: bool, ans_membrane: bool):
+def tying_tables(cell_type: str, ans_shear: bool, ans_thickness: bool, ans_membrane: bool,
+                 rule: tuple[np.ndarray, np.ndarray] | None = None):
     """Gauss rule and ANS interpolation of one cell type.
 
     Returns points (npt, 3) (the ng Gauss points first), weights (ng,), and the CSR tying table
     tie_ptr (6 ng + 1,), tie_pt, tie_w: component I of the natural strain at Gauss point g is
     sum_q tie_w[q] E_I(points[tie_pt[q]]) over q in tie_ptr[6 g + I] .. tie_ptr[6 g + I + 1].
+    ``rule`` (points, weights): the integration rule (default :func:`gauss_rule` of the cell type);
+    the shear and membrane tying points lie at the t of each Gauss point.
     """
-    gp, w = gauss_tensor(DEFAULT_RULE[cell_type])
+    gp, w = gauss_rule(cell_type) if rule is None else rule
     P = _Points(gp)
     rows: list[list[tuple[int, float]]] = []
     for g, (r, s, t) in enumerate(gp):
@@ -205,9 +317,12 @@ def tying_tables(cell_type: str, ans_shear: bool, ans_thickness: bool, ans_membr
     return np.array(P.pts), w, tie_ptr, tie_pt, tie_w
 
 
-def eas_tables(cell_type: str, neas: int, gauss_points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Natural component (neas,) and values (ng, neas) of the first ``neas`` EAS modes."""
-    modes = EAS_MODES[cell_type][:neas]
+def eas_tables(cell_type: str, neas: int, gauss_points: np.ndarray, n_thickness: int = 0
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Natural component and values (ng, .) of the first ``neas`` EAS modes followed by ``n_thickness``
+    thickness modes (:func:`thickness_modes`)."""
+    modes = EAS_MODES[cell_type][:neas] + thickness_modes(n_thickness)
+    neas = len(modes)
     comp = np.array([c for c, _ in modes], dtype=np.int64)
     val = np.array([[f(*p) for _, f in modes] for p in gauss_points], dtype=np.float64)
     val = val.reshape(len(gauss_points), neas)
@@ -221,46 +336,89 @@ class SolidShellBody(ElementBody):
     the EAS parameters for u (local Newton from their last values) and return condensed tangents;
     ``stress`` pushes S forward with the compatible F and reports the assumed strain.
 
+    State (:meth:`new_state`): ``alpha`` (a hint, the start of the local EAS Newton) and, for a material
+    with history (J2), ``hist`` (nelem, ngp, n_hist). An assembly reads the committed history from
+    ``state["hist_n"]`` when given (as :meth:`ElementBody.kernel_state` provides it), else from
+    ``state["hist"]``, and writes the trial at the solved alpha into ``state["hist"]``; the fields
+    (``stress``, ``energy``) read ``state["hist"]`` as the committed history and write nothing.
+
     Args:
         cell_type: "hex8" (quad4 faces) or "hex18" (quad9 faces).
         X: (nnode, 3) reference coordinates.
         cells: (nelem, nen) connectivity, thickness = third natural direction.
         material: a :mod:`covcontact.materials` material.
-        **options: eas (number of EAS modes), ans_shear, ans_thickness, ans_membrane (hex18); see
-            :func:`normalize_options` and :data:`DEFAULTS`.
+        **options: eas (number of EAS modes), ans_shear, ans_thickness, ans_membrane (hex18),
+            thickness_points, thickness_rule, eas_thickness; see :func:`normalize_options`, :data:`DEFAULTS`
+            and :func:`resolve_thickness` (attributes ``thickness_rule``, ``thickness_points``,
+            ``n_eas_thickness``; ``neas`` counts all EAS modes).
     """
 
     def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
                  chunk_bytes: int = 32 * 2**20, **options: Any) -> None:
-        if getattr(material, "n_hist", 0):
-            raise ValueError("solid-shells take hyperelastic materials only (no material history yet)")
         self.options = normalize_options(cell_type, options)
         super().__init__(cell_type, X, cells, material, chunk_bytes)
         msg = mesh_problem(cell_type, self.X, self.cells)
         if msg is not None:
             raise ValueError(msg)
         o = self.options
+        self.thickness_rule, self.thickness_points, self.n_eas_thickness = resolve_thickness(o, self.n_hist)
         pts, self.weights, self.tie_ptr, self.tie_pt, self.tie_w = tying_tables(
-            cell_type, o["ans_shear"], o["ans_thickness"], o["ans_membrane"])
+            cell_type, o["ans_shear"], o["ans_thickness"], o["ans_membrane"],
+            gauss_rule(cell_type, self.thickness_rule, self.thickness_points))
         self.points = pts
         self.dNp = np.ascontiguousarray(shape_functions(cell_type, pts)[1])
         self.dNc = np.ascontiguousarray(shape_functions(cell_type, np.zeros((1, 3)))[1][0])
-        self.neas = o["eas"]
-        self.eas_comp, self.eas_val = eas_tables(cell_type, self.neas, pts[: self.weights.size])
+        self.eas_comp, self.eas_val = eas_tables(cell_type, o["eas"], pts[: self.weights.size],
+                                                 self.n_eas_thickness)
+        self.neas = int(self.eas_comp.size)
 
     HINTS = ("alpha",)
 
+    @property
+    def n_hist(self) -> int:
+        """Material history length per Gauss point (0 for hyperelastic materials)."""
+        return int(getattr(self.material, "n_hist", 0))
+
     def new_state(self) -> dict[str, np.ndarray]:
         """EAS parameters alpha (nelem, neas), zero in the reference state (a hint: the start of the local
-        EAS solve, whose result depends on u only)."""
-        return {"alpha": np.zeros((self.n_elements, self.neas))}
+        EAS solve, whose result depends on u and the committed history only); for a material with history
+        also ``hist`` (nelem, ngp, n_hist), the material history per Gauss point (committed / trial)."""
+        st = {"alpha": np.zeros((self.n_elements, self.neas))}
+        if self.n_hist:
+            st["hist"] = np.zeros((self.n_elements, self.weights.size, self.n_hist))
+        return st
+
+    def _hist(self, state) -> tuple[np.ndarray, np.ndarray]:
+        """(committed, trial) history arrays of ``state``: ``hist_n`` if the caller passes it (read only),
+        else ``hist`` itself (the kernels copy each element's committed values first)."""
+        if self.n_hist == 0:
+            h = np.zeros((self.n_elements, self.weights.size, 0))
+            return h, h
+        hist = state.get("hist")
+        if hist is None:  # a state with the EAS start values only: virgin material
+            hist = state["hist"] = np.zeros((self.n_elements, self.weights.size, self.n_hist))
+        return state.get("hist_n", hist), hist
+
+    def gauss_volumes(self) -> np.ndarray:
+        """(nelem, ngp) reference volume w_g det J0 of every Gauss point (computed once)."""
+        if getattr(self, "_gauss_volumes", None) is None:
+            dN = self.dNp[: self.weights.size]
+            J0 = np.einsum("eai,gak->egik", self.X[self.cells], dN)
+            self._gauss_volumes = np.linalg.det(J0) * self.weights[None, :]
+        return self._gauss_volumes
 
     def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:
+        hist_n, hist = self._hist(state)
         solidshell_chunk(self.material.kind, self.material.params, self.X, u, self.cells, e0, state["alpha"], self.dNp,
                          self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
-                         want_K, Ke, fe, flags, nblocks)
+                         want_K, Ke, fe, flags, nblocks, hist_n, hist)
 
     def _gauss_fields(self, u, mode, out, state) -> None:
-        solidshell_fields(self.material.kind, self.material.params, self.X, u, self.cells, state["alpha"], self.dNp,
+        # the history of ``state`` is read as the committed one (never written)
+        hist_n = state.get("hist") if self.n_hist else None
+        if hist_n is None:
+            hist_n = np.zeros((self.n_elements, self.weights.size, self.n_hist))
+        alpha = state["alpha"].copy()  # the local EAS solve writes its result: not into the caller's state
+        solidshell_fields(self.material.kind, self.material.params, self.X, u, self.cells, alpha, self.dNp,
                           self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
-                          mode, out, get_num_threads())
+                          mode, out, get_num_threads(), hist_n)

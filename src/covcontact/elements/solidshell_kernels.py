@@ -11,6 +11,12 @@ condensed: K = K_uu - K_ua H^-1 K_au.
 
 Voigt order of natural and Cartesian strain: (rr, ss, tt, rs, st, rt) and (11, 22, 33, 12, 23, 13),
 engineering shear (2 E_ij), the order of :mod:`covcontact.materials`.
+
+Materials with history (J2): every evaluation of the local EAS Newton calls ``material_update`` at each
+Gauss point with an F such that F^T F = I + 2 E (E the enhanced strain) from the element's committed
+history ``hne`` (ng, nh) (a copy made before anything is written) and writes the trial history ``hist``
+(ng, nh); the last evaluation is at the solved alpha, so history, S and the algorithmic tangent D (which
+condenses alpha) belong to it.
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..materials.hyperelastic import SVK, VOIGT_PAIRS, material_response
+from ..materials.update import material_update
 from .solid import _jacobian
 
 #: element flags: 0 ok, 1 strain not admissible (det F <= 0 / C not positive definite),
@@ -147,6 +154,77 @@ def _chol_solve(L, n, b):
 
 
 @njit(cache=True)
+def _lu(A, n, LU, piv):
+    """LU factors with partial pivoting of the leading n x n block of A (into LU, row swaps in piv);
+    False if singular. The EAS matrix of a material with history falls back to it when H is indefinite
+    (an algorithmic tangent that is not positive definite)."""
+    for i in range(n):
+        for j in range(n):
+            LU[i, j] = A[i, j]
+    for k in range(n):
+        p = k
+        big = abs(LU[k, k])
+        for i in range(k + 1, n):
+            if abs(LU[i, k]) > big:
+                big = abs(LU[i, k])
+                p = i
+        piv[k] = p
+        if not (big > 0.0):
+            return False
+        if p != k:
+            for j in range(n):
+                t = LU[k, j]
+                LU[k, j] = LU[p, j]
+                LU[p, j] = t
+        for i in range(k + 1, n):
+            f = LU[i, k] / LU[k, k]
+            LU[i, k] = f
+            for j in range(k + 1, n):
+                LU[i, j] -= f * LU[k, j]
+    return True
+
+
+@njit(cache=True)
+def _lu_solve(LU, piv, n, b):
+    """b <- A^-1 b with the factors of :func:`_lu`."""
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            t = b[k]
+            b[k] = b[p]
+            b[p] = t
+    for i in range(n):
+        s = b[i]
+        for k in range(i):
+            s -= LU[i, k] * b[k]
+        b[i] = s
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for k in range(i + 1, n):
+            s -= LU[i, k] * b[k]
+        b[i] = s / LU[i, i]
+
+
+@njit(cache=True)
+def _factor(H, n, Hf, piv, allow_lu):
+    """Factor the EAS matrix: 1 Cholesky (H positive definite), 2 LU (only if allow_lu), 0 failed."""
+    if _chol(H, n, Hf):
+        return 1
+    if allow_lu and _lu(H, n, Hf, piv):
+        return 2
+    return 0
+
+
+@njit(cache=True)
+def _solve(Hf, piv, n, b, mode):
+    """b <- H^-1 b with the factors of :func:`_factor` (mode 1 Cholesky, 2 LU)."""
+    if mode == 1:
+        _chol_solve(Hf, n, b)
+    else:
+        _lu_solve(Hf, piv, n, b)
+
+
+@njit(cache=True)
 def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
              Gp, gp, Ep, Tg, Ec, Gam, detg, J0, Ji, T0, En, dU):
     """Geometry and assumed strains of one element.
@@ -215,10 +293,26 @@ def _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
 
 
 @njit(cache=True)
-def _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F):
-    """S, D at every Gauss point for parameters alpha; EAS residual h and matrix H. Returns a flag."""
+def _material(kind, params, E, F, S, D, hn, hist):
+    """S, D at Cartesian Green-Lagrange strain E for a material with history: ``material_update`` at an F
+    with F^T F = I + 2 E from the committed history hn, trial written to hist. Returns 0, or 1 if E is not
+    admissible (S = 0, D = Hooke, hist = hn) or the material reports a failure."""
+    if _stretch(E, F):
+        return 0 if material_update(kind, params, F, hn, hist, S, D) == 0 else 1
+    for k in range(hist.size):
+        hist[k] = hn[k]
+    _response(kind, params, E, F, S, D)
+    return 1
+
+
+@njit(cache=True)
+def _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F, hne, hist):
+    """S, D at every Gauss point for parameters alpha; EAS residual h and matrix H. Returns a flag.
+
+    hne, hist (ng, nh): committed and trial material history (nh = 0: hyperelastic, no history)."""
     ng = w.size
     neas = alpha.size
+    nh = hist.shape[1]
     flag = 0
     for m in range(neas):
         h[m] = 0.0
@@ -230,7 +324,10 @@ def _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F):
             for m in range(neas):
                 s += Gam[g, K, m] * alpha[m]
             Et[g, K] = s
-        if _response(kind, params, Et[g], F, S[g], D[g]) != 0:
+        if nh > 0:
+            if _material(kind, params, Et[g], F, S[g], D[g], hne[g], hist[g]) != 0:
+                flag = FLAG_INVERTED
+        elif _response(kind, params, Et[g], F, S[g], D[g]) != 0:
             flag = FLAG_INVERTED
         wd = w[g] * detg[g]
         for m in range(neas):
@@ -253,12 +350,15 @@ def _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F):
 
 
 @njit(cache=True)
-def _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F):
+def _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F, hne, hist, piv):
     """Solve the EAS equations h(alpha) = 0 (alpha in place, from its current value).
 
     On return S, D hold the response at the solution and H the (unfactored) EAS matrix. SVK: h is
-    linear in alpha, one solve is exact and S is updated linearly. Neo-Hooke: Newton until the
-    strain increment |Gamma dalpha| <= EAS_TOL |E|, then one more evaluation at the solution.
+    linear in alpha, one solve is exact and S is updated linearly. Neo-Hooke and J2: Newton until the
+    strain increment |Gamma dalpha| <= EAS_TOL |E|, then one more evaluation at the solution (J2: every
+    evaluation runs the return mapping from the committed history hne; hist holds the trial history, S
+    and D the consistent tangent of that last evaluation; an indefinite H, possible with an algorithmic
+    tangent, is solved by LU with partial pivoting, piv (neas,) int64 scratch).
     """
     ng = w.size
     neas = alpha.size
@@ -269,14 +369,15 @@ def _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et,
             break
     done = False
     for it in range(EAS_MAXIT):
-        flag = _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F)
+        flag = _evaluate(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Et, F, hne, hist)
         if flag != 0 or neas == 0 or done:
             return flag
-        if not _chol(H, neas, Hf):
+        mode = _factor(H, neas, Hf, piv, hist.shape[1] > 0)
+        if mode == 0:
             return FLAG_EAS
         for m in range(neas):
             dal[m] = -h[m]
-        _chol_solve(Hf, neas, dal)
+        _solve(Hf, piv, neas, dal, mode)
         for m in range(neas):
             alpha[m] += dal[m]
         dmax = 0.0
@@ -419,15 +520,15 @@ def _material_tangent(dNp, gp, w, tie_ptr, tie_pt, tie_w, Tg, detg, D, Gam, Bn, 
 
 
 @njit(cache=True)
-def _condense(Ke, Kua, Hf, neas, x):
-    """Ke -= Kua H^-1 Kua^T (upper triangle), H = Hf Hf^T."""
+def _condense(Ke, Kua, Hf, neas, x, piv, mode):
+    """Ke -= Kua H^-1 Kua^T (upper triangle), H factored by :func:`_factor` (mode)."""
     nd = Ke.shape[0]
     if neas == 0:
         return
     for r in range(nd):
         for m in range(neas):
             x[m] = Kua[r, m]
-        _chol_solve(Hf, neas, x)
+        _solve(Hf, piv, neas, x, mode)
         for c in range(r, nd):
             s = 0.0
             for m in range(neas):
@@ -437,30 +538,41 @@ def _condense(Ke, Kua, Hf, neas, x):
 
 @njit(cache=True)
 def _element(kind, params, Xe, ue, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
-             want_K, Ke, fe, ws3, ws4, ws2, wsg, wv):
+             want_K, Ke, fe, ws3, ws4, ws2, wsg, wv, hist_n, hist, hne):
     """Internal force fe and condensed tangent Ke of one element; alpha updated in place.
 
     Scratch: ws3 = (Gp, gp, sig) (npt, 3, 3) each; ws4 = (Tg, D) (ng, 6, 6); ws2 = (Ep, S, Et, Ec);
-    wsg = (Gam, detg); wv = small vectors/matrices. Returns a flag (0 ok).
+    wsg = (Gam, detg); wv = small vectors/matrices. Material history (ng, nh): hist_n committed (read,
+    may be the same array as hist), hist trial (written), hne scratch (the copy of hist_n the local
+    solve works from). A failed element (det J0 <= 0, local Newton failed) keeps hist = hist_n.
+    Returns a flag (0 ok).
     """
     Gp, gp, sig = ws3
     Tg, D = ws4
     Ep, S, Et, Ec = ws2
     Gam, detg = wsg
-    J0, Ji, T0, F, En, h, H, Hf, dal, a0, x, Bn, Bc, DB, DG, Kua = wv
+    J0, Ji, T0, F, En, h, H, Hf, dal, a0, x, Bn, Bc, DB, DG, Kua, piv = wv
     nd = fe.size
     neas = alpha.size
+    nh = hist.shape[1]
+    for g in range(w.size):
+        for k in range(nh):
+            hne[g, k] = hist_n[g, k]
     for m in range(neas):
         a0[m] = alpha[m]
     flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec, Gam,
                     detg, J0, Ji, T0, En, F)
     if flag != FLAG_REFERENCE:
-        f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F)
+        f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha, S, D, h, H, Hf, dal, Et, F, hne, hist, piv)
         if f2 != 0:
             flag = f2
     if flag != 0:
         for m in range(neas):
             alpha[m] = a0[m] if np.isfinite(a0[m]) else 0.0
+        if flag != FLAG_INVERTED:
+            for g in range(w.size):
+                for k in range(nh):
+                    hist[g, k] = hne[g, k]
         for r in range(nd):
             fe[r] = 0.0
         if want_K:
@@ -480,8 +592,9 @@ def _element(kind, params, Xe, ue, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, e
     if want_K:
         _material_tangent(dNp, gp, w, tie_ptr, tie_pt, tie_w, Tg, detg, D, Gam, Bn, Bc, DB, DG, Kua, Ke)
         if neas > 0 and flag == 0:
-            if _chol(H, neas, Hf):
-                _condense(Ke, Kua, Hf, neas, x)
+            mode = _factor(H, neas, Hf, piv, nh > 0)
+            if mode != 0:
+                _condense(Ke, Kua, Hf, neas, x, piv, mode)
             else:
                 flag = FLAG_EAS
         for r in range(nd):

@@ -29,36 +29,41 @@ def _scratch(conn, dNp, w, eas_comp):
     wsg = (np.empty((ng, 6, ne)), np.empty(ng))
     wv = (np.empty((3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((3, 3)), np.empty(6), np.empty(ne),
           np.empty((ne, ne)), np.empty((ne, ne)), np.empty(ne), np.empty(ne), np.empty(ne), np.empty((6, nd)),
-          np.empty((6, nd)), np.empty((6, nd)), np.empty((6, ne)), np.empty((nd, ne)))
+          np.empty((6, nd)), np.empty((6, nd)), np.empty((6, ne)), np.empty((nd, ne)),
+          np.zeros(ne, dtype=np.int64))
     return np.empty((nen, 3)), np.empty((nen, 3)), ws3, ws4, ws2, wsg, wv
 
 
 @njit(parallel=True, cache=True)
 def solidshell_chunk(kind, params, X, u, conn, e0, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
-                     eas_val, want_K, Ke, fe, flags, nblocks):
+                     eas_val, want_K, Ke, fe, flags, nblocks, hist_n, hist):
     """Element buffers Ke (nc, nd, nd), fe (nc, nd), flags (nc,) of elements e0 .. e0 + nc - 1.
 
     alpha (nelem, neas) holds the EAS parameters: read as the start of the local Newton, overwritten
-    with the solution.
+    with the solution. hist_n, hist (nelem, ng, nh): committed (read) and trial (written) material
+    history; they may be the same array (each element copies its committed values first); nh = 0 for
+    hyperelastic materials.
     """
     nc = fe.shape[0]
     nblk = max(1, min(nblocks, nc))
     for t in prange(nblk):
         lo, hi = block_range(t, nc, nblk)
         Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
+        hne = np.empty((w.size, hist.shape[2]))
         Kdummy = np.empty((0, 0))
         for c in range(lo, hi):
             e = e0 + c
             gather(X, u, conn, e, Xe, ue)
             Kc = Ke[c] if want_K else Kdummy
             flags[c] = _element(kind, params, Xe, ue, alpha[e], dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp,
-                                eas_val, want_K, Kc, fe[c], ws3, ws4, ws2, wsg, wv)
+                                eas_val, want_K, Kc, fe[c], ws3, ws4, ws2, wsg, wv, hist_n[e], hist[e], hne)
 
 
 @njit(parallel=True, cache=True)
 def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
-                      mode, out, nthreads):
-    """Per-element quantities at the solved EAS parameters.
+                      mode, out, nthreads, hist_n):
+    """Per-element quantities at the solved EAS parameters, with hist_n (ne, ng, nh) as the committed
+    material history (read only; the trial goes to scratch).
 
     mode 0: out (ne, 1) strain energy int W(E) dV (inf if E is not admissible); mode 1: out (ne, 1)
     minimum det J0 over the centre and all evaluation points; mode 2: out (ne, 18) volume averages of
@@ -72,13 +77,15 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
     for t in prange(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
+        hne = np.empty((ng, hist_n.shape[2]))
+        htr = np.empty((ng, hist_n.shape[2]))
         Gx = np.empty((nen, 3))
         Fc = np.empty((3, 3))
         Gp, gp, _sig = ws3
         Tg, D = ws4
         Ep, S, Et, Ec = ws2
         Gam, detg = wsg
-        J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua = wv
+        J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua, piv = wv
         for e in range(lo, hi):
             gather(X, u, conn, e, Xe, ue)
             for r in range(out.shape[1]):
@@ -91,8 +98,12 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
                 continue
             flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
                             Gam, detg, J0, Ji, T0, En, F)
+            for g in range(ng):
+                for k in range(hne.shape[1]):
+                    hne[g, k] = hist_n[e, g, k]
             if flag != FLAG_REFERENCE:
-                f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F)
+                f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F,
+                                  hne, htr, piv)
                 if f2 != 0:
                     flag = f2
             if flag != 0 and (mode == 0 or flag != FLAG_INVERTED):
