@@ -222,6 +222,7 @@ class Problem:
     source: Path | None = None
     stages: list[Stage] = field(default_factory=list)  # the stages after the first (this object's own)
     stage_name: str = "stage1"                           # the name of the first stage
+    units: str = ""  # as stated by the user, e.g. "mm, N, MPa" (length first): labels of the pictures
 
     def stage_list(self) -> list[tuple[str, Steps]]:
         """(name, steps) of every stage, the first included."""

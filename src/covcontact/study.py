@@ -6,6 +6,8 @@ import copy
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from .io.output import atomic_write_text
 
 CASE_TITLES = {"a": "a: main + rotational + curvature", "b": "b: main + rotational",
@@ -67,23 +69,36 @@ def write_tables(results: dict[str, dict], out: Path, title: str) -> None:
     atomic_write_text(out / "table.csv", "\n".join(csv) + "\n")
 
 
+_STYLES = [("o", "-"), ("s", "--"), ("^", "-."), ("D", ":"), ("v", (0, (5, 1, 1, 1))), ("x", (0, (1, 1)))]
+
+
 def plot_iterations(results: dict[str, dict], path: Path, title: str) -> None:
+    """Iterations per step and cumulative, one curve per case. Cases whose iteration counts coincide are
+    drawn with their own marker and line style, slightly offset sideways, and the legend says which ones
+    coincide (otherwise the later curve hides the earlier one)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
-    for case, summary in results.items():
-        steps = [s["step"] for s in summary["steps"]]
-        its = [s["iterations"] for s in summary["steps"]]
-        cum = []
-        total = 0
-        for i in its:
-            total += i
-            cum.append(total)
-        ax1.step(steps, its, where="mid", label=f"case {case}")
-        ax2.plot(steps, cum, label=f"case {case} ({total})")
+    series = {case: [s["iterations"] for s in summary["steps"]] for case, summary in results.items()}
+    cases = list(results)
+    width = 0.12
+    for k, (case, summary) in enumerate(results.items()):
+        steps = np.array([s["step"] for s in summary["steps"]], dtype=float)
+        its = series[case]
+        cum = np.cumsum(its) if its else np.zeros(0)
+        same = [c for c in cases if c != case and series[c] == its]
+        note = f" = {', '.join(same)}" if same else ""
+        marker, line = _STYLES[k % len(_STYLES)]
+        shift = (k - (len(cases) - 1) / 2) * width if same else 0.0
+        every = max(1, len(steps) // 25)
+        ax1.step(steps + shift, its, where="mid", linestyle=line, marker=marker, markevery=every, markersize=4,
+                 label=f"case {case}{note}")
+        total = int(cum[-1]) if len(cum) else 0
+        ax2.plot(steps + shift, cum, linestyle=line, marker=marker, markevery=every, markersize=4,
+                 label=f"case {case} ({total}){note}")
     ax1.set_xlabel("load step")
     ax1.set_ylabel("Newton iterations")
     ax2.set_xlabel("load step")

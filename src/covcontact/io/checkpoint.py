@@ -37,7 +37,7 @@ def _describe(obj, h) -> None:
     elif is_dataclass(obj) and not isinstance(obj, type):
         h.update(type(obj).__name__.encode())
         for f in fields(obj):
-            if f.name in ("source", "description", "output"):
+            if f.name in ("source", "description", "output", "units"):
                 continue
             h.update(f.name.encode())
             _describe(getattr(obj, f.name), h)

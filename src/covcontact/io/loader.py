@@ -370,6 +370,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     name = meta.get("name", "str")
     description = meta.get("description", "str", "")
     meta_stage = meta.get("stage", "str", "stage1")
+    units = meta.get("units", "str", "")
     meta.done()
 
     bodies: list[Body] = []
@@ -596,4 +597,5 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     top.done()
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
-                   output=output, source=path, stages=stages, stage_name=stage_name)
+                   output=output, source=path, stages=stages, stage_name=stage_name,
+                   units=units)

@@ -100,7 +100,7 @@ def _shade(polys: np.ndarray) -> np.ndarray:
 
 
 def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title: str,
-          view: tuple[float, float]) -> None:
+          view: tuple[float, float], length: str = "") -> None:
     import matplotlib
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
@@ -130,14 +130,15 @@ def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title:
     ax.set_zlim(lo[2], hi[2])
     ax.set_box_aspect(tuple(np.maximum(span, 1e-3 * span.max())))
     ax.view_init(elev=view[0], azim=view[1])
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
-    ax.set_zlabel("z")
+    unit = f" [{length}]" if length else ""
+    ax.set_xlabel("x" + unit)
+    ax.set_ylabel("y" + unit)
+    ax.set_zlabel("z" + unit)
     ax.tick_params(labelsize=7, pad=0)
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
         axis.set_major_locator(MaxNLocator(5))
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, shrink=0.55, pad=0.12, label="displacement magnitude")
+    fig.colorbar(sm, ax=ax, shrink=0.55, pad=0.12, label="displacement magnitude" + unit)
     ax.set_title(title)
     tmp = path.with_name("." + path.name + ".tmp.png")
     fig.savefig(tmp, bbox_inches="tight", pad_inches=0.15)
@@ -176,21 +177,33 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
     lam = _load_factor(out_dir, last.name)
     step = int(last.stem.split("_")[1])
     ends = _stage_ends(out_dir)
+    length = _length_unit(out_dir)
     if ends:  # a staged run: the pvd time is not a load factor
         final = f"final state: step {step}, end of stage {ends[-1][0]!r}"
     else:
         final = f"final state: step {step}" + (f", load factor {lam:.3g}" if lam is not None else "")
     for state, name, label in ((s0, "initial.png", "initial state"), (s1, "final.png", final)):
         path = out_dir / name
-        _draw(path, state, lo, hi, vmax, label, view)
+        _draw(path, state, lo, hi, vmax, label, view, length)
         written.append(path)
     for name, k in _stage_ends(out_dir)[:-1]:  # a staged run: the end of every stage but the last
         f = out_dir / f"step_{k:04d}.vtu"
         if f.exists():
             path = out_dir / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png"
-            _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view)
+            _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view, length)
             written.append(path)
     return written
+
+
+def _length_unit(out_dir: Path) -> str:
+    """The length unit of the problem's ``units`` (its first entry), from summary.json; "" if not stated."""
+    import json
+
+    try:
+        units = json.loads((out_dir / "summary.json").read_text()).get("units", "")
+    except (OSError, ValueError):
+        return ""
+    return units.replace(";", ",").split(",")[0].strip() if units else ""
 
 
 def _stage_ends(out_dir: Path) -> list[tuple[str, int]]:

@@ -164,6 +164,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         "dofs": model.n_dofs,
         "free_dofs": int(model.free.sum()),
         "linear_solver": newton.linear.name,
+        **({"units": problem.units} if problem.units else {}),
         "total_iterations": 0,
         "wall_time_s": 0.0,
         "steps": [],
