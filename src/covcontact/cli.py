@@ -119,6 +119,10 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     handler = {"run": cmd_run, "study": cmd_study, "check-tangent": cmd_check_tangent,
                "info": cmd_info}[args.command]
+    if args.command != "info":
+        from .compile_notice import install
+
+        install()  # one line on stderr when this run has to compile kernels (a new installation)
     try:
         return handler(args)
     except InputError as exc:

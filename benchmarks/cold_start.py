@@ -1,0 +1,100 @@
+"""First run against warm run: how much of a new installation's first run is numba compiling.
+
+Each problem runs as a whole process (``python -m covcontact run P --out TMP --quiet``) twice with the same,
+initially empty, numba cache directory (NUMBA_CACHE_DIR): the first run compiles every kernel it meets and
+writes the cache, the second loads it. Then ``--kernels`` runs the first problem once more in-process with
+a fresh cache and numba's compile events recorded: the compile time per kernel (inclusive of the kernels it
+compiles on the way). Writes JSON.
+
+    python benchmarks/cold_start.py --out cold_start.json
+    python benchmarks/cold_start.py --problems examples/paper/sphere_q9.toml --kernels
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from _report import emit
+
+ROOT = Path(__file__).resolve().parents[1]
+PROBLEMS = [ROOT / "examples" / "paper" / "sphere_q9.toml", ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml"]
+
+
+def timed_run(problem: Path, cache: str) -> tuple[float, int, str]:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    with tempfile.TemporaryDirectory() as out:
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-m", "covcontact", "run", str(problem), "--out", out, "--quiet"],
+                              env=env, capture_output=True, text=True, check=False)
+        lines = proc.stderr.strip().splitlines()
+        return time.perf_counter() - t0, proc.returncode, lines[-1] if lines else ""
+
+
+def kernel_times(problem: Path) -> list[dict]:
+    """Compile time per kernel of one in-process run with an empty cache (a child process)."""
+    code = f"""
+import json, os, sys, tempfile, time
+os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp()
+from numba.core import event
+open_ = {{}}
+spent = {{}}
+class Timer(event.Listener):
+    def on_start(self, e):
+        open_[id(e)] = time.perf_counter()
+    def on_end(self, e):
+        d = e.data["dispatcher"].py_func
+        name = d.__module__ + "." + d.__qualname__
+        spent[name] = spent.get(name, 0.0) + time.perf_counter() - open_.pop(id(e), time.perf_counter())
+event.register("numba:compile", Timer())
+from covcontact.io.loader import load_problem
+with tempfile.TemporaryDirectory() as out:
+    load_problem({str(problem)!r}).run(out=out, quiet=True)
+print(json.dumps(spent))
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    import json
+
+    spent = json.loads(proc.stdout.strip().splitlines()[-1])
+    return [{"kernel": k, "seconds": round(v, 2)} for k, v in sorted(spent.items(), key=lambda kv: -kv[1])]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--problems", nargs="*", type=Path, default=PROBLEMS)
+    ap.add_argument("--repeats", type=int, default=1, help="cold/warm pairs per problem (median reported)")
+    ap.add_argument("--kernels", action="store_true", help="also the compile time per kernel (first problem)")
+    ap.add_argument("--out", default=None)
+    args = ap.parse_args()
+    rows = []
+    for problem in args.problems:
+        cold, warm = [], []
+        for _ in range(args.repeats):
+            with tempfile.TemporaryDirectory() as cache:
+                c, code_c, _ = timed_run(problem, cache)
+                w, code_w, _ = timed_run(problem, cache)
+            cold.append(c)
+            warm.append(w)
+        cold.sort()
+        warm.sort()
+        row = {"problem": str(problem.relative_to(ROOT)) if problem.is_relative_to(ROOT) else str(problem),
+               "first_run_s": round(cold[len(cold) // 2], 2), "warm_run_s": round(warm[len(warm) // 2], 2),
+               "exit_codes": [code_c, code_w]}
+        row["ratio"] = round(row["first_run_s"] / row["warm_run_s"], 2)
+        rows.append(row)
+    result = {"python": platform.python_version(), "machine": platform.machine(), "problems": rows}
+    if args.kernels:
+        result["kernels"] = kernel_times(args.problems[0])[:40]
+    table = "\n".join(f"{r['problem']:50s} first {r['first_run_s']:7.1f} s  warm {r['warm_run_s']:6.1f} s  "
+                      f"ratio {r['ratio']:.1f}" for r in rows)
+    emit(result, args.out, table)
+
+
+if __name__ == "__main__":
+    main()
