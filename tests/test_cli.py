@@ -88,6 +88,19 @@ BAD_CASES = {
     "missing-mesh-file": (GOOD.replace('mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, '
                                        'ny = 2, nz = 2 }', 'mesh = { file = "nowhere.msh" }'),
                           "does not exist"),
+    "mesh-path-shown": (GOOD.replace('mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, '
+                                     'ny = 2, nz = 2 }', 'mesh = { file = "meshes/nowhere.msh" }'),
+                        "meshes/nowhere.msh; a relative path is taken from the problem file's folder"),
+    "suggest-key": (GOOD.replace('components = "xyz"', 'component = "xyz"'),
+                    "dirichlet[0].component: unknown key; did you mean 'components'?"),
+    "suggest-misspelt-required": (GOOD.replace("material = {", "materal = {"),
+                                  "bodies[0].material: missing required key (found 'materal'"),
+    "suggest-section": (GOOD.replace("[steps]", "[step]"), "step: unknown section; did you mean 'steps'?"),
+    "suggest-set": (GOOD.replace('set = "cube.zmin"', 'set = "cube.zmni"'), "did you mean 'zmin'?"),
+    "suggest-body": (GOOD.replace('set = "cube.zmin"', 'set = "cueb.zmin"'),
+                     "no body named 'cueb'; did you mean 'cube'?"),
+    "suggest-choice": (GOOD.replace('model = "svk"', 'model = "SVK"'), "did you mean 'svk'?"),
+    "suggest-generator-key": (GOOD.replace("nz = 2 }", "nzz = 2 }"), "did you mean 'nz'?"),
     "bad-tangent": (GOOD + '\n[[rigid]]\nname = "floor"\nshape = "plane"\npoint = [0.0, 0.0, 0.0]\n'
                            'normal = [0.0, 0.0, 1.0]\n\n[[contact]]\nslave = "cube.zmin"\nmaster = "floor"\n'
                            'penalty = 1.0\ntangent = "e"\n', "contact[0].tangent"),

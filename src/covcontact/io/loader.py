@@ -29,7 +29,7 @@ from ..problem import (
     Steps,
     Traction,
 )
-from .validate import _REQUIRED, InputError, Section
+from .validate import _REQUIRED, InputError, Section, suggest
 
 CELLS = ("hex8", "hex18", "hex27")
 RIGID_SHAPES = ("plane", "cylinder", "sphere", "mesh")
@@ -54,11 +54,12 @@ def build_mesh(sec: Section, base: Path, element: str | None):
         sec.done()
         path = (base / fname) if not Path(fname).is_absolute() else Path(fname)
         if not path.exists():
-            sec.fail(f"mesh file {fname} does not exist", "file")
+            sec.fail(f"mesh file {fname!r} does not exist (looked for {path}; a relative path is taken from the "
+                     f"problem file's folder)", "file")
         try:
             mesh = read_mesh(path)
         except (MeshError, ValueError, KeyError, OSError) as exc:
-            sec.fail(f"cannot read mesh file {fname}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}",
+            sec.fail(f"cannot read mesh file {path}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}",
                      "file")
         if element is not None and mesh.cell_type != element:
             sec.fail(f"element {element!r} does not match the mesh file's cells ({mesh.cell_type})", "file")
@@ -71,7 +72,8 @@ def build_mesh(sec: Section, base: Path, element: str | None):
     for key, value in sec.rest().items():
         if key not in params or key == "cell":
             allowed = ", ".join(k for k in params if k != "cell")
-            sec.fail(f"unknown key for generator {name!r} (allowed: {allowed})", key)
+            sec.fail(f"unknown key for generator {name!r}{suggest(key, [k for k in params if k != 'cell'])} "
+                     f"(allowed: {allowed})", key)
         if isinstance(value, bool) or not isinstance(value, (int, float, str, list)):
             sec.fail("must be a number, string or array", key)
         if isinstance(value, list):
@@ -280,7 +282,7 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
     def check_name(sec: Section, key: str, value: str, kinds: tuple[str, ...], what: str) -> tuple[str, object]:
         if value not in named or named[value][0] not in kinds:
             known = sorted(n for n, (k, _) in named.items() if k in kinds)
-            sec.fail(f"no {what} named {value!r} (named ones: {', '.join(known) or 'none'})", key)
+            sec.fail(f"no {what} named {value!r}{suggest(value, known)} (named ones: {', '.join(known) or 'none'})", key)
         if value in released_before:
             sec.fail(f"{value!r} was released in stage {released_before[value]!r}; a released condition "
                      f"stays free", key)
@@ -325,7 +327,7 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
                                               and o.motion is not None}
         for n in list(msec.data):
             if n not in movable:
-                msec.fail(f"no rigid body or Dirichlet condition with a motion named {n!r} (known: "
+                msec.fail(f"no rigid body or Dirichlet condition with a motion named {n!r}{suggest(n, movable)} (known: "
                           f"{', '.join(sorted(movable)) or 'none'})", n)
             if n in named and n in {r.name for r in rigid}:
                 msec.fail(f"{n!r} names both a rigid body and a Dirichlet condition; rename one", n)
@@ -342,7 +344,7 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
         pairs = {c.name for c in contacts}
         for n in list(csec.data):
             if n not in pairs:
-                csec.fail(f"no contact pair named {n!r} (known: {', '.join(sorted(pairs)) or 'none'})", n)
+                csec.fail(f"no contact pair named {n!r}{suggest(n, pairs)} (known: {', '.join(sorted(pairs)) or 'none'})", n)
             switch[n] = csec.get(n, "bool")
         csec.done()
     st.done()
@@ -363,9 +365,16 @@ def load_problem(path: str | Path) -> Problem:
     return problem_from_dict(raw, path)
 
 
+_TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "contact", "steps",
+              "stages", "solver", "output")
+
+
 def problem_from_dict(raw: dict, path: Path) -> Problem:
     base = path.parent
     top = Section(raw, "", path)
+    stray = sorted(set(top.data) - set(_TOP_LEVEL))
+    if stray:  # before anything else: a misspelt section would otherwise surface as a missing name elsewhere
+        top.fail("unknown section" + suggest(stray[0], _TOP_LEVEL, f" (known: {', '.join(_TOP_LEVEL)})"), stray[0])
     meta = top.get("problem", "table")
     name = meta.get("name", "str")
     description = meta.get("description", "str", "")
@@ -454,11 +463,14 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         if owner is None:
             owner = next((r.mesh for r in rigid if r.name == bname and r.mesh is not None), None)
         if owner is None:
-            sec.fail(f"{ref!r}: no body named {bname!r}", key)
+            names = [b.name for b in bodies] + [r.name for r in rigid if r.mesh is not None]
+            sec.fail(f"{ref!r}: no body named {bname!r}{suggest(bname, names)} (bodies: {', '.join(names) or 'none'})",
+                     key)
         sets = owner.node_sets if kind == "node" else owner.face_sets
         if sname not in sets:
             known = ", ".join(sorted(sets)) or "none"
-            sec.fail(f"{ref!r}: body {bname!r} has no {kind} set {sname!r} (known: {known})", key)
+            sec.fail(f"{ref!r}: body {bname!r} has no {kind} set {sname!r}{suggest(sname, sets)} (known: {known})",
+                     key)
         if len(sets[sname]) == 0:
             sec.fail(f"{ref!r}: {kind} set is empty", key)
         return bname, sname

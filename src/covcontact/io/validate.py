@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import math
 from pathlib import Path
 from typing import Any
@@ -12,6 +13,16 @@ class InputError(ValueError):
 
 
 _REQUIRED = object()
+
+
+def suggest(word: str, candidates, fallback: str = "") -> str:
+    """``"; did you mean 'x'?"`` for the closest of ``candidates`` to ``word`` (difflib), else ``fallback``."""
+    names = [str(c) for c in candidates]
+    close = difflib.get_close_matches(str(word), names, n=1, cutoff=0.6)
+    if not close:
+        lower = {n.lower(): n for n in names}
+        close = [lower[str(word).lower()]] if str(word).lower() in lower else []
+    return f"; did you mean {close[0]!r}?" if close else fallback
 
 
 def _type_name(value: Any) -> str:
@@ -28,6 +39,7 @@ class Section:
         if not isinstance(data, dict):
             self.fail(f"must be a table, got {_type_name(data)}")
         self.data = dict(data)
+        self.known: set[str] = set()
 
     def fail(self, msg: str, key: str | None = None):
         where = self.key_path(key) if key else self.path
@@ -37,19 +49,25 @@ class Section:
         return f"{self.path}.{key}" if self.path else key
 
     def has(self, key: str) -> bool:
+        self.known.add(key)
         return key in self.data
 
     def get(self, key: str, kind: str, default: Any = _REQUIRED, *, positive: bool = False,
             nonnegative: bool = False, choices: tuple | None = None, length: int | None = None) -> Any:
         """Take ``key``; kind is one of str, float, int, bool, vector, floats, table, array, any."""
+        self.known.add(key)
         if key not in self.data:
             if default is _REQUIRED:
-                self.fail("missing required key", key)
+                spelt = difflib.get_close_matches(key, [k for k in self.data if k not in self.known], n=1,
+                                                  cutoff=0.6)
+                hint = f" (found {spelt[0]!r}: a misspelling of {key!r}?)" if spelt else ""
+                self.fail(f"missing required key{hint}", key)
             return default
         value = self.data.pop(key)
         value = self._convert(key, value, kind, length)
         if choices is not None and value not in choices:
-            self.fail(f"{value!r} is not one of {', '.join(map(str, choices))}", key)
+            self.fail(f"{value!r} is not one of {', '.join(map(str, choices))}"
+                      f"{suggest(value, choices) if isinstance(value, str) else ''}", key)
         if positive and not value > 0:
             self.fail(f"must be > 0, got {value}", key)
         if nonnegative and not value >= 0:
@@ -100,7 +118,9 @@ class Section:
         out, self.data = self.data, {}
         return out
 
-    def done(self) -> None:
+    def done(self, known=()) -> None:
+        """Reject the keys nobody took; the message proposes the closest key this table knows."""
         if self.data:
             key = sorted(self.data)[0]
-            self.fail("unknown key", key)
+            allowed = (self.known | set(known)) - set(self.data)
+            self.fail("unknown key" + suggest(key, sorted(allowed)), key)
