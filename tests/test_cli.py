@@ -191,3 +191,31 @@ def test_console_script_runs(tmp_path):
                            str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert (tmp_path / "o" / "summary.json").exists()
+
+
+def test_every_option_has_help():
+    """`covcontact CMD --help` explains every option (argparse shows no text for options without help)."""
+    from covcontact.cli import _parser
+
+    parser = _parser()
+    subs = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    for name, sub in subs.choices.items():
+        assert sub.description, name
+        for action in sub._actions:
+            assert action.help, f"{name}: {action.dest} has no help text"
+
+
+def test_check_tangent_verdict_and_exit_code(tmp_path, capsys):
+    problem = ROOT / "examples" / "contact" / "block_on_sphere.toml"
+    code, out, _ = run_cli(["check-tangent", problem, "--step", "1", "--columns", "12"], capsys)
+    err = float(out.splitlines()[0].split("relative error")[1])
+    assert code == 0 and out.splitlines()[1].startswith("PASS") and err < 1e-6
+    # the main part alone is not the consistent tangent of a curved surface: a verdict of failure, exit 1
+    code, out, _ = run_cli(["check-tangent", problem, "--step", "1", "--columns", "12", "--tangent", "d"], capsys)
+    assert code == 1 and out.splitlines()[1].startswith("FAIL") and "--tangent exact" in out
+    # a tolerance below the measured error of the exact tangent fails too
+    code, out, _ = run_cli(["check-tangent", problem, "--step", "1", "--columns", "12", "--tol",
+                            f"{err / 10:.3e}"], capsys)
+    assert code == 1 and "FAIL" in out
+    code, _, stderr = run_cli(["check-tangent", problem, "--tol", "-1"], capsys)
+    assert code == 2 and "--tol" in stderr
