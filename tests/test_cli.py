@@ -219,3 +219,23 @@ def test_check_tangent_verdict_and_exit_code(tmp_path, capsys):
     assert code == 1 and "FAIL" in out
     code, _, stderr = run_cli(["check-tangent", problem, "--tol", "-1"], capsys)
     assert code == 2 and "--tol" in stderr
+
+
+def test_output_files_have_the_users_permissions(tmp_path, capsys):
+    """Every file of a run gets 0666 less the umask, as the pictures do, not a temporary file's 0600."""
+    import os
+    import stat
+
+    path = write(tmp_path, GOOD.replace("count = 2", "count = 2\n\n[output]\npictures = true"))
+    old = os.umask(0o027)
+    try:
+        code, _, _ = run_cli(["run", path, "--out", tmp_path / "o", "--quiet"], capsys)
+    finally:
+        os.umask(old)
+    assert code == 0
+    files = [f for f in (tmp_path / "o").rglob("*") if f.is_file()]
+    names = {f.name for f in files}
+    assert {"summary.json", "convergence.csv", "result.pvd", "step_0001.vtu", "checkpoint.npz"} <= names, names
+    assert any(n.endswith(".png") for n in names), names
+    for f in files:
+        assert stat.S_IMODE(f.stat().st_mode) == 0o640, (f.name, oct(f.stat().st_mode))

@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 import zipfile
 from dataclasses import fields, is_dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .atomic import replacing
 from .validate import InputError
 
 VERSION = 1
@@ -75,16 +74,8 @@ def save(out: Path, u: np.ndarray, arrays: dict[str, np.ndarray], meta: dict, ra
     """Write the checkpoint of one rank atomically."""
     path = path_for(out, rank, size)
     meta = dict(meta, version=VERSION, ranks=size)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
-    os.close(fd)
-    try:
-        with open(tmp, "wb") as fh:
-            np.savez(fh, u=u, meta=np.array(json.dumps(meta)), **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with replacing(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(fh, u=u, meta=np.array(json.dumps(meta)), **arrays)
     return path
 
 

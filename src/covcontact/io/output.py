@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import meshio
 import numpy as np
+
+from .atomic import replacing
 
 # hex18 has no VTK type: each element is written as four linear hexahedra over its 3x3 node grid
 _HEX18_SPLIT = np.array([
@@ -22,16 +22,8 @@ _VTK_NAME = {"hex8": "hexahedron", "hex27": "hexahedron27", "quad4": "quad", "qu
 
 def atomic_write_text(path: Path, text: str) -> None:
     """Write text to ``path`` through a temporary file in the same folder and a rename."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix="." + path.name, suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with replacing(path) as tmp, open(tmp, "w") as fh:
+        fh.write(text)
 
 
 def vtk_cells(cell_type: str, cells: np.ndarray) -> tuple[str, np.ndarray, np.ndarray]:
@@ -72,15 +64,8 @@ class ResultWriter:
                 cdata.setdefault(key, []).append(arr)
         mesh = meshio.Mesh(points, cells, point_data=point_data, cell_data=cdata)
         name = f"step_{step:04d}.vtu"
-        fd, tmp = tempfile.mkstemp(dir=self.out, prefix="." + name, suffix=".vtu")
-        os.close(fd)
-        try:
+        with replacing(self.out / name) as tmp:
             meshio.write(tmp, mesh, file_format="vtu", binary=True)
-            os.replace(tmp, self.out / name)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
         self.pvd_entries.append((time_value, name))
         self._write_pvd()
 

@@ -121,6 +121,6 @@ class Section:
     def done(self, known=()) -> None:
         """Reject the keys nobody took; the message proposes the closest key this table knows."""
         if self.data:
-            key = sorted(self.data)[0]
+            key = min(self.data)
             allowed = (self.known | set(known)) - set(self.data)
             self.fail("unknown key" + suggest(key, sorted(allowed)), key)

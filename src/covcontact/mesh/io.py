@@ -21,7 +21,6 @@ from __future__ import annotations
 import contextlib
 import io
 import os
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -29,6 +28,7 @@ import meshio
 import numpy as np
 
 from ..fem.shapes import NODES
+from ..io.atomic import replacing
 from .faces import match_boundary_faces
 from .mesh import Mesh
 
@@ -107,15 +107,8 @@ def write_vtu(
     m = to_meshio(mesh, point_data, cell_data)
     m.point_sets, m.cell_sets = {}, {}
     target = Path(path)
-    fd, tmp = tempfile.mkstemp(suffix=".vtu", prefix=f".{target.name}.", dir=target.parent or ".")
-    os.close(fd)
-    try:
+    with replacing(target) as tmp:
         meshio.write(tmp, m, file_format="vtu")
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
 
 
 def _groups(m: meshio.Mesh) -> dict[str, list[tuple[int, np.ndarray]]]:
