@@ -23,3 +23,14 @@ def test_example_runs(tmp_path, path):
     assert "warnings" not in summary, summary["warnings"]  # no example looks wrong to the guard rails
     if load_problem(path).output.vtu:
         assert (tmp_path / "result.pvd").exists()
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "examples").rglob("*.toml")), ids=lambda p: p.stem)
+def test_header_true_to_the_file(path):
+    """What an example's header comment says about the Newton criterion is what the file sets."""
+    header = " ".join(line.lstrip("# ") for line in path.read_text().splitlines() if line.startswith("#"))
+    criterion = load_problem(path).solver.criterion
+    if "with the energy criterion" in header:
+        assert criterion in ("energy", "both"), path
+    if "on the residual" in header:
+        assert criterion in ("residual", "both"), path

@@ -49,7 +49,7 @@ def _need_mpi():
     if MISSING:
         if os.environ.get("COVCONTACT_REQUIRE_MPI") == "1":
             pytest.fail(f"COVCONTACT_REQUIRE_MPI=1 but the MPI extra is missing: {MISSING}")
-        pytest.skip(f"MPI extra not installed ({MISSING}); pip install -e '.[mpi]'")
+        pytest.skip(f"MPI extra not installed ({MISSING}); bash tools/install-mpi.sh installs it (PETSc from source)")
 
 
 def _serial(path: Path, out: Path, solver: str | None = None):
