@@ -2,11 +2,14 @@
 
 Each problem runs as a whole process (``python -m covcontact run P --out TMP --quiet``) twice with the same,
 initially empty, numba cache directory (NUMBA_CACHE_DIR): the first run compiles every kernel it meets and
-writes the cache, the second loads it. Then ``--kernels`` runs the first problem once more in-process with
+writes the cache, the second loads it. With ``--compile-step`` a third, again empty, cache directory is
+first filled by ``covcontact compile`` (timed) and then the problem runs once more: the first run of an
+installation that ran the compile step (its stderr is checked for the compile notice). Then ``--kernels`` runs the first problem once more in-process with
 a fresh cache and numba's compile events recorded: the compile time per kernel (inclusive of the kernels it
 compiles on the way). Writes JSON.
 
     python benchmarks/cold_start.py --out cold_start.json
+    python benchmarks/cold_start.py --compile-step --out cold_start.json
     python benchmarks/cold_start.py --problems examples/paper/sphere_q9.toml --kernels
 """
 
@@ -27,14 +30,15 @@ ROOT = Path(__file__).resolve().parents[1]
 PROBLEMS = [ROOT / "examples" / "paper" / "sphere_q9.toml", ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml"]
 
 
-def timed_run(problem: Path, cache: str) -> tuple[float, int, str]:
+def timed_run(problem: Path | None, cache: str) -> tuple[float, int, str]:
+    """Wall time, exit code and stderr of ``covcontact run problem`` (``covcontact compile`` for None)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=cache)
     with tempfile.TemporaryDirectory() as out:
+        cmd = ["compile"] if problem is None else ["run", str(problem), "--out", out, "--quiet"]
         t0 = time.perf_counter()
-        proc = subprocess.run([sys.executable, "-m", "covcontact", "run", str(problem), "--out", out, "--quiet"],
-                              env=env, capture_output=True, text=True, check=False)
-        lines = proc.stderr.strip().splitlines()
-        return time.perf_counter() - t0, proc.returncode, lines[-1] if lines else ""
+        proc = subprocess.run([sys.executable, "-m", "covcontact", *cmd], env=env, capture_output=True, text=True,
+                              check=False)
+        return time.perf_counter() - t0, proc.returncode, proc.stderr
 
 
 def kernel_times(problem: Path) -> list[dict]:
@@ -69,6 +73,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--problems", nargs="*", type=Path, default=PROBLEMS)
     ap.add_argument("--repeats", type=int, default=1, help="cold/warm pairs per problem (median reported)")
+    ap.add_argument("--compile-step", action="store_true",
+                    help="also time `covcontact compile` into an empty cache and the first run after it")
     ap.add_argument("--kernels", action="store_true", help="also the compile time per kernel (first problem)")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
@@ -87,12 +93,22 @@ def main() -> None:
                "first_run_s": round(cold[len(cold) // 2], 2), "warm_run_s": round(warm[len(warm) // 2], 2),
                "exit_codes": [code_c, code_w]}
         row["ratio"] = round(row["first_run_s"] / row["warm_run_s"], 2)
+        if args.compile_step:
+            with tempfile.TemporaryDirectory() as cache:
+                step, code_s, _ = timed_run(None, cache)
+                after, code_a, err = timed_run(problem, cache)
+            row.update(compile_step_s=round(step, 2), first_run_after_compile_s=round(after, 2),
+                       ratio_after_compile=round(after / row["warm_run_s"], 2),
+                       compiled_during_run="compiling" in err, exit_codes_compile=[code_s, code_a])
         rows.append(row)
     result = {"python": platform.python_version(), "machine": platform.machine(), "problems": rows}
     if args.kernels:
         result["kernels"] = kernel_times(args.problems[0])[:40]
     table = "\n".join(f"{r['problem']:50s} first {r['first_run_s']:7.1f} s  warm {r['warm_run_s']:6.1f} s  "
-                      f"ratio {r['ratio']:.1f}" for r in rows)
+                      f"ratio {r['ratio']:.1f}" + (f"  compile step {r['compile_step_s']:.1f} s, then first run "
+                                                   f"{r['first_run_after_compile_s']:.1f} s (ratio "
+                                                   f"{r['ratio_after_compile']:.2f})" if "compile_step_s" in r else "")
+                      for r in rows)
     emit(result, args.out, table)
 
 

@@ -239,3 +239,22 @@ def test_output_files_have_the_users_permissions(tmp_path, capsys):
     assert any(n.endswith(".png") for n in names), names
     for f in files:
         assert stat.S_IMODE(f.stat().st_mode) == 0o640, (f.name, oct(f.stat().st_mode))
+
+
+def test_compile_command(capsys):
+    """`covcontact compile` runs its warm-up problems (here one of them) and says what it did."""
+    code, _, err = run_cli(["compile", "--only", "plane with friction"], capsys)
+    assert code == 0, err
+    assert "compiled hex8 on a plane with friction" in err and "1 warm-up problems" in err
+    code, _, err = run_cli(["compile", "--only", "no such label"], capsys)
+    assert code == 2 and "--only" in err and len(err.strip().splitlines()) == 1
+
+
+def test_warmup_problems_are_quiet_and_converge(capsys):
+    """Every warm-up problem is a valid, converging problem without start warnings."""
+    from covcontact.warmup import PROBLEMS, warm
+
+    done = warm()
+    assert [label for label, _ in done] == [label for label, _ in PROBLEMS]
+    err = capsys.readouterr().err
+    assert "warning" not in err and err.count("covcontact: compiled") == len(PROBLEMS)

@@ -1,4 +1,4 @@
-"""Command line: covcontact run | study | check-tangent | info.
+"""Command line: covcontact run | study | check-tangent | compile | info.
 
 Exit codes: 0 done; 1 a step did not converge even after cutbacks (converged steps are written);
 2 bad input or a checkpoint that cannot be resumed (one line on stderr); 3 anything else (a bug: the
@@ -64,6 +64,12 @@ def _parser() -> argparse.ArgumentParser:
                    help="tangent columns to difference: contact dofs first, then a random sample (default 60)")
     c.add_argument("--tol", type=float, default=1e-6,
                    help="largest relative error (Frobenius norm) that passes (default 1e-6)")
+    w = sub.add_parser("compile", help="compile every numerical kernel into numba's cache (once, after installing)",
+                       description="Run tiny problems that call every compiled kernel, so that numba's cache "
+                       "holds them all and the first real run starts at once. Run it once after installing "
+                       "covcontact or upgrading numba.")
+    w.add_argument("--only", default=None, metavar="TEXT",
+                   help="only the warm-up problems whose label contains TEXT (default: all)")
     sub.add_parser("info", help="version, linear solvers, threads",
                    description="Print the version, the linear solvers available here and the thread count.")
     return p
@@ -126,6 +132,21 @@ def cmd_check_tangent(args) -> int:
     return 0 if ok else 1
 
 
+def cmd_compile(args) -> int:
+    import time
+
+    from .warmup import PROBLEMS, warm
+
+    if args.only is not None and not any(args.only in label for label, _ in PROBLEMS):
+        raise InputError(f"--only: no warm-up problem matches {args.only!r} (labels: "
+                         f"{'; '.join(label for label, _ in PROBLEMS)})")
+    t0 = time.perf_counter()
+    done = warm(only=args.only)
+    print(f"covcontact: {len(done)} warm-up problems in {time.perf_counter() - t0:.1f} s; the kernels are in "
+          f"numba's cache", file=sys.stderr)
+    return 0
+
+
 def cmd_info(args) -> int:
     import numba
 
@@ -143,8 +164,8 @@ def cmd_info(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     handler = {"run": cmd_run, "study": cmd_study, "check-tangent": cmd_check_tangent,
-               "info": cmd_info}[args.command]
-    if args.command != "info":
+               "compile": cmd_compile, "info": cmd_info}[args.command]
+    if args.command not in ("info", "compile"):
         from .compile_notice import install
 
         install()  # one line on stderr when this run has to compile kernels (a new installation)

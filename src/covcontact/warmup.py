@@ -1,0 +1,239 @@
+"""``covcontact compile``: compile every numerical kernel once, into numba's cache, before the first real run.
+
+numba compiles a kernel the first time it is called and keeps the machine code in its cache (the
+``__pycache__`` folders of the installed package, or ``NUMBA_CACHE_DIR``). A new installation's first run
+therefore pays the compilation of every kernel it meets (docs/performance.md, "Cold start"). This module
+runs a handful of tiny problems that together call every compiled kernel with the argument types real runs
+use: each element family (hex8, hex27, F-bar hex8, solid-shells hex8 and hex18, elastic and plastic), each
+material, each kind of master surface (deformable facets quad4 and quad9, rigid meshes, analytic plane,
+cylinder and sphere), friction, the output fields. Run once after installing; later runs load the cache.
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+_STEPS = "\n[steps]\ncount = 2\n\n[output]\nevery = 1\n"
+
+_HEAD = '[problem]\nname = "{name}"\n\n'
+
+#: (label, problem text): tiny problems, two load steps each, VTU output on.
+PROBLEMS: tuple[tuple[str, str], ...] = (
+    ("hex8 on a plane with friction", """
+[[bodies]]
+name = "block"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 2, ny = 2, nz = 1 }
+[[rigid]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+[[contact]]
+slave = "block.zmin"
+master = "floor"
+penalty = 1.0e6
+weighting = "area"
+friction = 0.3
+[[dirichlet]]
+set = "block.zmax"
+components = "xyz"
+value = [0.05, 0.0, -0.01]
+"""),
+    ("hex27 Neo-Hooke on a sphere, exact tangent", """
+[[bodies]]
+name = "block"
+element = "hex27"
+material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-0.5, -0.5, 0.0] }
+[[rigid]]
+name = "ball"
+shape = "sphere"
+center = [0.0, 0.0, -1.0]
+radius = 1.0
+[[contact]]
+slave = "block.zmin"
+master = "ball"
+penalty = 1.0e5
+tangent = "exact"
+[[dirichlet]]
+set = "block.zmax"
+components = "xyz"
+value = [0.0, 0.0, -0.01]
+"""),
+    ("hex8 on a cylinder with friction", """
+[[bodies]]
+name = "block"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-0.5, -0.5, 0.0] }
+[[rigid]]
+name = "drum"
+shape = "cylinder"
+center = [0.0, 0.0, -1.0]
+axis = [0.0, 1.0, 0.0]
+radius = 1.0
+[[contact]]
+slave = "block.zmin"
+master = "drum"
+penalty = 1.0e5
+friction = 0.2
+[[dirichlet]]
+set = "block.zmax"
+components = "xyz"
+value = [0.02, 0.0, -0.01]
+"""),
+    ("two hex8 bodies, quad4 facets, friction", """
+[[bodies]]
+name = "base"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-1.0, -1.0, -0.5] }
+[[bodies]]
+name = "punch"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
+[[contact]]
+slave = "punch.zmin"
+master = "base.zmax"
+penalty = 1.0e6
+weighting = "area"
+friction = 0.2
+tangent = "exact"
+[[dirichlet]]
+set = "base.zmin"
+components = "xyz"
+[[dirichlet]]
+set = "punch.zmax"
+components = "xyz"
+value = [0.01, 0.0, -0.02]
+"""),
+    ("rigid meshed ball into a hex27 plate, quad9 facets", """
+[[bodies]]
+name = "plate"
+element = "hex27"
+material = { model = "svk", E = 1.0e4, nu = 0.3 }
+mesh = { generator = "plate", lx = 2.0, ly = 2.0, t = 0.1, nx = 3, ny = 3, origin = [-1.04, -0.97, -0.11] }
+[[rigid]]
+name = "ball"
+shape = "mesh"
+element = "hex8"
+mesh = { generator = "hemisphere_solid", radius = 0.5, n = 2 }
+motion = { translation = [0.0, 0.0, -0.05] }
+[[contact]]
+slave = "ball.curved"
+master = "plate.top"
+penalty = 1.0e3
+[[dirichlet]]
+set = "plate.xmin"
+components = "xyz"
+[[dirichlet]]
+set = "plate.xmax"
+components = "xyz"
+"""),
+    ("hex18 solid-shell on a rigid meshed sphere (quad9 master)", """
+[[bodies]]
+name = "plate"
+element = "hex18"
+formulation = "solid-shell"
+material = { model = "svk", E = 2.1e5, nu = 0.3 }
+mesh = { generator = "plate", lx = 9.0, ly = 4.0, t = 1.0, nx = 3, ny = 2 }
+[[rigid]]
+name = "sphere"
+shape = "mesh"
+element = "hex8"
+mesh = { generator = "sphere_patch", radius = 2.95, t = 0.1, theta0 = 0.0, theta1 = 1.2, phi0 = 0.0, phi1 = 6.283185307179586, n_theta = 2, n_phi = 8, center = [3.03, 2.03, -3.001] }
+[[contact]]
+slave = "sphere.outer"
+master = "plate.bottom"
+penalty = 1.0e4
+weighting = "area"
+[[dirichlet]]
+set = "plate.xmin"
+components = "xyz"
+[[force]]
+set = "plate.xmax"
+value = [0.0, 0.0, -1.0]
+distribution = "total"
+"""),
+    ("hex8 solid-shell, J2 with Swift hardening, on a rigid meshed cylinder", """
+[[bodies]]
+name = "strip"
+element = "hex8"
+formulation = "solid-shell"
+options = { thickness_points = 3 }
+material = { model = "j2", E = 2.1e5, nu = 0.3, hardening = { law = "swift", K = 500.0, eps0 = 0.01, n = 0.2 } }
+mesh = { generator = "plate", lx = 9.0, ly = 4.0, t = 1.0, nx = 3, ny = 2 }
+[[rigid]]
+name = "drum"
+shape = "mesh"
+element = "hex27"
+mesh = { generator = "cylinder_patch", radius = 2.95, length = 4.0, angle0 = -0.5708, angle1 = 0.5708, t = 0.1, n_circ = 2, n_len = 2, axis = "y", center = [4.5, 0.0, -3.001] }
+[[contact]]
+slave = "drum.outer"
+master = "strip.bottom"
+penalty = 1.0e4
+[[dirichlet]]
+set = "strip.xmin"
+components = "xyz"
+[[dirichlet]]
+set = "strip.xmax"
+components = "z"
+value = -0.5
+"""),
+    ("F-bar hex8 and hex8, J2 with Voce and kinematic hardening, Hill48", """
+[[bodies]]
+name = "block"
+element = "hex8"
+formulation = "fbar"
+material = { model = "j2", E = 1000.0, nu = 0.3, yield_stress = 1.0, kinematic_modulus = 10.0, hardening = { law = "voce", sigma_inf = 1.5, delta = 10.0, modulus = 1.0 }, hill48 = { r0 = 1.5, r45 = 1.2, r90 = 1.8 } }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 1, ny = 1, nz = 2 }
+[[bodies]]
+name = "cap"
+element = "hex8"
+material = { model = "j2", E = 1000.0, nu = 0.3, yield_stress = 1.0, hardening = { law = "linear", modulus = 10.0 } }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 1, ny = 1, nz = 1, origin = [0.0, 0.0, 1.0] }
+[[dirichlet]]
+set = "block.zmin"
+components = "xyz"
+[[dirichlet]]
+set = "block.zmax"
+components = "z"
+value = 0.01
+[[dirichlet]]
+set = "cap.zmax"
+components = "xyz"
+value = [0.0, 0.0, -0.01]
+"""),
+)
+
+
+def warm(stream=None, only: str | None = None, quiet: bool = False) -> list[tuple[str, float]]:
+    """Run every warm-up problem (or those whose label contains ``only``); (label, seconds) per problem.
+
+    A line per problem goes to ``stream`` (default: the current stderr) unless ``quiet``.
+    """
+    from .io.loader import problem_from_dict
+
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, (label, body) in enumerate(PROBLEMS):
+            if only is not None and only not in label:
+                continue
+            text = _HEAD.format(name=f"warmup-{i}") + body + _STEPS
+            problem = problem_from_dict(tomllib.loads(text), Path(tmp) / f"warmup-{i}.toml")
+            t0 = time.perf_counter()
+            result = problem.run(out=Path(tmp) / f"w{i}", quiet=True)
+            dt = time.perf_counter() - t0
+            if result.exit_code != 0:
+                raise RuntimeError(f"warm-up problem {label!r} did not converge (exit {result.exit_code})")
+            times.append((label, dt))
+            if not quiet:
+                print(f"covcontact: compiled {label} ({dt:.1f} s)", file=stream or sys.stderr, flush=True)
+    return times
