@@ -45,6 +45,10 @@ def test_first_hour(tmp_path, capsys):
     last = meshio.read(out / files[-1])
     assert np.isfinite(last.point_data["displacement"]).all()
     assert np.nanmax(last.point_data["contact_pressure"]) > 0
+    # the contact force acts on the block (slave side) and, opposite, on the sphere
+    on = steps[-1]["contact_force_on"]
+    np.testing.assert_allclose(on["block"], steps[-1]["contact_force"], rtol=1e-12)
+    np.testing.assert_allclose(on["ball"], -np.array(steps[-1]["contact_force"]), rtol=1e-12)
 
     # 2. the same from Python: the same iterations per step and the same contact force
     result = load_problem(PROBLEM).run(out=tmp_path / "api", tangent="exact", quiet=True)

@@ -51,9 +51,17 @@ def step_report(manager, x: np.ndarray, lam: float, state: ContactState) -> dict
             entry.update(augmentations=rows[0][6], max_penetration=max(r[5] for r in rows))
         pairs[p.name] = entry
     total_force = np.sum([v["contact_force"] for v in pairs.values()], axis=0).tolist() if pairs else [0.0] * 3
+    # the resultant contact force acting on each body: + on the slave side, - on the master side of a pass
+    on_body: dict[str, np.ndarray] = {}
+    for k, p in enumerate(manager.passes):
+        f = np.sum([e[k][4] for e in every], axis=0)
+        for body, sign in ((p.slave_body, 1.0), (p.master_body, -1.0)):
+            if body:
+                on_body[body] = on_body.get(body, np.zeros(3)) + sign * f
     gaps = [v["min_gap"] for v in pairs.values() if v["min_gap"] is not None]
     return {"active_contacts": sum(v["active_contacts"] for v in pairs.values()),
             "min_gap": min(gaps) if gaps else None, "contact_force": total_force,
+            "contact_force_on": {b: f.tolist() for b, f in on_body.items()},
             "contribution_percent": contrib, "pairs": pairs}
 
 

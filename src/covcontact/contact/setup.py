@@ -38,6 +38,8 @@ class Pass:
     global_index: np.ndarray | None = None  # distributed runs: positions of these slaves in the whole pass
     pair: str = ""                     # the contact pair this pass belongs to
     rigid: str = ""                    # the rigid body of an analytic master surface
+    slave_body: str = ""               # the body that carries the slave nodes
+    master_body: str = ""              # the body of the master surface
 
     @property
     def ns(self) -> int:
@@ -134,7 +136,8 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         eps = np.full(len(slaves), float(penalty))
     ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
     kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
-          "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name}
+          "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
+          "slave_body": slave[0], "master_body": master[0]}
     mmesh, moff = num.mesh_of(master[0])
     if mmesh is None:
         rb = next(r for r in num.problem.rigid if r.name == master[0])
