@@ -190,5 +190,39 @@ def test_target_on_a_moved_component_is_refused(tmp_path):
                     "free": ["z"], "force": [0.0, 0.0, -10.0]},
                    {"slave": "block.zmax", "master": "plate", "penalty": 1e5})
     raw["stages"] = [{"name": "bad", "targets": {"plate": [1.0, 0.0, -10.0]}}]
-    with pytest.raises(InputError, match="rigid body 'plate' is moved in x"):
+    with pytest.raises(InputError, match="force x component given, but rigid body 'plate' is moved in 'x'"):
+        problem_from_dict(raw, tmp_path / "p.toml")
+
+
+def test_stage_targets_a_moment(tmp_path):
+    """A rigid plate pressed by a force, then tilted by a moment given as a stage target: in each stage the
+    contact force and moment balance the applied ones on the free components, and the plate turns."""
+    raw = _problem({"name": "plate", "shape": "plane", "point": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, -1.0],
+                    "free": ["z", "rx", "ry"], "force": [0.0, 0.0, -10.0], "reference": [0.5, 0.5, 1.0]},
+                   {"slave": "block.zmax", "master": "plate", "penalty": 1e5, "weighting": "area"})
+    raw["problem"]["stage"] = "press"
+    raw["steps"] = {"count": 2}
+    raw["stages"] = [{"name": "tilt", "steps": {"count": 2}, "targets": {"plate": {"moment": [0.0, 0.3, 0.0]}}}]
+    res = _run(raw, tmp_path)
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    for s in steps:
+        rb = s["rigid_bodies"]["plate"]
+        np.testing.assert_allclose(np.add(rb["contact_force"], rb["applied_force"])[2], 0.0, atol=1e-6)
+        np.testing.assert_allclose(np.add(rb["contact_moment"], rb["applied_moment"])[:2], 0.0, atol=1e-6)
+    pressed, tilted = steps[1]["rigid_bodies"]["plate"], steps[-1]["rigid_bodies"]["plate"]
+    np.testing.assert_allclose(pressed["applied_moment"], 0.0, atol=1e-12)
+    np.testing.assert_allclose(tilted["applied_moment"], [0.0, 0.3, 0.0], atol=1e-12)
+    np.testing.assert_allclose(tilted["applied_force"], [0.0, 0.0, -10.0], atol=1e-12)  # held
+    # pressed, it tilts only slightly (the block's lateral expansion shifts the pressure centre); the
+    # moment turns it about +y by a good deal more
+    assert tilted["rotation"][1] - pressed["rotation"][1] > 10 * abs(pressed["rotation"][1])
+
+
+def test_moment_target_on_a_moved_component_is_refused(tmp_path):
+    raw = _problem({"name": "plate", "shape": "plane", "point": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, -1.0],
+                    "free": ["z"], "force": [0.0, 0.0, -10.0]},
+                   {"slave": "block.zmax", "master": "plate", "penalty": 1e5, "weighting": "area"})
+    raw["stages"] = [{"name": "tilt", "targets": {"plate": {"moment": [0.0, 0.3, 0.0]}}}]
+    with pytest.raises(InputError, match="moment y component given, but rigid body 'plate' is moved in 'ry'"):
         problem_from_dict(raw, tmp_path / "p.toml")

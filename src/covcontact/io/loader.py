@@ -311,12 +311,21 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
                 targets[n] = _dirichlet_values(tsec, n, len(obj.components))
             elif kind == "pressure":
                 targets[n] = tsec.get(n, "float")
-            elif kind == "rigid":  # the force of a rigid body with free components
-                targets[n] = tsec.get(n, "vector")
-                bad = [i for i in range(3) if targets[n][i] != 0.0 and i not in obj.free]
-                if bad:
-                    tsec.fail(f"{'xyz'[bad[0]]} component given, but rigid body {n!r} is moved in "
-                              f"{'xyz'[bad[0]]}", n)
+            elif kind == "rigid":  # the force (a vector) or {force, moment} of a rigid body with free components
+                if isinstance(tsec.data[n], dict):
+                    t = tsec.get(n, "table")
+                    targets[n] = {k: t.get(k, "vector") for k in ("force", "moment") if t.has(k)}
+                    if not targets[n]:
+                        t.fail("give 'force' and/or 'moment'")
+                    t.done()
+                else:
+                    targets[n] = {"force": tsec.get(n, "vector")}
+                for key, base in (("force", 0), ("moment", 3)):
+                    vec = targets[n].get(key, (0.0, 0.0, 0.0))
+                    bad = [i for i in range(3) if vec[i] != 0.0 and base + i not in obj.free]
+                    if bad:
+                        tsec.fail(f"{key} {'xyz'[bad[0]]} component given, but rigid body {n!r} is moved in "
+                                  f"{_COMPONENT_NAMES[base + bad[0]]!r}", n)
             else:
                 targets[n] = tsec.get(n, "vector")
         tsec.done()

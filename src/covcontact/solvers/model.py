@@ -182,11 +182,11 @@ class Model:
             force, moment = self.loading.rigid_load(ref.name, lam)
             theta = x[ref.B]
             # the contact residual on (A, B) is -(force, T^T moment) on the body
-            moment = -np.linalg.solve(tangent_map(theta).T, r[ref.B])
+            contact_moment = -np.linalg.solve(tangent_map(theta).T, r[ref.B])
             out[ref.name] = {"displacement": (x[ref.A] - ref.origin).tolist(),
                              "rotation": theta.tolist(),
                              "applied_force": force.tolist(), "applied_moment": moment.tolist(),
-                             "contact_force": (-r[ref.A]).tolist(), "contact_moment": moment.tolist()}
+                             "contact_force": (-r[ref.A]).tolist(), "contact_moment": contact_moment.tolist()}
         return out
 
     def start_warnings(self, u: np.ndarray, state: State) -> list[str]:

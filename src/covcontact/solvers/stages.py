@@ -167,8 +167,13 @@ class StagePlan:
                 f, m = f0 + lam_end * (f1 - f0), m0 + lam_end * (m1 - m0)
                 if name in st.remove:
                     spec.rigid_loads[name] = (f, 0.0 * f, m, 0.0 * m)
-                elif name in st.targets:
-                    spec.rigid_loads[name] = (f, np.asarray(st.targets[name], dtype=float), m, m)
+                elif name in st.targets:  # a new force, or a table with a new force and/or moment
+                    tgt = st.targets[name]
+                    if isinstance(tgt, dict):
+                        spec.rigid_loads[name] = (f, np.asarray(tgt.get("force", f), dtype=float), m,
+                                                  np.asarray(tgt.get("moment", m), dtype=float))
+                    else:
+                        spec.rigid_loads[name] = (f, np.asarray(tgt, dtype=float), m, m)
                 else:
                     spec.rigid_loads[name] = (f, f, m, m)
             self.stages.append(spec)
