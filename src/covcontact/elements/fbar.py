@@ -1,4 +1,10 @@
-"""F-bar hexahedron (hex8) for nearly incompressible and plastic solids, total Lagrangian.
+"""F-bar hexahedra (hex8, hex27) for nearly incompressible and plastic solids, total Lagrangian.
+
+hex27 (3 x 3 x 3 Gauss points) takes for J_c at each Gauss point the volume change J projected (L2 over the
+element) onto the linear functions 1, xi, eta, zeta: the F-bar analogue of the Q2/P1 mixed element, four
+volume constraints per element instead of 27. A single J_c per element would leave the quadratic conformal
+displacement modes (u = 2 (b . x) x - |x|^2 b, whose strain is a pure dilatation linear in x) without
+stiffness. hex27 has the spatial form only.
 
 de Souza Neto, Peric, Dutko & Owen (1996), "Design of simple low order finite elements for large strain
 analysis of nearly incompressible solids", Int. J. Solids Struct. 33, 3277-3296: at every Gauss point the
@@ -81,13 +87,73 @@ def _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0):
 
 
 @njit(cache=True)
-def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, hist_n, hist, hn,
-                  J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D, FS, T, A, Q, x, y):
+def _projected_dilatation(Xe, ue, dNdxi, w, Pv, J0, Ji, G, F, Fi, g, Jb, G0, Mw, Hw):
+    """The volume change J projected onto the linear functions P = (1, xi, eta, zeta) of the element (L2 over
+    the reference volume): Jb[gp] = P(gp) . c with M c = int P J dV0, M = int P P^T dV0, and its gradients
+    G0[gp, a] (d ln Jb[gp] = G0[gp, a] . du_a). Mw (4, 4) and Hw (4, nen, 3) are scratch.
+    Returns (smallest det J0, smallest Jb); the latter 0 when det F <= 0 at a point."""
+    nen = Xe.shape[0]
+    m = Pv.shape[1]
+    dmin = np.inf
+    for i in range(m):
+        for j in range(m):
+            Mw[i, j] = 0.0
+        for a in range(nen):
+            for k in range(3):
+                Hw[i, a, k] = 0.0
+    c = np.zeros(m)
+    for gp in range(w.size):
+        det = _jacobian(Xe, dNdxi[gp], J0, Ji)
+        dmin = min(dmin, det)
+        if not (det > 0.0):
+            return det, 0.0
+        _kinematics(dNdxi[gp], Ji, ue, G, F)
+        J = inverse3(F, Fi)
+        if not (J > 0.0):
+            return dmin, 0.0
+        _spatial_gradients(Fi, G, g)
+        wd = w[gp] * det
+        for i in range(m):
+            c[i] += wd * Pv[gp, i] * J
+            for j in range(m):
+                Mw[i, j] += wd * Pv[gp, i] * Pv[gp, j]
+            for a in range(nen):
+                for k in range(3):
+                    Hw[i, a, k] += wd * Pv[gp, i] * J * g[a, k]
+    Minv = np.linalg.inv(Mw)
+    jmin = np.inf
+    for gp in range(w.size):
+        # row r = P(gp)^T M^-1
+        r = np.zeros(m)
+        for i in range(m):
+            for j in range(m):
+                r[j] += Pv[gp, i] * Minv[i, j]
+        jb = 0.0
+        for j in range(m):
+            jb += r[j] * c[j]
+        Jb[gp] = jb
+        jmin = min(jmin, jb)
+        if not (jb > 0.0):
+            continue
+        for a in range(nen):
+            for k in range(3):
+                t = 0.0
+                for j in range(m):
+                    t += r[j] * Hw[j, a, k]
+                G0[gp, a, k] = t / jb
+    return dmin, jmin
+
+
+@njit(cache=True)
+def _fbar_element(kind, params, form, volume, Xe, ue, dNdxi, dNc, w, Pv, want_K, Ke, fe, hist_n, hist, hn,
+                  J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D, FS, T, A, Q, x, y, Jb, G0, Mw, Hw):
     """Internal force fe (24,) and exact tangent Ke (24, 24) of one F-bar hex8 (both overwritten).
 
     hist_n (ngp, nh) committed history (read), hist (ngp, nh) trial (written); hn (nh,) scratch.
     Returns 0, 1 if det F <= 0 at the centre or at a Gauss point or the material failed, 2 if det J0 <= 0
-    (such points are skipped; at the centre the whole element is).
+    (such points are skipped; at the centre the whole element is). ``volume``: 0 the volume change of the
+    centre (J_c), 1 J projected onto the linear functions Pv (ngp, 4) of the element (hex27; spatial form
+    only; Jb (ngp,), G0 (ngp, nen, 3), Mw, Hw scratch).
     """
     nen = Xe.shape[0]
     nd = 3 * nen
@@ -98,7 +164,10 @@ def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, his
         for r in range(nd):
             for s in range(nd):
                 Ke[r, s] = 0.0
-    detc, Jc = _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0)
+    if volume == 0:
+        detc, Jc = _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0)
+    else:
+        detc, Jc = _projected_dilatation(Xe, ue, dNdxi, w, Pv, J0, Ji, G, F, Fi, g, Jb, G0, Mw, Hw)
     if not (detc > 0.0 and Jc > 0.0):
         for gp in range(w.size):
             for k in range(nh):
@@ -121,10 +190,12 @@ def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, his
                 hist[gp, k] = hist_n[gp, k]
             continue
         _spatial_gradients(Fi, G, g)
+        gz = g0 if volume == 0 else G0[gp]
+        Jz = Jc if volume == 0 else Jb[gp]
         for a in range(nen):
             for i in range(3):
-                q[a, i] = (g0[a, i] - g[a, i]) / 3.0
-        phi = (Jc / J) ** (1.0 / 3.0)
+                q[a, i] = (gz[a, i] - g[a, i]) / 3.0
+        phi = (Jz / J) ** (1.0 / 3.0)
         for i in range(3):
             for j in range(3):
                 Fb[i, j] = phi * F[i, j]
@@ -219,9 +290,16 @@ def _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Ke, fe, his
                     for l in range(3):
                         v = Q[k, l, 0] * Gb0 + Q[k, l, 1] * Gb1 + Q[k, l, 2] * Gb2
                         v += x[a, k] * q[b, l] + q[a, k] * y[b, l] + cq * q[a, k] * q[b, l]
-                        v -= pg * (g0[b, k] * g0[a, l] - g[b, k] * g[a, l])
+                        if form == 0:
+                            v -= pg * (g0[b, k] * g0[a, l] - g[b, k] * g[a, l])
                         Ke[3 * a + k, 3 * b + l] += v
     return flag
+
+
+@njit(cache=True)
+def _projection_work(ngp, nen, m):
+    """Scratch of the projected volume change: Jb (ngp,), G0 (ngp, nen, 3), Mw (m, m), Hw (m, nen, 3)."""
+    return np.empty(ngp), np.empty((ngp, nen, 3)), np.empty((m, m)), np.empty((m, nen, 3))
 
 
 @njit(cache=True)
@@ -233,8 +311,8 @@ def _work(nen, nh):
 
 
 @njit(parallel=True, cache=True)
-def fbar_chunk(kind, params, form, X, u, conn, e0, dNdxi, dNc, w, want_K, Ke, fe, flags, nblocks, hist_n,
-               hist):
+def fbar_chunk(kind, params, form, volume, X, u, conn, e0, dNdxi, dNc, w, Pv, want_K, Ke, fe, flags, nblocks,
+               hist_n, hist):
     """Element buffers Ke (nc, 24, 24), fe (nc, 24) and flags (nc,) of elements e0 .. e0 + nc - 1.
 
     The chunk is split into ``nblocks`` contiguous blocks (the parallel iterations), each with its own
@@ -256,16 +334,17 @@ def fbar_chunk(kind, params, form, X, u, conn, e0, dNdxi, dNc, w, want_K, Ke, fe
         x = np.empty((nen, 3))
         y = np.empty((nen, 3))
         Kdummy = np.empty((0, 0))
+        Jb, G0, Mw, Hw = _projection_work(w.size, nen, Pv.shape[1])
         for c in range(lo, hi):
             gather(X, u, conn, e0 + c, Xe, ue)
             Kc = Ke[c] if want_K else Kdummy
-            flags[c] = _fbar_element(kind, params, form, Xe, ue, dNdxi, dNc, w, want_K, Kc, fe[c],
+            flags[c] = _fbar_element(kind, params, form, volume, Xe, ue, dNdxi, dNc, w, Pv, want_K, Kc, fe[c],
                                      hist_n[e0 + c], hist[e0 + c], hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb,
-                                     S, D, FS, T, A, Q, x, y)
+                                     S, D, FS, T, A, Q, x, y, Jb, G0, Mw, Hw)
 
 
 @njit(parallel=True, cache=True)
-def fbar_gauss_fields(kind, params, X, u, conn, dNdxi, dNc, w, mode, out, nthreads, hist_n):
+def fbar_gauss_fields(kind, params, volume, X, u, conn, dNdxi, dNc, w, Pv, mode, out, nthreads, hist_n):
     """Per-element Gauss-point quantities of F-bar hex8 (serial per block, parallel over blocks).
 
     mode 0: out (ne, 1) strain energy int W(F_bar) dV (inf where det F or det F_c <= 0);
@@ -282,6 +361,7 @@ def fbar_gauss_fields(kind, params, X, u, conn, dNdxi, dNc, w, mode, out, nthrea
         ue = np.empty((nen, 3))
         hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D = _work(nen, hist_n.shape[2])
         hscr = np.empty(hist_n.shape[2])
+        Jb, G0, Mw, Hw = _projection_work(w.size, nen, Pv.shape[1])
         for e in range(lo, hi):
             gather(X, u, conn, e, Xe, ue)
             for r in range(out.shape[1]):
@@ -294,6 +374,10 @@ def fbar_gauss_fields(kind, params, X, u, conn, dNdxi, dNc, w, mode, out, nthrea
                 continue
             if not (detc > 0.0):
                 continue
+            if volume != 0:
+                detc, Jc = _projected_dilatation(Xe, ue, dNdxi, w, Pv, J0, Ji, G, F, Fi, g, Jb, G0, Mw, Hw)
+                if not (detc > 0.0):
+                    continue
             vol = 0.0
             for gp in range(w.size):
                 det = _jacobian(Xe, dNdxi[gp], J0, Ji)
@@ -307,7 +391,7 @@ def fbar_gauss_fields(kind, params, X, u, conn, dNdxi, dNc, w, mode, out, nthrea
                     if mode == 0:
                         out[e, 0] = np.inf
                     continue
-                phi = (Jc / J) ** (1.0 / 3.0)
+                phi = ((Jc if volume == 0 else Jb[gp]) / J) ** (1.0 / 3.0)
                 for i in range(3):
                     for j in range(3):
                         Fb[i, j] = phi * F[i, j]
@@ -354,15 +438,24 @@ class FbarBody(ElementBody):
 
     def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
                  form: str = "spatial", chunk_bytes: int = 32 * 2**20) -> None:
-        if cell_type != "hex8":
-            raise ValueError(f"F-bar elements are hex8 only, got cell type {cell_type!r}")
+        if cell_type not in ("hex8", "hex27"):
+            raise ValueError(f"F-bar elements are hex8 or hex27, got cell type {cell_type!r}")
         if form not in FBAR_FORMS:
             raise ValueError(f"unknown F-bar form {form!r}; known: {', '.join(FBAR_FORMS)}")
         super().__init__(cell_type, X, cells, material, chunk_bytes)
         self.form = form
-        self.points, self.weights = gauss_tensor((2, 2, 2))
-        self.dNdxi = np.ascontiguousarray(shape_functions("hex8", self.points)[1])
-        self.dNc = np.ascontiguousarray(shape_functions("hex8", np.zeros((1, 3)))[1][0])
+        n = 2 if cell_type == "hex8" else 3
+        self.points, self.weights = gauss_tensor((n, n, n))
+        #: 0: the centre's volume change (hex8, the paper's element); 1: J projected onto the linear functions
+        #: (1, xi, eta, zeta) of the element (hex27, the F-bar analogue of Q2/P1: a constant volume change per
+        #: element would leave the quadratic conformal modes, whose dilatation is linear, without stiffness)
+        self.volume = 0 if cell_type == "hex8" else 1
+        self.Pv = (np.zeros((self.weights.size, 0)) if self.volume == 0 else
+                   np.ascontiguousarray(np.column_stack([np.ones(self.weights.size), self.points])))
+        if self.volume != 0 and form != "spatial":
+            raise ValueError("F-bar hex27 has the spatial form only (form = \"spatial\")")
+        self.dNdxi = np.ascontiguousarray(shape_functions(cell_type, self.points)[1])
+        self.dNc = np.ascontiguousarray(shape_functions(cell_type, np.zeros((1, 3)))[1][0])
 
     @property
     def n_hist(self) -> int:
@@ -385,10 +478,11 @@ class FbarBody(ElementBody):
         # copies each point's committed values before overwriting them with the trial)
         hist = state["hist"]
         hist_n = state.get("hist_n", hist)
-        fbar_chunk(self.material.kind, self.material.params, FBAR_FORMS[self.form], self.X, u, self.cells, e0,
-                   self.dNdxi, self.dNc, self.weights, want_K, Ke, fe, flags, nblocks, hist_n, hist)
+        fbar_chunk(self.material.kind, self.material.params, FBAR_FORMS[self.form], self.volume, self.X, u,
+                   self.cells, e0, self.dNdxi, self.dNc, self.weights, self.Pv, want_K, Ke, fe, flags, nblocks,
+                   hist_n, hist)
 
     def _gauss_fields(self, u, mode, out, state) -> None:
-        fbar_gauss_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.dNdxi,
-                          self.dNc, self.weights, mode, out, get_num_threads(), state["hist"])
+        fbar_gauss_fields(self.material.kind, self.material.params, self.volume, self.X, u, self.cells, self.dNdxi,
+                          self.dNc, self.weights, self.Pv, mode, out, get_num_threads(), state["hist"])
 

@@ -412,13 +412,15 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             except ValueError as exc:
                 b.fail(str(exc), "options")
         elif formulation == "fbar":
-            if mesh.cell_type != "hex8":
-                b.fail(f"formulation = \"fbar\" needs hex8 elements, got {mesh.cell_type}", "formulation")
+            if mesh.cell_type not in ("hex8", "hex27"):
+                b.fail(f"formulation = \"fbar\" needs hex8 or hex27 elements, got {mesh.cell_type}", "formulation")
             unknown = sorted(set(options) - {"form"})
             if unknown:
                 b.fail(f"unknown option {unknown[0]!r} for formulation = \"fbar\" (known: form)", "options")
             if options.get("form", "spatial") not in ("spatial", "variational"):
                 b.fail(f"form must be \"spatial\" or \"variational\", got {options['form']!r}", "options")
+            if mesh.cell_type == "hex27" and options.get("form", "spatial") != "spatial":
+                b.fail("F-bar hex27 has the spatial form only; leave out 'form'", "options")
         elif options:
             b.fail("options are only known for formulation = \"solid-shell\" and \"fbar\"", "options")
         bodies.append(Body(bname, mesh, material, formulation, options))
