@@ -134,7 +134,7 @@ def test_sigint_exit_code_and_status(tmp_path):
     with np.load(out / "checkpoint.npz") as data:
         assert np.all(np.isfinite(data["u"]))
     for row in (out / "convergence.csv").read_text().splitlines()[1:]:
-        assert len(row.split(",")) == 5
+        assert len(row.split(",")) == 7
 
 
 def _one_error_line(res: subprocess.CompletedProcess, *words: str) -> None:

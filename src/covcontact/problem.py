@@ -190,6 +190,10 @@ class SolverOptions:
     max_cutbacks: int = 6
     line_search: bool = False
     divergence_factor: float = 1e4
+    #: inexact Newton: corrections by GMRES preconditioned with the last factorisation, refactorising only
+    #: when GMRES needs more than ``krylov_max`` iterations or the outer convergence stalls (direct solvers)
+    reuse_factorization: bool = False
+    krylov_max: int = 30
 
 
 @dataclass

@@ -608,6 +608,8 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             max_cutbacks=s.get("max_cutbacks", "int", solver.max_cutbacks, nonnegative=True),
             line_search=s.get("line_search", "bool", solver.line_search),
             divergence_factor=s.get("divergence_factor", "float", solver.divergence_factor, positive=True),
+            reuse_factorization=s.get("reuse_factorization", "bool", solver.reuse_factorization),
+            krylov_max=s.get("krylov_max", "int", solver.krylov_max, positive=True),
         )
         s.done()
     o = top.get("output", "table", None)

@@ -17,6 +17,13 @@ Whatever the criterion, a step also converges on the round-off floor: the energy
 residual stopped falling (thin shells: about eps_mach E A per node, whatever the load increment). A step that diverges, runs out of
 iterations, inverts an element or meets a singular matrix is cut back (its increment halved) up to
 ``max_cutbacks`` times in a row.
+
+Factorisation reuse (``SolverOptions.reuse_factorization``, direct solvers): a correction is first sought by
+GMRES on the new tangent, preconditioned by the last factorisation (of an earlier iteration or step), to the
+relative residual eta_k = min(1e-3, 1e-3 ||R_k|| / ||R_0||) (a forcing term that falls with the outer
+residual, so the outer convergence stays quadratic); a new factorisation is made when GMRES does not get
+there in ``krylov_max`` iterations, when the outer residual stalled (||R_k|| > 0.5 ||R_(k-1)||) after an
+inexact correction, or when there is none yet. Counts and times: ``Newton.stats``.
 """
 
 from __future__ import annotations
@@ -25,6 +32,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse.linalg as sla
 
 from ..assembly.system import InvertedElementError
 from .linear import LinearSolverError, SingularMatrixError, make_solver
@@ -40,6 +48,8 @@ class IterationRecord:
     residual: float
     energy: float
     active: int
+    linear: str = ""      # how the correction was solved: "factor" (new factorisation) or "krylov"
+    krylov: int = 0       # GMRES iterations spent on it (including a failed attempt before a factorisation)
 
 
 @dataclass
@@ -66,13 +76,48 @@ class Newton:
         self.linear = make_solver(linear or options.linear, symmetric=model.symmetric)
         self.linear.set_near_null_space(model.near_null_space())  # rigid-body modes (AMG only)
         self.scale_seen = 0.0  # the largest force scale of the converged steps so far
-        self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0}
+        self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}
+        self.stats = {"factorizations": 0, "krylov_solves": 0, "krylov_iterations": 0}
+        self._stalled = False  # the last inexact correction did not reduce the residual enough
 
     # ------------------------------------------------------------------------------------------
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
         return self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=self.timing)
 
-    def _solve(self, K, rhs):
+    def _krylov(self, K, rhs, eta: float):
+        """GMRES on K du = rhs preconditioned by the last factorisation; None when it needs more than
+        ``krylov_max`` iterations (or breaks down)."""
+        t0 = time.perf_counter()
+        n = K.shape[0]
+        prec = sla.LinearOperator((n, n), matvec=self.linear._solve, dtype=np.float64)
+        count = [0]
+
+        def tick(_):
+            count[0] += 1
+
+        nb = float(np.linalg.norm(rhs))
+        try:
+            du, _ = sla.gmres(K, rhs, M=prec, rtol=eta, atol=0.0, restart=self.opt.krylov_max, maxiter=1,
+                              callback=tick, callback_type="pr_norm")
+        except (ValueError, ArithmeticError):
+            du = None
+        self.timing["krylov"] += time.perf_counter() - t0
+        self.stats["krylov_iterations"] += count[0]
+        if du is None or not np.all(np.isfinite(du)):
+            return None
+        if float(np.linalg.norm(rhs - K @ du)) > eta * nb:  # judged on the true residual
+            return None
+        self.stats["krylov_solves"] += 1
+        return du
+
+    def _solve(self, K, rhs, eta: float | None = None):
+        if (eta is not None and self.opt.reuse_factorization and self.linear.direct and not self._stalled
+                and getattr(self.linear, "_K", None) is not None and self.linear._K.shape == K.shape):
+            du = self._krylov(K, rhs, eta)
+            if du is not None:
+                return du
+        self._stalled = False
+        self.stats["factorizations"] += 1
         t0 = time.perf_counter()
         du = self.linear.solve(K, rhs)
         dt = time.perf_counter() - t0
@@ -133,8 +178,13 @@ class Newton:
             out.converged = True
             return out, trial
         e0 = None
+        rn_prev = r0
+        inexact = False
         for it in range(1, opt.max_iterations + 1):
-            du = self._solve(K, rhs)
+            eta = min(1e-3, 1e-3 * rn_prev / max(r0, 1e-300))
+            n_fact, n_kry = self.stats["factorizations"], self.stats["krylov_iterations"]
+            du = self._solve(K, rhs, eta)
+            inexact = self.stats["factorizations"] == n_fact
             du[~free] = du_d[~free] if it == 1 else 0.0
             eta = 1.0
             if opt.line_search and it > 1:
@@ -152,8 +202,13 @@ class Newton:
             K = m.eliminate(K)
             self.timing["bc"] += time.perf_counter() - t0
             rn = float(np.linalg.norm(rhs))
+            if inexact and rn > 0.5 * rn_prev:  # stalled after an inexact correction: refactorise next
+                self._stalled = True
+            rn_prev = rn
             out.residual_norms.append(rn)
-            out.records.append(IterationRecord(it, rn, energy, m.active_count(trial)))
+            out.records.append(IterationRecord(it, rn, energy, m.active_count(trial),
+                                               "krylov" if inexact else "factor",
+                                               self.stats["krylov_iterations"] - n_kry))
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
                 return out, trial
