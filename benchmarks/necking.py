@@ -16,7 +16,7 @@ from pathlib import Path
 from _report import emit
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "verification"))
-from necking_setup import IMPERFECTION, RADIUS, considere_peak, necking_problem, results  # noqa: E402
+from necking_setup import IMPERFECTION, RADIUS, considere_peak, necking_problem, results
 
 
 def main() -> None:
