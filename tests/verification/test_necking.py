@@ -19,8 +19,8 @@ def test_necking_bar_coarse(tmp_path):
     peak = considere_peak(IMPERFECTION * RADIUS)
     assert abs(r["peak_force"] / peak - 1.0) < 0.015, (r["peak_force"], peak)
     assert r["peak_force"] < considere_peak(RADIUS)
-    # the neck: the middle thins far more than the end (measured 0.46 against 0.88 at 14 mm)
-    assert r["neck_ratio"] < 0.6 and r["end_ratio"] > 0.85
+    # the neck: the middle thins far more than the end (measured 0.459 against 0.963 at 14 mm)
+    assert r["neck_ratio"] < 0.6 and r["end_ratio"] > 0.9
     # past the peak the force falls as the neck deepens (measured 42.6 kN at 14 mm)
     assert r["force"][-1] < 0.65 * r["peak_force"]
     f = np.array(r["force"])
