@@ -20,7 +20,7 @@ iterations, inverts an element or meets a singular matrix is cut back (its incre
 
 Factorisation reuse (``SolverOptions.reuse_factorization``, direct solvers): a correction is first sought by
 GMRES on the new tangent, preconditioned by the last factorisation (of an earlier iteration or step), to the
-relative residual eta_k = min(1e-3, 1e-3 ||R_k|| / ||R_0||) (a forcing term that falls with the outer
+relative residual eta_k = min(1e-4, 1e-4 ||R_k|| / ||R_0||) (a forcing term that falls with the outer
 residual, so the outer convergence stays quadratic); a new factorisation is made when GMRES does not get
 there in ``krylov_max`` iterations, when the outer residual stalled (||R_k|| > 0.5 ||R_(k-1)||) after an
 inexact correction, or when there is none yet. Counts and times: ``Newton.stats``.
@@ -216,7 +216,7 @@ class Newton:
         rn_prev = r0
         inexact = False
         for it in range(1, opt.max_iterations + 1):
-            eta = min(1e-3, 1e-3 * rn_prev / max(r0, 1e-300))
+            eta = min(1e-4, 1e-4 * rn_prev / max(r0, 1e-300))
             n_fact, n_kry = self.stats["factorizations"], self.stats["krylov_iterations"]
             du = self._solve(K, rhs, eta)
             inexact = self.stats["factorizations"] == n_fact
