@@ -226,3 +226,24 @@ def test_moment_target_on_a_moved_component_is_refused(tmp_path):
     raw["stages"] = [{"name": "tilt", "targets": {"plate": {"moment": [0.0, 0.3, 0.0]}}}]
     with pytest.raises(InputError, match="moment y component given, but rigid body 'plate' is moved in 'ry'"):
         problem_from_dict(raw, tmp_path / "p.toml")
+
+
+def test_force_driven_body_is_parked_when_its_pairs_are_off(tmp_path):
+    """A stage that switches off every pair of a force-driven plate holds the plate where it is (nothing
+    else would restrain it); the block, unloaded, springs back to its original height; resume-safe state."""
+    raw = _problem({"name": "plate", "shape": "plane", "point": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, -1.0],
+                    "free": ["z"], "force": [0.0, 0.0, -10.0]},
+                   {"name": "press", "slave": "block.zmax", "master": "plate", "penalty": 1e5,
+                    "weighting": "area"})
+    raw["problem"]["stage"] = "press"
+    raw["steps"] = {"count": 2}
+    raw["stages"] = [{"name": "lift", "steps": {"count": 2}, "contacts": {"press": False}}]
+    res = _run(raw, tmp_path)
+    assert res.exit_code == 0, res.summary["steps"][-1].get("failure")
+    pressed, lifted = res.summary["steps"][1], res.summary["steps"][-1]
+    z_pressed = pressed["rigid_bodies"]["plate"]["displacement"][2]
+    assert z_pressed < -0.009
+    # parked: the plate stays where the press left it, the block is free of load
+    assert lifted["rigid_bodies"]["plate"]["displacement"][2] == pytest.approx(z_pressed, abs=1e-14)
+    np.testing.assert_allclose(lifted["reactions"]["block.zmin"], 0.0, atol=1e-8)
+    assert lifted["active_contacts"] == 0

@@ -43,7 +43,8 @@ class Model:
     def set_stage(self, state: State) -> None:
         """Prescribe what ``state``'s stage prescribes (after a stage change or a resume)."""
         spec = self.stages[state.stage]
-        self.loading = Loading(spec, self.system.X, state.forces.get("release"), state.forces.get("held"))
+        self.loading = Loading(spec, self.system.X, state.forces.get("release"), state.forces.get("held"),
+                               state.forces.get("parked"))
         self.system.set_constraints(spec.constrained)
         self.contact.set_stage(spec.motions, spec.contacts)
 
@@ -58,6 +59,10 @@ class Model:
             release = np.zeros(self.n_dofs)
             release[spec.released] = R[spec.released]
             forces = {"release": release, "held": held}
+        if spec.parked.size:  # free rigid bodies without an active pair stay where they are
+            parked = np.zeros(self.n_dofs)
+            parked[spec.parked] = u[spec.parked]
+            forces["parked"] = parked
         new = committed.but(stage=committed.stage + 1, lam=0.0, forces=forces)
         self.set_stage(new)
         return new.but(contact=self.contact.switch(new.contact))
@@ -161,7 +166,7 @@ class Model:
         for ref in self.system.reference:
             for c in ref.free:
                 dof = 3 * (ref.A if c < 3 else ref.B) + c % 3
-                if diag[dof] == 0.0:
+                if diag[dof] == 0.0 and self.system.free[dof]:
                     raise SingularMatrixError(
                         f"rigid body {ref.name!r} is free in {names[c]} but nothing restrains it there (no "
                         f"active contact); start it touching its partner or prescribe that component until "

@@ -83,6 +83,10 @@ class StageSpec:
     release_names: tuple[str, ...] = ()
     constrained: np.ndarray = field(default=None, repr=False)
     rigid_loads: dict = field(default_factory=dict)  # reference body -> (force, moment) at lam = 0 and at 1
+    #: free dofs of reference bodies whose contact pairs are all off in this stage: held where the stage
+    #: found them (nothing else would restrain them)
+    parked: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64), repr=False)
+    parked_names: tuple[str, ...] = ()
 
     @property
     def lam_end(self) -> float:
@@ -187,17 +191,24 @@ class StagePlan:
             f0 += sysm.load_vector(load, start[key])
             f1 += sysm.load_vector(load, target[key])
         conds = list(conds)
+        parked, parked_names = [], []
         for ref in getattr(sysm, "reference", []):
             comps = tuple(c for c in range(6) if c not in ref.free)
             if comps:
                 conds.append(_Condition(f"rigid:{ref.name}", np.array([ref.A]), comps, None, None,
                                         motions[ref.name], ref))
+            pairs = [c.name for c in self.problem.contacts if ref.name in (c.slave[0], c.master[0])]
+            if ref.free and not any(contacts.get(n, True) for n in pairs):
+                parked += [3 * (ref.A if c < 3 else ref.B) + c % 3 for c in ref.free]
+                parked_names.append(ref.name)
         constrained = np.zeros(sysm.n_dofs, dtype=bool)
         for c in conds:
             constrained[c.dofs] = True
+        parked = np.array(sorted(parked), dtype=np.int64)
+        constrained[parked] = True
         released = released[~constrained[released]] if released.size else released
         return StageSpec(index, name, tuple(factors), conds, released, f0, f1, motions, contacts, names,
-                         constrained)
+                         constrained, parked=parked, parked_names=tuple(parked_names))
 
     def __len__(self) -> int:
         return len(self.stages)
@@ -210,12 +221,13 @@ class Loading:
     """The prescribed displacements and external forces of one stage as functions of its load factor."""
 
     def __init__(self, spec: StageSpec, X: np.ndarray, release: np.ndarray | None = None,
-                 held: np.ndarray | None = None):
+                 held: np.ndarray | None = None, parked: np.ndarray | None = None):
         self.spec = spec
         self.X = X
         n = len(spec.load_start)
         self.release = np.zeros(n) if release is None else release
         self.held = np.zeros(n) if held is None else held
+        self.parked = np.zeros(n) if parked is None else parked  # displacements of the parked dofs
         self.constrained = spec.constrained
         self.free = ~spec.constrained
         self._dofs = [c.dofs for c in spec.conditions]
@@ -227,6 +239,8 @@ class Loading:
         u = np.zeros(len(self.constrained))
         for c, dofs in zip(self.spec.conditions, self._dofs):
             u[dofs] = c.values(self.X, lam)
+        if self.spec.parked.size:
+            u[self.spec.parked] = self.parked[self.spec.parked]
         return u
 
     def external(self, lam: float) -> np.ndarray:
