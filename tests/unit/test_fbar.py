@@ -63,6 +63,19 @@ def tangent(body, u, state=None) -> tuple[np.ndarray, np.ndarray]:
     return P.csr(data).toarray(), r
 
 
+def fd_tangent(body, u, h: float, state_of=lambda: None) -> np.ndarray:
+    """Central differences of the residual, column by column; ``state_of()`` gives each evaluation its
+    material state (a fresh trial from the same committed history)."""
+    Kfd = np.empty((u.size, u.size))
+    for j in range(u.size):
+        up = u.ravel().copy()
+        um = u.ravel().copy()
+        up[j] += h
+        um[j] -= h
+        Kfd[:, j] = (residual(body, up, state_of()) - residual(body, um, state_of())) / (2.0 * h)
+    return Kfd
+
+
 def rotation(axis, angle: float) -> np.ndarray:
     a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
     W = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
@@ -279,15 +292,7 @@ def test_history_committed_read_and_trial_written(form):
     only = {"hist": h0.copy()}
     assert np.array_equal(residual(body, u2, only), r) and np.array_equal(only["hist"], ks2["hist"])
     # the tangent is the exact derivative of the residual at fixed committed history (plastic points)
-    h = 1e-7
-    Kfd = np.empty_like(K)
-    for j in range(K.shape[0]):
-        up = u2.ravel().copy()
-        um = u2.ravel().copy()
-        up[j] += h
-        um[j] -= h
-        Kfd[:, j] = (residual(body, up, body.kernel_state(committed, committed))
-                     - residual(body, um, body.kernel_state(committed, committed))) / (2.0 * h)
+    Kfd = fd_tangent(body, u2, 1e-7, lambda: body.kernel_state(committed, committed))
     assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()  # measured 4e-9
 
 
@@ -363,17 +368,7 @@ def test_hex27_tangent_matches_central_differences(mat):
     K, r = tangent(body, u, state=trial)
     if mat == "j2":
         assert trial["hist"].any()  # yielded
-    h = 1e-6
-    Kfd = np.empty_like(K)
-    for j in range(K.shape[0]):
-        up = u.ravel().copy()
-        um = u.ravel().copy()
-        up[j] += h
-        um[j] -= h
-        st = {"hist_n": state["hist"], "hist": state["hist"].copy()}
-        rp = residual(body, up, st)
-        rm = residual(body, um, {"hist_n": state["hist"], "hist": state["hist"].copy()})
-        Kfd[:, j] = (rp - rm) / (2.0 * h)
+    Kfd = fd_tangent(body, u, 1e-6, lambda: {"hist_n": state["hist"], "hist": state["hist"].copy()})
     assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()
     assert not state["hist"].any()  # evaluating never changes the committed history
 
