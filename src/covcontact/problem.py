@@ -194,6 +194,9 @@ class SolverOptions:
     #: when GMRES needs more than ``krylov_max`` iterations or the outer convergence stalls (direct solvers)
     reuse_factorization: bool = False
     krylov_max: int = 30
+    #: first iterate of a step: "tangent" (the tangent at the converged state with the prescribed increment)
+    #: or "extrapolate" (the previous step's increment scaled to this one, then Newton)
+    predictor: str = "tangent"
 
 
 @dataclass

@@ -610,6 +610,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             divergence_factor=s.get("divergence_factor", "float", solver.divergence_factor, positive=True),
             reuse_factorization=s.get("reuse_factorization", "bool", solver.reuse_factorization),
             krylov_max=s.get("krylov_max", "int", solver.krylov_max, positive=True),
+            predictor=s.get("predictor", "str", solver.predictor, choices=("tangent", "extrapolate")),
         )
         s.done()
     o = top.get("output", "table", None)

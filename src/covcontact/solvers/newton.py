@@ -126,6 +126,7 @@ class Newton:
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}
         self.stats = {"factorizations": 0, "krylov_solves": 0, "krylov_iterations": 0}
         self._stalled = False  # the last inexact correction did not reduce the residual enough
+        self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
 
     # ------------------------------------------------------------------------------------------
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
@@ -198,6 +199,13 @@ class Newton:
         else:
             m.begin_step()
         du_d = m.prescribed(lam_b) - m.prescribed(lam_a)
+        last = self._last
+        if (opt.predictor == "extrapolate" and last is not None and lam_b > lam_a
+                and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
+            # the previous increment scaled to this step on the free dofs, the prescribed increment on the others
+            u[free] += (lam_b - lam_a) / (last[1] - last[0]) * last[2][free]
+            u[~free] += du_d[~free]
+            du_d = np.zeros_like(du_d)
         R, K, trial = self._evaluate(u, lam_b, committed, trial)
         t0 = time.perf_counter()
         rhs = -R - K @ du_d
@@ -285,6 +293,8 @@ class Newton:
             saved = u.copy()
             res, trial = self._try(u, lam, target, committed, None)
             outcomes.append(res)
+            # the extrapolating predictor continues from a converged step; a failed one retries without it
+            self._last = (lam, target, u - saved) if res.converged else None
             augment = 0
             # augmented Lagrangian: Uzawa updates at the converged state, each followed by Newton
             while res.converged and (new := self.model.augment(trial)) is not None:

@@ -176,6 +176,9 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
     t_before = 0.0  # wall time of the runs before a resume
     if resume:
         u, arrays, meta = checkpoint.load(out, problem_hash, rank, size)
+        last_increment = arrays.pop("newton.last_increment", None)
+        if last_increment is not None and meta.get("last_step_lams"):
+            newton._last = (*(float(v) for v in meta["last_step_lams"]), np.array(last_increment))
         try:
             state = State.from_arrays(arrays, like=state)
         except (KeyError, ValueError) as exc:
@@ -289,11 +292,15 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                         summary["wall_time_s"] = t_before + time.perf_counter() - t_start
                         writer.write_summary(summary)
                         if k % problem.output.checkpoint_every == 0 or k == nsteps or last:
-                            checkpoint.save(out, u, state.arrays(),
+                            extra, lams = {}, None
+                            if newton._last is not None:  # the extrapolating predictor's memory
+                                extra["newton.last_increment"] = newton._last[2]
+                                lams = [newton._last[0], newton._last[1]]
+                            checkpoint.save(out, u, {**state.arrays(), **extra},
                                             {"problem_hash": problem_hash, "summary": json.loads(
                                                 json.dumps(summary, default=_jsonable)),
                                              "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"],
-                                             "force_scale": newton.scale_seen},
+                                             "force_scale": newton.scale_seen, "last_step_lams": lams},
                                             rank, size)
                 if status == "failed":
                     break
