@@ -48,6 +48,17 @@ def ironing(tmp: Path) -> Path:
         (r"\[steps\]\nfactors = \[[^\]]*\]", f"[steps]\nfactors = [{factors}]")])
 
 
+def ironing_extrapolated(tmp: Path) -> Path:
+    """Ironing with the extrapolating predictor: its memory of the last increment is in the checkpoint."""
+    path = ironing(tmp)
+    text = path.read_text()
+    text = text.replace("[solver]\n", "[solver]\npredictor = \"extrapolate\"\n", 1) if "[solver]" in text \
+        else text + '\n[solver]\npredictor = "extrapolate"\n'
+    out = tmp / "ironing_extrapolated.toml"
+    out.write_text(text)
+    return out
+
+
 def augmented(tmp: Path) -> Path:
     return _variant("contact/block_on_plane_augmented.toml", tmp, "augmented",
                     [(r"\[steps\][^\[]*", _steps(12) + "\n")])
@@ -92,7 +103,8 @@ def _summary(out: Path) -> dict:
     return json.loads((out / "summary.json").read_text())
 
 
-@pytest.mark.parametrize("make", [ironing, augmented, shells], ids=["ironing", "augmented", "solid-shells"])
+@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells],
+                         ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     problem = make(tmp_path)
     ref = _run(problem, tmp_path / "ref")
