@@ -293,7 +293,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                         writer.write_summary(summary)
                         if k % problem.output.checkpoint_every == 0 or k == nsteps or last:
                             extra, lams = {}, None
-                            if newton._last is not None:  # the extrapolating predictor's memory
+                            if newton._last is not None and problem.solver.predictor == "extrapolate":
                                 extra["newton.last_increment"] = newton._last[2]
                                 lams = [newton._last[0], newton._last[1]]
                             checkpoint.save(out, u, {**state.arrays(), **extra},
