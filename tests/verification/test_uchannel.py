@@ -1,0 +1,243 @@
+"""U-channel draw bending (NUMISHEET'93 2D benchmark): forming with a force-controlled blank holder, then
+springback (examples/forming/uchannel.toml; docs/verification.md, "U-channel draw bending").
+
+Half model, plane strain: blank 175 x 35 x 0.78 mm, plastic solid-shell hex8 with 5 Gauss points through
+the thickness, Swift hardening sigma = 565.32 (0.007117 + eps_p)^0.2589 MPa; punch half-width 35 mm and die
+opening half-width 37 mm, both corner radii 5 mm; blank holder an analytic plane with only z free, pressed
+with 1225 N (2.45 kN on the whole blank); Coulomb mu = 0.144 on every pair. The release: the holder force
+lowered to 50 N, the holder pair switched off, then the die pairs, then the punch pairs; the blank is then
+held by the symmetry plane and the centre line's bottom nodes (which followed the punch).
+
+The full 70 mm stroke takes minutes (docs/verification.md gives the angles); this test runs a CI-size
+version of the same file: a 15 mm stroke in 1 mm steps on the 2 mm mesh (about 30 s). Checked, each a
+quantity that a broken contact, friction, reference-node or plasticity path would change:
+
+- the blank holder's equilibrium (summary.json ``rigid_bodies``): the contact force on it balances the
+  applied 1225 N at every step, and once the sheet slides its friction force is mu times it (full slip);
+- the blank's own z equilibrium: the five pairs' contact forces and the centre node's reaction sum to zero;
+- the punch force (on the punch: its two pairs, plus the centre node that moves with it) is positive and
+  of the size of a steady-draw estimate: the sidewall tension T = (2 mu F_h + 2 M_p w / R_m) e^(mu pi / 2)
+  (holder and die friction, bending plus unbending over the die corner, capstan friction round it), with
+  M_p = sigma_0' t^2 / 4, sigma_0' = 2 / sqrt(3) sigma_Swift(eps_b), eps_b = t / (2 R_m) the bending strain
+  and R_m = R + t/2 the mid-surface radius;
+- the plastic strain where the sheet bent round the die corner is of the size of the bending strain
+  t / (2 R_m) (cell average over the thickness: about half of it);
+- springback opens the channel: the angle between the channel bottom and the sheet beyond the punch
+  corner grows on release; the release stages are (nearly) elastic: their plastic dissipation is a small
+  part of the forming's;
+- the sheet stays clear of the walls of punch and die (not modelled): no node beyond the punch wall
+  x = 35 above the punch corner or beyond the die wall x = 37 below the die corner.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from covcontact.io.loader import problem_from_dict
+
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLE = ROOT / "examples" / "forming" / "uchannel.toml"
+T, W, L = 0.78, 35.0, 175.0            # thickness, width, half length (mm)
+R_PUNCH = R_DIE = 5.0
+X_PUNCH, X_DIE = 35.0, 37.0            # punch half-width, die opening half-width
+F_HOLDER, MU = 1225.0, 0.144           # holder force on the half model (N), Coulomb coefficient
+K, EPS0, N_SWIFT = 565.32, 0.007117, 0.2589
+
+
+def uchannel(stroke: float = 70.0, steps: int | None = None, nx: int | None = None,
+             thickness_points: int | None = None, every: int = 10**6) -> dict:
+    """The example as a dict, with another stroke, number of draw steps or mesh. The holder's nodal
+    penalty keeps its pressure stiffness (per area) when the mesh changes."""
+    raw = tomllib.loads(EXAMPLE.read_text())
+    blank = raw["bodies"][0]
+    nx0 = blank["mesh"]["nx"]
+    if nx is not None:
+        blank["mesh"]["nx"] = nx
+        for c in raw["contact"]:
+            if c["weighting"] == "nodal":
+                c["penalty"] *= nx0 / nx
+    if thickness_points is not None:
+        blank["options"]["thickness_points"] = thickness_points
+    draw = raw["stages"][0]
+    assert draw["name"] == "draw"
+    draw["targets"]["pin"] = -stroke
+    for m in draw["motions"].values():
+        m["translation"] = [0.0, 0.0, -stroke - 0.002]
+    if steps is not None:
+        draw["steps"] = {"count": steps}
+    raw["output"] = {"every": every, "checkpoint_every": 10**6}
+    return raw
+
+
+def midline(X: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """The blank's mid-surface in the (x, z) plane, ordered by X: the mean of the four nodes of each column."""
+    x = X + u
+    cols = np.round(X[:, 0], 6)
+    return np.array([x[cols == c][:, [0, 2]].mean(axis=0) for c in np.unique(cols)])
+
+
+def _line(P: np.ndarray) -> np.ndarray:
+    _, _, vt = np.linalg.svd(P - P.mean(axis=0))
+    return vt[0]
+
+
+def _circle(P: np.ndarray) -> tuple[np.ndarray, float]:
+    A = np.c_[2.0 * P, np.ones(len(P))]
+    sol = np.linalg.lstsq(A, (P**2).sum(axis=1), rcond=None)[0]
+    return sol[:2], float(np.sqrt(sol[2] + sol[:2] @ sol[:2]))
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    return math.degrees(math.acos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0)))
+
+
+def springback_measures(X: np.ndarray, u_loaded: np.ndarray, u_final: np.ndarray, stroke: float,
+                        margin: float = 1.0) -> dict:
+    """NUMISHEET'93 springback measures from the mid-surface after release.
+
+    The parts are chosen on the loaded shape (end of the stroke): the bottom, the mid-surface points on the
+    punch face (x < 30 - margin); the sidewall, those between the two corners (x in (30, 42) and z from
+    margin above the punch corner's upper tangent line to margin below the die corner's lower one);
+    the flange, those on the die face (x > 42 + margin). After release: straight lines fitted to bottom and
+    flange, a circle to the sidewall (radius rho; rho_sign +1 when the sidewall bulges outward);
+
+    - theta1: the angle between the flange (pointing outward) and the sidewall (pointing down from its
+      upper end, tangent of the circle there);
+    - theta2: the angle between the bottom (pointing to the centre) and the sidewall (pointing up from its
+      lower end, tangent of the circle there);
+
+    both 90 degrees for the ideal channel. ``theta1_chord``, ``theta2_chord``: the same with the sidewall's
+    chord in place of the tangents. Needs a straight sidewall of a few elements (a stroke of about 20 mm
+    or more); for short strokes ``theta2_chord`` alone is meaningful."""
+    loaded, final = midline(X, u_loaded), midline(X, u_final)
+    zb = loaded[0, 1]
+    bottom = loaded[:, 0] < 30.0 - margin
+    side = ((loaded[:, 0] > 30.0) & (loaded[:, 0] < 42.0) & (loaded[:, 1] > zb + R_PUNCH + margin)
+            & (loaded[:, 1] < zb + stroke - R_DIE - margin))
+    flange = loaded[:, 0] > 42.0 + margin
+    db = _line(final[bottom])
+    db = db if db[0] < 0 else -db
+    out = {"n_bottom": int(bottom.sum()), "n_side": int(side.sum()), "n_flange": int(flange.sum())}
+    if flange.sum() >= 2:
+        df = _line(final[flange])
+        df = df if df[0] > 0 else -df
+    S = final[side]
+    if len(S) >= 2:
+        lo, hi = S[np.argmin(S[:, 1])], S[np.argmax(S[:, 1])]
+        chord = hi - lo
+        out["theta2_chord"] = _angle(db, chord)
+        if flange.sum() >= 2:
+            out["theta1_chord"] = _angle(-chord, df)
+    if len(S) >= 4:
+        c, rho = _circle(S)
+
+        def tangent(p, toward):
+            r = p - c
+            tv = np.array([-r[1], r[0]])
+            return tv if tv @ (toward - p) > 0 else -tv
+
+        out["rho"] = rho
+        mid = S[len(S) // 2]
+        out["rho_sign"] = float(-np.sign(chord[0] * (mid - lo)[1] - chord[1] * (mid - lo)[0]))
+        out["theta2"] = _angle(db, tangent(lo, hi))
+        if flange.sum() >= 2:
+            out["theta1"] = _angle(tangent(hi, lo), df)
+    return out
+
+
+def run_uchannel(raw: dict, out: Path) -> dict:
+    """Run; return the summary, the reference points, the loaded (end of draw) and final displacements."""
+    problem = problem_from_dict(raw, EXAMPLE)
+    res = problem.run(out=out)
+    assert res.exit_code == 0, res.summary["steps"][-1].get("failure")
+    X = problem.bodies[0].mesh.points
+    n = len(X)
+    k_draw = [s["step"] for s in res.summary["steps"] if s["stage"] == "draw"][-1]
+    vtu = meshio.read(out / f"step_{k_draw:04d}.vtu")
+    return {"summary": res.summary, "X": X, "u_loaded": vtu.point_data["displacement"][:n],
+            "eps_p": vtu.cell_data["equivalent_plastic_strain"][0][: problem.bodies[0].mesh.n_cells],
+            "u_final": res.u.reshape(-1, 3)[:n]}
+
+
+def swift(eps: float) -> float:
+    return K * (EPS0 + eps) ** N_SWIFT
+
+
+def tension_estimate() -> float:
+    """Steady sidewall tension of the half model (N): holder and die friction, bending and unbending over
+    the die corner, capstan friction round its quarter circle."""
+    r_m = R_DIE + T / 2
+    m_p = 2.0 / math.sqrt(3.0) * swift(T / (2 * r_m)) * T**2 / 4
+    return (2 * MU * F_HOLDER + 2 * m_p * W / r_m) * math.exp(MU * math.pi / 2)
+
+
+STROKE, STEPS = 15.0, 15
+
+
+@pytest.fixture(scope="module")
+def ci_run(tmp_path_factory):
+    return run_uchannel(uchannel(STROKE, STEPS), tmp_path_factory.mktemp("uchannel"))
+
+
+def test_holder_equilibrium_and_full_slip(ci_run):
+    steps = [s for s in ci_run["summary"]["steps"] if s["stage"] in ("clamp", "draw")]
+    for s in steps:
+        h = s["rigid_bodies"]["holder"]
+        f_applied = -F_HOLDER * (s["load_factor"] if s["stage"] == "clamp" else 1.0)
+        assert h["applied_force"][2] == pytest.approx(f_applied, rel=1e-12)
+        assert h["contact_force"][2] + h["applied_force"][2] == pytest.approx(0.0, abs=2e-5 * F_HOLDER)
+    # drawing: the sheet slides under the holder, the friction force on it is mu times the normal force
+    for s in [s for s in steps if s["stage"] == "draw"][2:]:
+        fx = s["rigid_bodies"]["holder"]["contact_force"][0]
+        assert abs(fx) == pytest.approx(MU * F_HOLDER, rel=1e-2)  # (a few nodes may stick in a step)
+
+
+def test_blank_equilibrium_and_punch_force(ci_run):
+    steps = [s for s in ci_run["summary"]["steps"] if s["stage"] == "draw"]
+    for s in steps:
+        fz = sum(p["contact_force"][2] for p in s["pairs"].values()) + s["reactions"]["blank.pin"][2]
+        assert fz == pytest.approx(0.0, abs=2e-5 * F_HOLDER)
+    punch = np.array([-(s["pairs"]["punch"]["contact_force"][2] + s["pairs"]["punch_corner"]["contact_force"][2]
+                        + s["reactions"]["blank.pin"][2]) for s in steps])
+    assert np.all(punch[1:] > 0.0)
+    estimate = tension_estimate()  # about 1.3 kN
+    late = punch[len(punch) // 2:]   # after 7.5 mm the sheet has gone round the die corner
+    assert 0.5 * estimate < late.mean() < 1.5 * estimate
+    # the centre node that moves with the punch carries a small part of it
+    pin = np.array([s["reactions"]["blank.pin"][2] for s in steps[len(steps) // 2:]])
+    assert np.all(np.abs(pin) < 0.15 * late)
+
+
+def test_plastic_strain_in_the_bends(ci_run):
+    eps_b = T / (2 * (R_DIE + T / 2))  # 7.2 %: the bending strain at the surfaces
+    eps = ci_run["eps_p"]
+    assert 0.3 * eps_b < eps.max() < 1.0 * eps_b
+    stages = {s["name"]: s for s in ci_run["summary"]["stages"]}
+    assert stages["draw"]["plastic_dissipation"] > 0.0
+    after = sum(abs(stages[k]["plastic_dissipation"]) for k in ("unclamp", "lift", "release", "withdraw"))
+    assert after < 0.02 * stages["draw"]["plastic_dissipation"]
+
+
+def test_springback_opens_the_channel(ci_run):
+    loaded = springback_measures(ci_run["X"], ci_run["u_loaded"], ci_run["u_loaded"], STROKE)
+    final = springback_measures(ci_run["X"], ci_run["u_loaded"], ci_run["u_final"], STROKE)
+    assert loaded["n_side"] >= 1 and loaded["n_bottom"] >= 10 and loaded["n_flange"] >= 30
+    assert 85.0 < loaded["theta2_chord"] < 95.0   # formed: the sheet leaves the punch corner vertically
+    assert final["theta2_chord"] > loaded["theta2_chord"] + 1.0
+
+
+def test_sheet_clear_of_the_walls(ci_run):
+    X = ci_run["X"]
+    for u in (ci_run["u_loaded"],):
+        x = X + u
+        zp = -STROKE + T + R_PUNCH  # the punch corner's centre height at the end of the stroke
+        top = np.isclose(X[:, 2], T)
+        assert np.all(x[top & (x[:, 2] > zp + 1e-6), 0] > X_PUNCH - 1e-3)
+        bot = np.isclose(X[:, 2], 0.0)
+        assert np.all(x[bot & (x[:, 2] < -R_DIE - 1e-6), 0] < X_DIE + 1e-3)
