@@ -1,9 +1,11 @@
 """Newton with cutbacks and line search on a problem whose full step inverts elements."""
 
+import zlib
 from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from covcontact.materials import NeoHooke
 from covcontact.mesh.generators import block
@@ -95,3 +97,67 @@ def test_extrapolating_predictor_same_answer_fewer_iterations(tmp_path):
     assert np.allclose(a.u, b.u, atol=1e-8 * np.abs(a.u).max())
     for sa, sb in zip(a.summary["steps"], b.summary["steps"], strict=True):
         np.testing.assert_allclose(sb["contact_force"], sa["contact_force"], rtol=1e-6, atol=1e-9)
+
+
+class _NoisyLinearModel:
+    """K u = lam f with a residual that cannot fall below ``floor`` (a stand-in for round-off, as in thin
+    shells: eps_mach E A per node): R(u) = K u - lam f + floor * r(u), r of unit norm."""
+
+    symmetric = True
+
+    def __init__(self, floor: float):
+        rng = np.random.default_rng(0)
+        A = rng.standard_normal((6, 6))
+        self.K = sp.csr_matrix(A @ A.T + 6.0 * np.eye(6))
+        self.f = rng.standard_normal(6)
+        self.free = np.ones(6, dtype=bool)
+        self.floor = floor
+
+    def near_null_space(self):
+        return None
+
+    def start_step(self, committed):
+        return committed
+
+    def begin_step(self):
+        pass
+
+    def prescribed(self, lam):
+        return np.zeros(6)
+
+    def external(self, lam):
+        return lam * self.f
+
+    def eliminate(self, K):
+        return K
+
+    def active_count(self, trial):
+        return 0
+
+    def evaluate(self, u, lam, committed, guess, want_K=True, timing=None):
+        noise = np.random.default_rng(zlib.crc32(u.tobytes())).standard_normal(6)  # changes with every u
+        R = self.K @ u - lam * self.f + self.floor * noise / np.linalg.norm(noise)
+        return R, self.K, guess
+
+
+def test_step_starting_almost_converged_stops_at_the_round_off_floor():
+    """A step whose first iterate is already within 1e-6 of the solution (as after the extrapolating
+    predictor) has its relative references (R_0, R_1, the first energy) near the floor itself; it must
+    converge once the residual is below rtol of the force scale and has stopped falling, not run out of
+    iterations."""
+    from covcontact.solvers.newton import Newton
+
+    model = _NoisyLinearModel(floor=1e-10)
+    u = np.linalg.solve(model.K.toarray(), model.f) + 1e-6          # almost the solution at lam = 1
+    newton = Newton(model, SolverOptions(rtol=1e-8, atol=1e-14, max_iterations=25), linear="superlu")
+    out, _ = newton.step(u, 0.0, 1.0, None)
+    assert out.converged, out.reason
+    assert out.iterations <= 4
+    r = out.residual_norms
+    assert r[-1] < 1e-8 * np.linalg.norm(model.f) and r[-1] >= 0.5 * r[-2]
+    assert np.linalg.norm(model.K @ u - model.f) < 1e-9
+    # a residual that is still falling fast is not taken for the floor
+    model.floor = 0.0
+    u = np.linalg.solve(model.K.toarray(), model.f) + 1e-6
+    out, _ = newton.step(u, 0.0, 1.0, None)
+    assert out.converged and out.residual_norms[-1] < 1e-13

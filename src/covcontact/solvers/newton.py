@@ -13,8 +13,10 @@ remaining iterations are plain Newton with homogeneous Dirichlet conditions. Con
   the residual of the previous iteration, so it needs one iteration more than the residual test);
 - ``"both"``: both.
 
-Whatever the criterion, a step also converges on the round-off floor: the energy criterion holds and the
-residual stopped falling (thin shells: about eps_mach E A per node, whatever the load increment). A step that diverges, runs out of
+Whatever the criterion, a step also converges on the round-off floor: the residual stopped falling and
+either the energy criterion holds or the residual is below rtol * F and fell by less than half in each of
+the last two iterations (thin shells: about eps_mach E A per node, whatever the load increment; the second
+form serves steps that start almost converged, whose relative references are at round-off themselves). A step that diverges, runs out of
 iterations, inverts an element or meets a singular matrix is cut back (its increment halved) up to
 ``max_cutbacks`` times in a row.
 
@@ -260,8 +262,13 @@ class Newton:
             scale_k = max(scale, reactions)
             conv_energy = energy <= opt.etol * e0
             conv_res = rn <= max(opt.rtol * r_ref, opt.atol * scale_k)
-            # round-off floor: the energy criterion holds and the residual stopped falling
-            floor = conv_energy and it >= 2 and rn >= 0.5 * out.residual_norms[-2]
+            # round-off floor: the energy criterion holds and the residual stopped falling; or the residual is
+            # below rtol of the force scale and stopped falling for two iterations (a step that starts almost
+            # converged, e.g. after the extrapolating predictor, has r_ref and the energy reference themselves
+            # at round-off, so neither relative test can hold)
+            rs = out.residual_norms
+            stalled = it >= 2 and rn >= 0.5 * rs[-2]
+            floor = stalled and (conv_energy or (it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k))
             conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
             if conv or floor:
                 out.converged = True
