@@ -9,8 +9,10 @@ from covcontact.cli import main
 from covcontact.io.loader import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]
+#: examples that take minutes; each is run at a CI size by its own test (same file, shorter loading)
+LONG = {"forming/uchannel": "tests/verification/test_uchannel.py"}
 EXAMPLES = sorted(p for sub in ("solid", "contact", "verification", "plasticity", "forming")
-                  for p in (ROOT / "examples" / sub).glob("*.toml"))
+                  for p in (ROOT / "examples" / sub).glob("*.toml") if f"{sub}/{p.stem}" not in LONG)
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: f"{p.parent.name}/{p.stem}")
@@ -34,3 +36,9 @@ def test_header_true_to_the_file(path):
         assert criterion in ("energy", "both"), path
     if "on the residual" in header:
         assert criterion in ("residual", "both"), path
+
+
+@pytest.mark.parametrize("name", sorted(LONG))
+def test_long_examples_have_a_ci_size_test(name):
+    test = ROOT / LONG[name]
+    assert (ROOT / "examples" / f"{name}.toml").exists() and f"{name}.toml" in test.read_text()

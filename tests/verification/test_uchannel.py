@@ -107,14 +107,14 @@ def springback_measures(X: np.ndarray, u_loaded: np.ndarray, u_final: np.ndarray
     the flange, those on the die face (x > 42 + margin). After release: straight lines fitted to bottom and
     flange, a circle to the sidewall (radius rho; rho_sign +1 when the sidewall bulges outward);
 
-    - theta1: the angle between the flange (pointing outward) and the sidewall (pointing down from its
-      upper end, tangent of the circle there);
-    - theta2: the angle between the bottom (pointing to the centre) and the sidewall (pointing up from its
-      lower end, tangent of the circle there);
+    - theta1: the angle between the bottom (pointing to the centre) and the sidewall (pointing up from its
+      lower end, tangent of the circle there), at the punch side;
+    - theta2: the angle between the flange (pointing outward) and the sidewall (pointing down from its
+      upper end, tangent of the circle there), at the die side;
 
     both 90 degrees for the ideal channel. ``theta1_chord``, ``theta2_chord``: the same with the sidewall's
     chord in place of the tangents. Needs a straight sidewall of a few elements (a stroke of about 20 mm
-    or more); for short strokes ``theta2_chord`` alone is meaningful."""
+    or more); for short strokes ``theta1_chord`` alone is meaningful."""
     loaded, final = midline(X, u_loaded), midline(X, u_final)
     zb = loaded[0, 1]
     bottom = loaded[:, 0] < 30.0 - margin
@@ -131,9 +131,9 @@ def springback_measures(X: np.ndarray, u_loaded: np.ndarray, u_final: np.ndarray
     if len(S) >= 2:
         lo, hi = S[np.argmin(S[:, 1])], S[np.argmax(S[:, 1])]
         chord = hi - lo
-        out["theta2_chord"] = _angle(db, chord)
+        out["theta1_chord"] = _angle(db, chord)
         if flange.sum() >= 2:
-            out["theta1_chord"] = _angle(-chord, df)
+            out["theta2_chord"] = _angle(-chord, df)
     if len(S) >= 4:
         c, rho = _circle(S)
 
@@ -145,9 +145,9 @@ def springback_measures(X: np.ndarray, u_loaded: np.ndarray, u_final: np.ndarray
         out["rho"] = rho
         mid = S[len(S) // 2]
         out["rho_sign"] = float(-np.sign(chord[0] * (mid - lo)[1] - chord[1] * (mid - lo)[0]))
-        out["theta2"] = _angle(db, tangent(lo, hi))
+        out["theta1"] = _angle(db, tangent(lo, hi))
         if flange.sum() >= 2:
-            out["theta1"] = _angle(tangent(hi, lo), df)
+            out["theta2"] = _angle(tangent(hi, lo), df)
     return out
 
 
@@ -228,8 +228,8 @@ def test_springback_opens_the_channel(ci_run):
     loaded = springback_measures(ci_run["X"], ci_run["u_loaded"], ci_run["u_loaded"], STROKE)
     final = springback_measures(ci_run["X"], ci_run["u_loaded"], ci_run["u_final"], STROKE)
     assert loaded["n_side"] >= 1 and loaded["n_bottom"] >= 10 and loaded["n_flange"] >= 30
-    assert 85.0 < loaded["theta2_chord"] < 95.0   # formed: the sheet leaves the punch corner vertically
-    assert final["theta2_chord"] > loaded["theta2_chord"] + 1.0
+    assert 85.0 < loaded["theta1_chord"] < 95.0   # formed: the sheet leaves the punch corner vertically
+    assert final["theta1_chord"] > loaded["theta1_chord"] + 1.0
 
 
 def test_sheet_clear_of_the_walls(ci_run):
