@@ -32,6 +32,7 @@ quantity that a broken contact, friction, reference-node or plasticity path woul
 from __future__ import annotations
 
 import math
+import sys
 import tomllib
 from pathlib import Path
 
@@ -40,6 +41,9 @@ import numpy as np
 import pytest
 
 from covcontact.io.loader import problem_from_dict
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples" / "forming"))
+from uchannel_springback import springback_measures
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "forming" / "uchannel.toml"
@@ -73,82 +77,6 @@ def uchannel(stroke: float = 70.0, steps: int | None = None, nx: int | None = No
         draw["steps"] = {"count": steps}
     raw["output"] = {"every": every, "checkpoint_every": 10**6}
     return raw
-
-
-def midline(X: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """The blank's mid-surface in the (x, z) plane, ordered by X: the mean of the four nodes of each column."""
-    x = X + u
-    cols = np.round(X[:, 0], 6)
-    return np.array([x[cols == c][:, [0, 2]].mean(axis=0) for c in np.unique(cols)])
-
-
-def _line(P: np.ndarray) -> np.ndarray:
-    _, _, vt = np.linalg.svd(P - P.mean(axis=0))
-    return vt[0]
-
-
-def _circle(P: np.ndarray) -> tuple[np.ndarray, float]:
-    A = np.c_[2.0 * P, np.ones(len(P))]
-    sol = np.linalg.lstsq(A, (P**2).sum(axis=1), rcond=None)[0]
-    return sol[:2], float(np.sqrt(sol[2] + sol[:2] @ sol[:2]))
-
-
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
-    return math.degrees(math.acos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0)))
-
-
-def springback_measures(X: np.ndarray, u_loaded: np.ndarray, u_final: np.ndarray, stroke: float,
-                        margin: float = 1.0) -> dict:
-    """NUMISHEET'93 springback measures from the mid-surface after release.
-
-    The parts are chosen on the loaded shape (end of the stroke): the bottom, the mid-surface points on the
-    punch face (x < 30 - margin); the sidewall, those between the two corners (x in (30, 42) and z from
-    margin above the punch corner's upper tangent line to margin below the die corner's lower one);
-    the flange, those on the die face (x > 42 + margin). After release: straight lines fitted to bottom and
-    flange, a circle to the sidewall (radius rho; rho_sign +1 when the sidewall bulges outward);
-
-    - theta1: the angle between the bottom (pointing to the centre) and the sidewall (pointing up from its
-      lower end, tangent of the circle there), at the punch side;
-    - theta2: the angle between the flange (pointing outward) and the sidewall (pointing down from its
-      upper end, tangent of the circle there), at the die side;
-
-    both 90 degrees for the ideal channel. ``theta1_chord``, ``theta2_chord``: the same with the sidewall's
-    chord in place of the tangents. Needs a straight sidewall of a few elements (a stroke of about 20 mm
-    or more); for short strokes ``theta1_chord`` alone is meaningful."""
-    loaded, final = midline(X, u_loaded), midline(X, u_final)
-    zb = loaded[0, 1]
-    bottom = loaded[:, 0] < 30.0 - margin
-    side = ((loaded[:, 0] > 30.0) & (loaded[:, 0] < 42.0) & (loaded[:, 1] > zb + R_PUNCH + margin)
-            & (loaded[:, 1] < zb + stroke - R_DIE - margin))
-    flange = loaded[:, 0] > 42.0 + margin
-    db = _line(final[bottom])
-    db = db if db[0] < 0 else -db
-    out = {"n_bottom": int(bottom.sum()), "n_side": int(side.sum()), "n_flange": int(flange.sum())}
-    if flange.sum() >= 2:
-        df = _line(final[flange])
-        df = df if df[0] > 0 else -df
-    S = final[side]
-    if len(S) >= 2:
-        lo, hi = S[np.argmin(S[:, 1])], S[np.argmax(S[:, 1])]
-        chord = hi - lo
-        out["theta1_chord"] = _angle(db, chord)
-        if flange.sum() >= 2:
-            out["theta2_chord"] = _angle(-chord, df)
-    if len(S) >= 4:
-        c, rho = _circle(S)
-
-        def tangent(p, toward):
-            r = p - c
-            tv = np.array([-r[1], r[0]])
-            return tv if tv @ (toward - p) > 0 else -tv
-
-        out["rho"] = rho
-        mid = S[len(S) // 2]
-        out["rho_sign"] = float(-np.sign(chord[0] * (mid - lo)[1] - chord[1] * (mid - lo)[0]))
-        out["theta1"] = _angle(db, tangent(lo, hi))
-        if flange.sum() >= 2:
-            out["theta2"] = _angle(tangent(hi, lo), df)
-    return out
 
 
 def run_uchannel(raw: dict, out: Path) -> dict:
