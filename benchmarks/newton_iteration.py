@@ -9,6 +9,8 @@ iterations. Writes JSON.
     python benchmarks/newton_iteration.py --quick                      # small sizes only
     python benchmarks/newton_iteration.py --blocks --plates 408 --iterations 2   # one 1e6-dof plate,
                                                                        # two Newton iterations timed
+    python benchmarks/newton_iteration.py --blocks --plates 408 --reuse          # the whole step, reusing
+                                                                       # factorisations (inexact Newton)
 """
 
 from __future__ import annotations
@@ -66,9 +68,10 @@ def two_blocks_problem(n: int) -> Problem:
         steps=Steps.equal(1), output=OutputOptions(vtu=False), solver=SolverOptions())
 
 
-def measure(prob: Problem, iterations: int | None = None) -> dict:
+def measure(prob: Problem, iterations: int | None = None, reuse: bool = False) -> dict:
     if iterations:  # time a fixed number of iterations of the first step (no cutback)
         prob.solver = SolverOptions(max_iterations=iterations, max_cutbacks=0)
+    prob.solver.reuse_factorization = reuse
     t0 = time.perf_counter()
     model = Model(prob)
     newton = Newton(model, prob.solver)
@@ -80,7 +83,9 @@ def measure(prob: Problem, iterations: int | None = None) -> dict:
     its = max(sum(o.iterations for o in outcomes), 1)
     per_it = {k: v / its for k, v in newton.timing.items()}
     return {"problem": prob.name, "dofs": model.n_dofs, "converged": ok, "iterations": its,
-            "cutbacks": cutbacks, "setup_s": t_setup, "wall_s": wall,
+            "cutbacks": cutbacks, "setup_s": t_setup, "wall_s": wall, "reuse_factorization": reuse,
+            "factorizations": newton.stats["factorizations"], "krylov_iterations": newton.stats["krylov_iterations"],
+            "residual_norms": [r for o in outcomes for r in o.residual_norms],
             "per_iteration_s": per_it, "iteration_total_s": wall / its,
             "solver": newton.linear.name,
             "peak_rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
@@ -96,6 +101,8 @@ def main() -> None:
                     help="two-block sizes n (mesh-facet contact between deformable bodies)")
     ap.add_argument("--iterations", type=int, default=None,
                     help="time only this many Newton iterations of the step (for the largest sizes)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="[solver] reuse_factorization = true: GMRES preconditioned by the last factorisation")
     args = ap.parse_args()
     blocks = [8, 12] if args.quick else [8, 16, 24, 32, 40]
     plates = [20, 40] if args.quick else [40, 80, 120, 160, 200]
@@ -106,13 +113,13 @@ def main() -> None:
     measure(block_problem(4))  # compile
     rows = []
     for n in blocks:
-        rows.append(measure(block_problem(n), args.iterations))
+        rows.append(measure(block_problem(n), args.iterations, args.reuse))
         print(json.dumps(rows[-1]))
     for n in plates:
-        rows.append(measure(plate_problem(n), args.iterations))
+        rows.append(measure(plate_problem(n), args.iterations, args.reuse))
         print(json.dumps(rows[-1]))
     for n in args.two_blocks:
-        rows.append(measure(two_blocks_problem(n), args.iterations))
+        rows.append(measure(two_blocks_problem(n), args.iterations, args.reuse))
         print(json.dumps(rows[-1]))
     result = {"benchmark": "newton_iteration", "machine": platform.machine(), "threads": numba.get_num_threads(),
               "date": time.strftime("%Y-%m-%d"), "rows": rows}

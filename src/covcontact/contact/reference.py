@@ -55,15 +55,21 @@ def tangent_map(theta: np.ndarray) -> np.ndarray:
     return np.eye(3) + a * K + b * (K @ K)
 
 
-def tangent_map_derivative(theta: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """d(T(theta)^T v)/d theta for a fixed v: (3, 3), by complex steps."""
+def tangent_map_derivatives(theta: np.ndarray) -> np.ndarray:
+    """D (3, 3, 3) with D[i] = d(T(theta)^T e_i)/d theta, by complex steps: d(T^T v)/d theta = v_i D[i] is
+    linear in v, so one evaluation serves every v."""
     h = 1e-30
-    out = np.zeros((3, 3))
+    out = np.zeros((3, 3, 3))
     for k in range(3):
         th = np.asarray(theta, dtype=complex).copy()
         th[k] += 1j * h
-        out[:, k] = (tangent_map(th).T @ v).imag / h
+        out[:, :, k] = tangent_map(th).imag / h   # (T^T e_i)_j = T_ij
     return out
+
+
+def tangent_map_derivative(theta: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """d(T(theta)^T v)/d theta for a fixed v: (3, 3)."""
+    return np.einsum("i,ijk->jk", np.asarray(v, dtype=np.float64), tangent_map_derivatives(theta))
 
 
 def rotation_vector(Rm: np.ndarray) -> np.ndarray:
@@ -157,8 +163,8 @@ def map_rigid_nodes(conn: np.ndarray, R: np.ndarray, K: np.ndarray | None, owner
                     G[:, 3 * jb: 3 * jb + 3, 3 * jb: 3 * jb + 3] += T.T @ skew(fa) @ skew(ry) @ T
                 mom += np.cross(ry, fa)
             if k is not None:
-                for e in range(m):
-                    G[e, 3 * jb: 3 * jb + 3, 3 * jb: 3 * jb + 3] += tangent_map_derivative(pose.theta, mom[e])
+                G[:, 3 * jb: 3 * jb + 3, 3 * jb: 3 * jb + 3] += np.einsum(
+                    "mi,ijk->mjk", mom, tangent_map_derivatives(pose.theta))
         r_new = np.einsum("mij,mi->mj", P, r)
         k_new = None if k is None else np.einsum("mia,mij,mjb->mab", P, k, P) + G
         out.append((new_conn, r_new, k_new))
@@ -191,8 +197,7 @@ def map_analytic(slaves: np.ndarray, xs: np.ndarray, f: np.ndarray, K: np.ndarra
     dd[:, :, 3:6] = -np.eye(3)
     dmom = -Sf @ dd + Sd @ Jf
     Kn[:, 6:9] = -np.einsum("ji,mjk->mik", T, dmom)
-    for e in range(m):
-        Kn[e, 6:9, 6:9] -= tangent_map_derivative(pose.theta, mom[e])
+    Kn[:, 6:9, 6:9] -= np.einsum("mi,ijk->mjk", mom, tangent_map_derivatives(pose.theta))
     return conn, r, Kn
 
 
