@@ -259,6 +259,110 @@ contacts = { touch = false }
     np.testing.assert_allclose(plate, np.tile([0.0, 0.0, 0.03], (len(plate), 1)), atol=1e-14)
 
 
+PRESS = """
+[problem]
+name = "press"
+[[bodies]]
+name = "block"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2 }
+[[rigid]]
+name = "plate"
+shape = "plane"
+point = [0.0, 0.0, 1.0]
+normal = [0.0, 0.0, -1.0]
+PLATE
+[[contact]]
+name = "touch"
+slave = "block.zmax"
+master = "plate"
+penalty = 1.0e6
+[[dirichlet]]
+set = "block.zmin"
+components = "z"
+[[dirichlet]]
+set = "block.xmin"
+components = "x"
+[[dirichlet]]
+set = "block.ymin"
+components = "y"
+[solver]
+rtol = 1.0e-12
+[steps]
+count = 2
+"""
+
+
+def test_released_pair_ramps_its_force_to_zero(tmp_path):
+    """release = ["touch"]: the pair is off from the start of the stage and the force it carried is applied
+    as a load ramped to zero, so the block unloads gradually (against an abrupt switch-off)."""
+    text = PRESS.replace("PLATE", 'motion = { translation = [0.0, 0.0, -0.001] }') + """
+[[stages]]
+name = "unload"
+steps = { count = 4 }
+release = ["touch"]
+"""
+    path = tmp_path / "rel.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "rel")
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    r0 = steps[1]["reactions"]["block.zmin"][2]
+    assert r0 > 0.5  # pressed: about E * 0.001 * area = 1
+    for s in steps[2:]:
+        assert s["active_contacts"] == 0
+        lam = s["load_factor"]
+        # the released force falls linearly; the block follows it (elastic, strain 1e-3: nearly linear)
+        assert s["reactions"]["block.zmin"][2] == pytest.approx((1.0 - lam) * r0, rel=2e-3, abs=1e-9)
+    assert steps[-1]["iterations"] <= 3
+    x, X = _final_points(tmp_path / "rel")
+    np.testing.assert_allclose(x[:27], X[:27], atol=1e-9)  # unloaded: back to the reference shape
+    assert res.summary["stages"][1]["released"] == ["touch"]
+
+
+def test_motion_takes_over_the_free_component_of_a_pressed_tool(tmp_path):
+    """A plane pressed onto the block with a force (z free), then lifted by a stage motion: its z is held
+    where the stage found it and moved by the translation; the contact opens and the block unloads."""
+    text = PRESS.replace("PLATE", 'free = ["z"]\nforce = [0.0, 0.0, -1.0]') + """
+[[stages]]
+name = "lift"
+steps = { count = 2 }
+motions = { plate = { translation = [0.0, 0.0, 0.05] } }
+"""
+    path = tmp_path / "lift.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "lift")
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    pressed = steps[1]["rigid_bodies"]["plate"]
+    assert pressed["contact_force"][2] == pytest.approx(1.0, rel=1e-6)  # balances the applied force
+    z1 = pressed["displacement"][2]
+    assert z1 < 0.0
+    for s, lam in zip(steps[2:], (0.5, 1.0)):
+        assert s["rigid_bodies"]["plate"]["displacement"][2] == pytest.approx(z1 + 0.05 * lam, abs=1e-12)
+    assert steps[-1]["active_contacts"] == 0
+    assert abs(steps[-1]["reactions"]["block.zmin"][2]) < 1e-9
+
+
+@pytest.mark.parametrize("stages, message", [
+    ('[[stages]]\nname = "a"\ncontacts = { touch = false }\n[[stages]]\nname = "b"\nrelease = ["touch"]\n',
+     "contact pair 'touch' is off at the start of this stage"),
+    ('[[stages]]\nname = "a"\nrelease = ["touch"]\ncontacts = { touch = true }\n',
+     "released and switched in 'contacts'"),
+    ('[[stages]]\nname = "a"\nrelease = ["touch"]\n[[stages]]\nname = "b"\nrelease = ["touch"]\n',
+     "contact pair 'touch' was released in stage 'a'"),
+    ('[[stages]]\nname = "a"\nrelease = ["tuch"]\n', "contact pair named 'tuch'; did you mean 'touch'?"),
+    ('[[stages]]\nname = "a"\nmotions = { plate = { rotation = [0.0, 0.1, 0.0] } }\n',
+     "rigid body 'plate' has free components: a stage motion holds them and may only translate it"),
+])
+def test_bad_pair_release_and_free_body_motion(tmp_path, stages, message):
+    path = tmp_path / "bad.toml"
+    path.write_text(PRESS.replace("PLATE", 'free = ["z"]\nforce = [0.0, 0.0, -1.0]') + stages)
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert message in str(err.value) and "\n" not in str(err.value), str(err.value)
+
+
 def test_loads_take_new_targets_and_are_removed(tmp_path):
     path = tmp_path / "loads.toml"
     path.write_text("""
@@ -330,7 +434,7 @@ def test_resume_across_stages_is_exact(tmp_path, monkeypatch, stop_at):
 
 
 @pytest.mark.parametrize("stages, message", [
-    ('[[stages]]\nname = "a"\nrelease = ["nope"]\n', "no Dirichlet condition named 'nope'"),
+    ('[[stages]]\nname = "a"\nrelease = ["nope"]\n', "no Dirichlet condition or contact pair named 'nope'"),
     ('[[stages]]\nname = "a"\nrelease = ["pull"]\n[[stages]]\nname = "b"\nrelease = ["pull"]\n',
      "'pull' was released in stage 'a'"),
     ('[[stages]]\nname = "a"\nrelease = ["pull", "pull"]\n', "names a condition twice"),

@@ -289,7 +289,28 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
         return named[value]
 
     release = _strs(st, "release")
+    pair_names = {c.name for c in contacts}
+    pair_on = {c.name: bool(c.enabled) for c in contacts}  # as the stages before leave the pairs
+    for x in earlier:
+        pair_on.update(x.contacts)
+        pair_on.update({n: False for n in x.release if n in pair_names})
     for n in release:
+        is_condition = n in named and named[n][0] == "dirichlet"
+        if is_condition and n in pair_names:
+            st.fail(f"{n!r} names both a Dirichlet condition and a contact pair; rename one", "release")
+        if not is_condition and n in pair_names:  # a pair: switched off, its forces ramped to zero
+            if n in released_before:
+                st.fail(f"contact pair {n!r} was released in stage {released_before[n]!r}", "release")
+            if not pair_on[n]:
+                st.fail(f"contact pair {n!r} is off at the start of this stage; there is nothing to release",
+                        "release")
+            if n in st.data.get("contacts", {}):
+                st.fail(f"contact pair {n!r} is released and switched in 'contacts' in the same stage", "release")
+            continue
+        if n not in named or named[n][0] != "dirichlet":
+            known = sorted({k for k, (kind, _) in named.items() if kind == "dirichlet"} | pair_names)
+            st.fail(f"no Dirichlet condition or contact pair named {n!r}{suggest(n, known)} (named ones: "
+                    f"{', '.join(known) or 'none'})", "release")
         check_name(st, "release", n, ("dirichlet",), "Dirichlet condition")
     if len(set(release)) != len(release):
         st.fail("names a condition twice", "release")
@@ -338,7 +359,7 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
             if n not in movable:
                 msec.fail(f"no rigid body or Dirichlet condition with a motion named {n!r}{suggest(n, movable)} (known: "
                           f"{', '.join(sorted(movable)) or 'none'})", n)
-            if n in named and n in {r.name for r in rigid}:
+            if n in named and named[n][0] == "dirichlet" and n in {r.name for r in rigid}:
                 msec.fail(f"{n!r} names both a rigid body and a Dirichlet condition; rename one", n)
             if n in release:
                 msec.fail(f"{n!r} is released and given a motion in the same stage", n)
@@ -346,6 +367,12 @@ def _stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, 
                 msec.fail(f"{n!r} was released in stage {released_before[n]!r}; a released condition stays "
                           f"free", n)
             motions[n] = _motion(msec.get(n, "table"))
+            body = next((r for r in rigid if r.name == n), None)
+            if body is not None and body.free and (np.any(motions[n].rotation != 0.0)
+                                                   or n in targets):
+                msec.fail(f"rigid body {n!r} has free components: a stage motion holds them and may only "
+                          f"translate it ({'no rotation' if n not in targets else 'no force target as well'})",
+                          n)
         msec.done()
     switch = {}
     csec = st.get("contacts", "table", None)

@@ -54,10 +54,15 @@ class Model:
         spec = self.stages[committed.stage + 1]
         forces = {}
         held = self.loading.left_over()
-        if spec.released.size or np.any(held):
-            R, _, _ = self.evaluate(u, committed.lam, committed, want_K=False)
+        if spec.released.size or np.any(held) or spec.released_pairs:
             release = np.zeros(self.n_dofs)
-            release[spec.released] = R[spec.released]
+            if spec.released.size:
+                R, _, _ = self.evaluate(u, committed.lam, committed, want_K=False)
+                release[spec.released] = R[spec.released]
+            if spec.released_pairs:  # the pairs' forces on the bodies become loads ramped to zero
+                r_pairs = self._pair_residual(u, committed, spec.released_pairs)
+                r_pairs[spec.constrained] = 0.0
+                release -= r_pairs
             forces = {"release": release, "held": held}
         if spec.parked.size:  # free rigid bodies without an active pair stay where they are
             parked = np.zeros(self.n_dofs)
@@ -66,6 +71,19 @@ class Model:
         new = committed.but(stage=committed.stage + 1, lam=0.0, forces=forces)
         self.set_stage(new)
         return new.but(contact=self.contact.switch(new.contact))
+
+    def _pair_residual(self, u: np.ndarray, committed: State, names: tuple[str, ...]) -> np.ndarray:
+        """The contact residual of the named pairs alone at ``u`` (the current stage's motions), on the
+        system's dofs."""
+        enabled = list(self.contact.enabled)
+        try:
+            self.contact.enabled = [e and p.pair in names for e, p in zip(enabled, self.contact.passes)]
+            self.contact.begin_step()
+            ev, _ = self.contact.evaluate(self.positions(u), committed.lam, committed.contact, None, False)
+        finally:
+            self.contact.enabled = enabled
+            self.contact.begin_step()
+        return ev.blocks.residual()
 
     # delegation -------------------------------------------------------------------------------
     @property

@@ -87,6 +87,10 @@ class StageSpec:
     #: found them (nothing else would restrain them)
     parked: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64), repr=False)
     parked_names: tuple[str, ...] = ()
+    #: parked dofs moved by a motion this stage gives their body: (dofs, RigidMotion, components 0..2)
+    parked_moves: list = field(default_factory=list, repr=False)
+    #: contact pairs released at the start of this stage: switched off, their forces ramped to zero
+    released_pairs: tuple[str, ...] = ()
 
     @property
     def lam_end(self) -> float:
@@ -164,9 +168,13 @@ class StagePlan:
                 new_motions[name] = StagedMotion(nm, *pose) if nm is not None else StagedMotion.hold(*pose)
             new_contacts = dict(prev.contacts)
             new_contacts.update({k2: bool(v) for k2, v in st.contacts.items()})
+            cond_names = {c.name for c in prev.conditions}
+            pairs_released = tuple(n for n in st.release if n not in cond_names and n in new_contacts)
+            new_contacts.update({n: False for n in pairs_released})
             rel = np.unique(np.concatenate(released)) if released else np.zeros(0, np.int64)
             spec = self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
-                              new_motions, new_contacts, tuple(st.release))
+                              new_motions, new_contacts, tuple(st.release), st.motions)
+            spec.released_pairs = pairs_released
             for name, (f0, f1, m0, m1) in prev.rigid_loads.items():
                 f, m = f0 + lam_end * (f1 - f0), m0 + lam_end * (m1 - m0)
                 if name in st.remove:
@@ -183,7 +191,8 @@ class StagePlan:
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
-    def _spec(self, index, name, factors, conds, released, loads, start, target, motions, contacts, names):
+    def _spec(self, index, name, factors, conds, released, loads, start, target, motions, contacts, names,
+              moved=None):
         sysm = self.system
         f0 = np.zeros(sysm.n_dofs)
         f1 = np.zeros(sysm.n_dofs)
@@ -191,16 +200,23 @@ class StagePlan:
             f0 += sysm.load_vector(load, start[key])
             f1 += sysm.load_vector(load, target[key])
         conds = list(conds)
-        parked, parked_names = [], []
+        parked, parked_names, parked_moves = [], [], []
         for ref in getattr(sysm, "reference", []):
             comps = tuple(c for c in range(6) if c not in ref.free)
             if comps:
                 conds.append(_Condition(f"rigid:{ref.name}", np.array([ref.A]), comps, None, None,
                                         motions[ref.name], ref))
             pairs = [c.name for c in self.problem.contacts if ref.name in (c.slave[0], c.master[0])]
-            if ref.free and not any(contacts.get(n, True) for n in pairs):
+            off = not any(contacts.get(n, True) for n in pairs)
+            # a stage motion for a body with free components takes them over: the body is held where the
+            # stage found it and translated by the motion (e.g. a blank holder lifted off by displacement)
+            driven = moved is not None and ref.name in moved
+            if ref.free and (off or driven):
                 parked += [3 * (ref.A if c < 3 else ref.B) + c % 3 for c in ref.free]
                 parked_names.append(ref.name)
+                trans = tuple(c for c in ref.free if c < 3)
+                if driven and trans:
+                    parked_moves.append((3 * ref.A + np.array(trans), moved[ref.name], trans))
         constrained = np.zeros(sysm.n_dofs, dtype=bool)
         for c in conds:
             constrained[c.dofs] = True
@@ -208,7 +224,7 @@ class StagePlan:
         constrained[parked] = True
         released = released[~constrained[released]] if released.size else released
         return StageSpec(index, name, tuple(factors), conds, released, f0, f1, motions, contacts, names,
-                         constrained, parked=parked, parked_names=tuple(parked_names))
+                         constrained, parked=parked, parked_names=tuple(parked_names), parked_moves=parked_moves)
 
     def __len__(self) -> int:
         return len(self.stages)
@@ -241,13 +257,15 @@ class Loading:
             u[dofs] = c.values(self.X, lam)
         if self.spec.parked.size:
             u[self.spec.parked] = self.parked[self.spec.parked]
+            for dofs, motion, comps in self.spec.parked_moves:
+                u[dofs] += motion.offset(lam)[list(comps)]
         return u
 
     def external(self, lam: float) -> np.ndarray:
         """External force vector at lam: loads, the released reactions' ramp, the held forces."""
         s = self.spec
         f = s.load_start + lam * (s.load_target - s.load_start)
-        if s.released.size or np.any(self.held):
+        if s.released.size or s.released_pairs or np.any(self.held):
             f = f + max(0.0, 1.0 - lam) * self.release + self.held
         return f
 
