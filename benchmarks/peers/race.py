@@ -211,7 +211,9 @@ class Cell:
                 "cpus_reported": std["cpus"], "F": F}
 
     def codes(self) -> dict:
-        c = {"covcontact": (self.run_ours, self.ours_record), "kratos": (self.run_kratos, self.kratos_record)}
+        c = {"covcontact": (self.run_ours, self.ours_record)}
+        if self.args.kratos:
+            c["kratos"] = (self.run_kratos, self.kratos_record)
         if self.ccx_job is not None:
             c["ccx"] = (self.run_ccx, self.ccx_record)
         return c
@@ -256,16 +258,18 @@ def table(records: list[dict], threads: int) -> str:
     rows = [f"threads: {threads}", "", head, "|" + "---|" * 13]
     for r in records:
         c = r["codes"]
-        o, k, x = c["covcontact"], c["kratos"], c.get("ccx")
-        it = f"{o['iterations']} / {k['iterations']} / {x['iterations'] if x else '-'}"
+        o, k, x = c["covcontact"], c.get("kratos"), c.get("ccx")
+        it = f"{o['iterations']} / {k['iterations'] if k else '-'} / {x['iterations'] if x else '-'}"
         fh = "-"
         if r["problem"] == "hertz":
-            fh = " / ".join(f"{v['F_over_FH'][-1]:.4f}" if "F_over_FH" in v else "-" for v in (o, k, x) if v)
-        fd = f"{k.get('F_diff_max', float('nan')):.1e} / " + (f"{x.get('F_diff_max', float('nan')):.1e}" if x else "-")
+            fh = " / ".join(f"{v['F_over_FH'][-1]:.4f}" if v and "F_over_FH" in v else "-" for v in (o, k, x))
+        fd = (f"{k.get('F_diff_max', float('nan')):.1e}" if k else "-") + " / " + (
+            f"{x.get('F_diff_max', float('nan')):.1e}" if x else "-")
+        conv = f"{sum(k['steps_converged'])}/{len(k['steps_converged'])}" if k else "-"
         rows.append(f"| {r['problem']} | {r['size']} | {r['mesh']} | {r['dofs']} | {o['wall_median_s']:.2f}"
-                    f" | {k['wall_median_s']:.2f} | {k['time_ratio_over_covcontact']:.2f}"
+                    f" | {k['wall_median_s'] if k else '-'} | {k['time_ratio_over_covcontact'] if k else '-'}"
                     f" | {x['wall_median_s'] if x else '-'} | {x['time_ratio_over_covcontact'] if x else '-'}"
-                    f" | {it} | {sum(k['steps_converged'])}/{len(k['steps_converged'])} | {fd} | {fh} |")
+                    f" | {it} | {conv} | {fd} | {fh} |")
     return "\n".join(rows)
 
 
@@ -286,6 +290,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--kratos-python", default=os.environ.get("KRATOS_PYTHON"),
                     help="Python with the Kratos wheels (default: $KRATOS_PYTHON)")
     ap.add_argument("--no-ccx", dest="ccx", action="store_false", help="leave CalculiX out even if installed")
+    ap.add_argument("--no-kratos", dest="kratos", action="store_false",
+                    help="leave Kratos out (sizes where its runs take too long)")
     ap.add_argument("--two-blocks-penalty", type=float, default=2.5e5)
     ap.add_argument("--hertz-penalty", type=float, default=1e4)
     ap.add_argument("--keep", type=Path, help="keep inputs and results in this directory")
@@ -295,7 +301,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.worker_hertz:
         n, penalty, out = args.worker_hertz
         return worker_hertz(int(n), float(penalty), out)
-    if not args.kratos_python:
+    if args.kratos and not args.kratos_python:
         print("give --kratos-python (or set KRATOS_PYTHON): the Python of an environment with Kratos", file=sys.stderr)
         return 2
     args.ccx = args.ccx and shutil.which("ccx") is not None
@@ -314,7 +320,7 @@ def main(argv: list[str] | None = None) -> int:
     result = {"benchmark": "peers_race", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "cpus": os.cpu_count(), "threads": args.threads,
               "repeats": args.repeats, "steps": STEPS,
-              "kratos_version": records[0]["codes"]["kratos"]["version"] if records else "",
+              "kratos_version": records[0]["codes"]["kratos"]["version"] if records and args.kratos else None,
               "ccx_version": _ccx_version() if args.ccx else None, "covcontact": _covcontact_state(),
               "total_s": round(time.perf_counter() - t0, 1), "records": records}
     emit(result, args.out, table(records, args.threads))
