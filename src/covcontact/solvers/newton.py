@@ -14,9 +14,10 @@ remaining iterations are plain Newton with homogeneous Dirichlet conditions. Con
 - ``"both"``: both.
 
 Whatever the criterion, a step also converges on the round-off floor: the residual stopped falling and
-either the energy criterion holds or the residual is below rtol * F and fell by less than half in each of
-the last two iterations (thin shells: about eps_mach E A per node, whatever the load increment; the second
-form serves steps that start almost converged, whose relative references are at round-off themselves). A step that diverges, runs out of
+either the energy criterion holds or the residual is below rtol * F, fell by less than half in each of the
+last two iterations and the last correction is below 1e-10 of the solution (thin shells: about eps_mach E A
+per node, whatever the load increment; the second form serves steps that start almost converged, whose
+relative references are at round-off themselves). A step that diverges, runs out of
 iterations, inverts an element or meets a singular matrix is cut back (its increment halved) up to
 ``max_cutbacks`` times in a row.
 
@@ -263,12 +264,15 @@ class Newton:
             conv_energy = energy <= opt.etol * e0
             conv_res = rn <= max(opt.rtol * r_ref, opt.atol * scale_k)
             # round-off floor: the energy criterion holds and the residual stopped falling; or the residual is
-            # below rtol of the force scale and stopped falling for two iterations (a step that starts almost
-            # converged, e.g. after the extrapolating predictor, has r_ref and the energy reference themselves
-            # at round-off, so neither relative test can hold)
+            # below rtol of the force scale, stopped falling for two iterations and the correction is at
+            # round-off of the solution (a step that starts almost converged, e.g. after the extrapolating
+            # predictor, has r_ref and the energy reference themselves at round-off, so neither relative test
+            # can hold; a slowly converging step still makes corrections and goes on)
             rs = out.residual_norms
             stalled = it >= 2 and rn >= 0.5 * rs[-2]
-            floor = stalled and (conv_energy or (it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k))
+            floor = stalled and (conv_energy or (
+                it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k
+                and eta * float(np.linalg.norm(du[free])) <= 1e-10 * float(np.linalg.norm(u[free]))))
             conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
             if conv or floor:
                 out.converged = True
