@@ -56,6 +56,27 @@ def _pardiso_function():
     return fn
 
 
+@lru_cache(maxsize=1)
+def _mkl_local_threads():
+    """MKL's ``mkl_set_num_threads_local`` (None if the runtime lacks it): sets the calling thread's MKL thread
+    count and returns the previous setting (0: the global one)."""
+    import pypardiso
+
+    try:
+        fn = pypardiso.PyPardisoSolver().libmkl["MKL_Set_Num_Threads_Local"]
+    except (AttributeError, KeyError, OSError):
+        return None
+    fn.argtypes = [ctypes.c_int]
+    fn.restype = ctypes.c_int
+    return fn
+
+
+#: below this many unknowns PARDISO runs on one thread: measured on hex8 block and plate tangents (2 cores,
+#: benchmarks/newton_iteration.py with MKL_NUM_THREADS=1 and 2), two threads factorise 5-40 % slower and
+#: substitute 2-10 times slower up to about 1e4 unknowns and factorise faster from 1.5e4 on (docs/performance.md)
+PARDISO_SERIAL_BELOW = 12_000
+
+
 def _upper_structure(K: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """CSR structure (ia, ja int32) of the upper triangle of K with every diagonal entry present,
     and for each entry its position in K.data (K.nnz for a structural zero on the diagonal)."""
@@ -137,11 +158,17 @@ class PardisoSolver(LinearSolver):
             return ctypes.byref(c(v))
 
         i32p = ctypes.POINTER(ctypes.c_int32)
-        self._fn(self.pt.ctypes.data, ref(1), ref(1), ref(self.mtype), ref(phase), ref(self._n),
-                 self._a.ctypes.data, self._ia.ctypes.data_as(i32p), self._ja.ctypes.data_as(i32p),
-                 None, ref(nrhs), self.iparm.ctypes.data_as(i32p), ref(0),
-                 (dummy if b is None else b).ctypes.data, (dummy if x is None else x).ctypes.data,
-                 ctypes.byref(err))
+        local = _mkl_local_threads() if 0 < self._n < PARDISO_SERIAL_BELOW else None
+        previous = local(1) if local is not None else None
+        try:
+            self._fn(self.pt.ctypes.data, ref(1), ref(1), ref(self.mtype), ref(phase), ref(self._n),
+                     self._a.ctypes.data, self._ia.ctypes.data_as(i32p), self._ja.ctypes.data_as(i32p),
+                     None, ref(nrhs), self.iparm.ctypes.data_as(i32p), ref(0),
+                     (dummy if b is None else b).ctypes.data, (dummy if x is None else x).ctypes.data,
+                     ctypes.byref(err))
+        finally:
+            if local is not None:
+                local(previous)
         return err.value
 
     def _values(self, K: sp.csr_matrix) -> np.ndarray:
