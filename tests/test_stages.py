@@ -195,70 +195,6 @@ motions = { clamp = { translation = [0.0, 0.3, 0.0], rotation = [0.0, 0.0, -0.2]
     np.testing.assert_allclose(x[end], expected, atol=1e-12)
 
 
-def test_rigid_body_motion_continues_and_pair_switches_off(tmp_path):
-    """A plane presses a block, then lifts beyond it (stage 2), or the pair is switched off (stage 2')."""
-    base = """
-[problem]
-name = "press"
-[[bodies]]
-name = "block"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2 }
-[[rigid]]
-name = "plate"
-shape = "plane"
-point = [0.0, 0.0, 1.0]
-normal = [0.0, 0.0, -1.0]
-motion = { translation = [0.0, 0.0, -0.02] }
-[[contact]]
-name = "touch"
-slave = "block.zmax"
-master = "plate"
-penalty = 1.0e6
-[[dirichlet]]
-set = "block.zmin"
-components = "z"
-[[dirichlet]]
-set = "block.xmin"
-components = "x"
-[[dirichlet]]
-set = "block.ymin"
-components = "y"
-[steps]
-count = 2
-"""
-    lift = base + """
-[[stages]]
-name = "lift"
-steps = { count = 2 }
-motions = { plate = { translation = [0.0, 0.0, 0.05] } }
-"""
-    off = base + """
-[[stages]]
-name = "off"
-steps = { count = 1 }
-contacts = { touch = false }
-"""
-    for name, text in (("lift", lift), ("off", off)):
-        path = tmp_path / f"{name}.toml"
-        path.write_text(text)
-        res = load_problem(path).run(out=tmp_path / name)
-        assert res.exit_code == 0, name
-        steps = res.summary["steps"]
-        assert steps[1]["reactions"]["block.zmin"][2] > 10.0  # pressed: about E * 0.02 * area = 20
-        assert steps[-1]["active_contacts"] == 0
-        if name == "lift":  # the plate 0.03 above the block's (unloaded) top
-            assert steps[-1]["min_gap"] == pytest.approx(0.03, rel=1e-9)
-        assert abs(steps[-1]["reactions"]["block.zmin"][2]) < 1e-9
-        x, X = _final_points(tmp_path / name)
-        np.testing.assert_allclose(x[:27], X[:27], atol=1e-9)  # the block (27 nodes) is unloaded
-    # where the plate went: stage 1 moved it by -0.02, stage 2 by +0.05 from there
-    m = meshio.read(sorted((tmp_path / "lift").glob("step_*.vtu"))[-1])
-    plate = m.point_data["displacement"][27:]  # after the block's 27 nodes: the drawn plane
-    assert len(plate) > 0
-    np.testing.assert_allclose(plate, np.tile([0.0, 0.0, 0.03], (len(plate), 1)), atol=1e-14)
-
-
 PRESS = """
 [problem]
 name = "press"
@@ -291,6 +227,41 @@ rtol = 1.0e-12
 [steps]
 count = 2
 """
+
+
+def test_rigid_body_motion_continues_and_pair_switches_off(tmp_path):
+    """A plane presses a block, then lifts beyond it (stage 2), or the pair is switched off (stage 2')."""
+    base = PRESS.replace("PLATE", "motion = { translation = [0.0, 0.0, -0.02] }")
+    lift = base + """
+[[stages]]
+name = "lift"
+steps = { count = 2 }
+motions = { plate = { translation = [0.0, 0.0, 0.05] } }
+"""
+    off = base + """
+[[stages]]
+name = "off"
+steps = { count = 1 }
+contacts = { touch = false }
+"""
+    for name, text in (("lift", lift), ("off", off)):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text)
+        res = load_problem(path).run(out=tmp_path / name)
+        assert res.exit_code == 0, name
+        steps = res.summary["steps"]
+        assert steps[1]["reactions"]["block.zmin"][2] > 10.0  # pressed: about E * 0.02 * area = 20
+        assert steps[-1]["active_contacts"] == 0
+        if name == "lift":  # the plate 0.03 above the block's (unloaded) top
+            assert steps[-1]["min_gap"] == pytest.approx(0.03, rel=1e-9)
+        assert abs(steps[-1]["reactions"]["block.zmin"][2]) < 1e-9
+        x, X = _final_points(tmp_path / name)
+        np.testing.assert_allclose(x[:27], X[:27], atol=1e-9)  # the block (27 nodes) is unloaded
+    # where the plate went: stage 1 moved it by -0.02, stage 2 by +0.05 from there
+    m = meshio.read(sorted((tmp_path / "lift").glob("step_*.vtu"))[-1])
+    plate = m.point_data["displacement"][27:]  # after the block's 27 nodes: the drawn plane
+    assert len(plate) > 0
+    np.testing.assert_allclose(plate, np.tile([0.0, 0.0, 0.03], (len(plate), 1)), atol=1e-14)
 
 
 def test_released_pair_ramps_its_force_to_zero(tmp_path):
