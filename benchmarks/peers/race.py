@@ -79,45 +79,18 @@ def thread_env(threads: int) -> dict:
 
 
 def two_blocks_toml(size: str, penalty: float) -> str:
-    """The problem file of one two_blocks size (benchmarks/problems/two_blocks_5k.toml with other counts)."""
+    """The problem file of one two_blocks size: benchmarks/problems/two_blocks_5k.toml with other element counts
+    and penalty (same material, supports, 10 steps, no VTU)."""
     bn, bz, pn, pz = TWO_BLOCKS[size]
-    return f"""# two_blocks race problem, size {size} (written by benchmarks/peers/race.py)
-[problem]
-name = "two-blocks-{size}"
-
-[[bodies]]
-name = "base"
-element = "hex8"
-material = {{ model = "svk", E = 1000.0, nu = 0.3 }}
-mesh = {{ generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = {bn}, ny = {bn}, nz = {bz}, origin = [-1.0, -1.0, -0.5] }}
-
-[[bodies]]
-name = "punch"
-element = "hex8"
-material = {{ model = "svk", E = 1000.0, nu = 0.3 }}
-mesh = {{ generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = {pn}, ny = {pn}, nz = {pz}, origin = [-0.5, -0.5, 0.0] }}
-
-[[contact]]
-slave = "punch.zmin"
-master = "base.zmax"
-penalty = {penalty!r}
-weighting = "area"
-
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.0, 0.0, -0.05]
-
-[steps]
-count = {STEPS}
-
-[output]
-vtu = false
-"""
+    text = (ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml").read_text()
+    for old, new in (('name = "two-blocks-5k"', f'name = "two-blocks-{size}"'),
+                     ("nx = 10, ny = 10, nz = 5", f"nx = {bn}, ny = {bn}, nz = {bz}"),
+                     ("nx = 11, ny = 11, nz = 5", f"nx = {pn}, ny = {pn}, nz = {pz}"),
+                     ("penalty = 1.0e6", f"penalty = {penalty!r}"), ("count = 10", f"count = {STEPS}")):
+        if old not in text:
+            raise RuntimeError(f"two_blocks_5k.toml changed: {old!r} not found")
+        text = text.replace(old, new, 1)
+    return f"# two_blocks race problem, size {size} (written by benchmarks/peers/race.py)\n" + text
 
 
 # -- preparing one race cell ------------------------------------------------------------------------------
