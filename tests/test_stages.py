@@ -443,3 +443,38 @@ motion = { translation = [0.1, 0.0, 0.0] }
 """)
     with pytest.raises(InputError, match="either 'value' or 'motion'"):
         load_problem(path)
+
+
+@pytest.mark.parametrize("stop_at", [3, 5])
+def test_resume_inside_a_pair_release_is_exact(tmp_path, monkeypatch, stop_at):
+    """A run stopped at the first or third step of a stage that releases a contact pair (the released
+    contact forces are part of the committed state) resumes to the end of the run never stopped."""
+    path = tmp_path / "rel.toml"
+    path.write_text(PRESS.replace("PLATE", 'motion = { translation = [0.0, 0.0, -0.001] }') + """
+[[stages]]
+name = "unload"
+steps = { count = 4 }
+release = ["touch"]
+""")
+    problem = load_problem(path)
+    ref = problem.run(out=tmp_path / "ref")
+    advance = run_module.Newton.advance
+    calls = {"n": 0}
+
+    def stopping(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == stop_at:
+            raise Interrupted(15)
+        return advance(self, *args, **kwargs)
+
+    monkeypatch.setattr(run_module.Newton, "advance", stopping)
+    assert problem.run(out=tmp_path / "cut").exit_code == 143
+    monkeypatch.setattr(run_module.Newton, "advance", advance)
+    resumed = problem.run(out=tmp_path / "cut", resume=True)
+    assert resumed.exit_code == 0
+    np.testing.assert_allclose(resumed.u, ref.u, rtol=1e-10, atol=1e-14)
+    a = json.loads((tmp_path / "ref" / "summary.json").read_text())
+    b = json.loads((tmp_path / "cut" / "summary.json").read_text())
+    assert [s["iterations"] for s in a["steps"]] == [s["iterations"] for s in b["steps"]]
+    assert [s["reactions"]["block.zmin"][2] for s in a["steps"]] == pytest.approx(
+        [s["reactions"]["block.zmin"][2] for s in b["steps"]], rel=1e-9, abs=1e-12)
