@@ -40,10 +40,6 @@ from ..assembly.system import InvertedElementError
 from .linear import LinearSolverError, SingularMatrixError, make_solver
 
 
-#: halvings of a line-search step whose trial point inverts an element (1/256 at most) before the step fails
-_INVERSION_HALVINGS = 8
-
-
 def gmres_right(A, b: np.ndarray, prec, tol: float, m: int):
     """One cycle of GMRES(m) on A x = b from x = 0 with right preconditioning x = prec(y): the Arnoldi basis
     by classical Gram-Schmidt with one reorthogonalisation, Givens rotations for the least-squares problem.
@@ -131,7 +127,7 @@ class Newton:
         self.linear.set_near_null_space(model.near_null_space())  # rigid-body modes (AMG only)
         self.scale_seen = 0.0  # the largest force scale of the converged steps so far
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}
-        self.stats = {"factorizations": 0, "krylov_solves": 0, "krylov_iterations": 0, "inversion_halvings": 0}
+        self.stats = {"factorizations": 0, "krylov_solves": 0, "krylov_iterations": 0}
         self._stalled = False  # the last inexact correction did not reduce the residual enough
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
 
@@ -175,35 +171,19 @@ class Newton:
         return du
 
     def _line_search(self, u, du, lam, R0, committed, trial):
-        """Step length eta in (0, 1] along du: a secant search on du . R(u + eta du) = 0. A trial point that
-        inverts an element halves the step (up to ``_INVERSION_HALVINGS`` times) instead of failing the step;
-        the largest admissible eta bounds the search."""
         s0 = float(du @ R0)
-        eta_max = 1.0
-        for k in range(_INVERSION_HALVINGS + 1):
-            try:
-                R1, _, _ = self._evaluate(u + eta_max * du, lam, committed, trial, want_K=False)
-                break
-            except InvertedElementError:
-                if k == _INVERSION_HALVINGS:
-                    raise
-                eta_max *= 0.5
-        self.stats["inversion_halvings"] += k
+        R1, _, _ = self._evaluate(u + du, lam, committed, trial, want_K=False)
         s1 = float(du @ R1)
         if s0 == 0.0 or abs(s1) <= 0.8 * abs(s0):
-            return eta_max
-        lo = min(0.1, eta_max)
-        a0, a1, f0, f1 = 0.0, eta_max, s0, s1
-        eta = eta_max
+            return 1.0
+        a0, a1, f0, f1 = 0.0, 1.0, s0, s1
+        eta = 1.0
         for _ in range(6):
             if f1 == f0:
                 break
             eta = a1 - f1 * (a1 - a0) / (f1 - f0)
-            eta = float(np.clip(eta, lo, eta_max))
-            try:
-                Rt, _, _ = self._evaluate(u + eta * du, lam, committed, trial, want_K=False)
-            except InvertedElementError:
-                return a1  # the last admissible point evaluated
+            eta = float(np.clip(eta, 0.1, 1.0))
+            Rt, _, _ = self._evaluate(u + eta * du, lam, committed, trial, want_K=False)
             ft = float(du @ Rt)
             if abs(ft) <= 0.8 * abs(s0):
                 break
