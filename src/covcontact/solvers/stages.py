@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..motion import RigidMotion, StagedMotion
+from ..motion import StagedMotion
 
 
 @dataclass
