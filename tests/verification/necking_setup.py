@@ -4,43 +4,26 @@ tests/verification/test_necking.py and benchmarks/necking.py."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import brentq
 
-from covcontact.io.loader import problem_from_dict
+# the bar itself is the stand-alone example's (geometry, material, mesh, supports): one definition for the
+# example, this test set-up and benchmarks/necking.py
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples" / "plasticity"))
+from necking_bar import DELTA, HALF_LENGTH, IMPERFECTION, NU, RADIUS, SIGMA_0, SIGMA_INF, E, H, build
 
-#: geometry (mm) and material (MPa) as published: length 53.334, radius 6.413, radius 0.982 R in the middle
-RADIUS, HALF_LENGTH, IMPERFECTION = 6.413, 53.334 / 2.0, 0.982
-E, NU, SIGMA_0, SIGMA_INF, DELTA, H = 206900.0, 0.29, 450.0, 715.0, 16.93, 129.24
+__all__ = ["HALF_LENGTH", "IMPERFECTION", "NU", "RADIUS", "E", "considere_peak", "necking_problem", "results"]
 
 
 def necking_problem(n: int, nz: int, steps: int, half_elongation: float = 7.0):
     """The eighth of the bar (x, y >= 0, 0 <= z <= L/2; symmetry on x = 0, y = 0, z = 0) with n x n elements
     over the quarter cross-section (a square mapped onto the quarter disc) and nz along the half length,
     twice as fine at the neck (z = 0) as at the pulled end; the end moves by ``half_elongation`` along z
-    (free in x and y). The radius grows linearly from 0.982 R in the middle to R at the end."""
-    raw = {"problem": {"name": "necking-bar", "units": "mm, N, MPa"},
-           "bodies": [{"name": "bar", "formulation": "fbar",
-                       "material": {"model": "j2", "E": E, "nu": NU, "yield_stress": SIGMA_0,
-                                    "hardening": {"law": "voce", "sigma_inf": SIGMA_INF, "delta": DELTA,
-                                                  "modulus": H}},
-                       "mesh": {"generator": "block", "lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": n, "ny": n,
-                                "nz": nz}}],
-           "dirichlet": [{"set": "bar.xmin", "components": "x"}, {"set": "bar.ymin", "components": "y"},
-                         {"set": "bar.zmin", "components": "z"},
-                         {"name": "pull", "set": "bar.zmax", "components": "z", "value": half_elongation}],
-           "steps": {"count": steps}, "solver": {"line_search": True}, "output": {"vtu": False}}
-    problem = problem_from_dict(raw, Path("necking_bar.toml"))
-    X = problem.bodies[0].mesh.points
-    x, y, s = X[:, 0].copy(), X[:, 1].copy(), X[:, 2].copy()
-    z = HALF_LENGTH * s * (0.5 + 0.5 * s)
-    r = RADIUS * (IMPERFECTION + (1.0 - IMPERFECTION) * z / HALF_LENGTH)
-    X[:, 0] = r * x * np.sqrt(1.0 - 0.5 * y * y)  # the square onto the quarter disc, x = 0 and y = 0 kept
-    X[:, 1] = r * y * np.sqrt(1.0 - 0.5 * x * x)
-    X[:, 2] = z
-    return problem
+    (free in x and y). The radius grows linearly from 0.982 R in the middle to R at the end. No VTU output."""
+    return build(n, nz, steps, half_elongation, vtu=False)
 
 
 def results(problem, res) -> dict:
