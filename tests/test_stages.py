@@ -228,6 +228,14 @@ rtol = 1.0e-12
 count = 2
 """
 
+#: the block pressed by a plane moved 0.001 down, then its pair released over four steps
+PRESS_RELEASE = PRESS.replace("PLATE", 'motion = { translation = [0.0, 0.0, -0.001] }') + """
+[[stages]]
+name = "unload"
+steps = { count = 4 }
+release = ["touch"]
+"""
+
 
 def test_rigid_body_motion_continues_and_pair_switches_off(tmp_path):
     """A plane presses a block, then lifts beyond it (stage 2), or the pair is switched off (stage 2')."""
@@ -267,14 +275,8 @@ contacts = { touch = false }
 def test_released_pair_ramps_its_force_to_zero(tmp_path):
     """release = ["touch"]: the pair is off from the start of the stage and the force it carried is applied
     as a load ramped to zero, so the block unloads gradually (against an abrupt switch-off)."""
-    text = PRESS.replace("PLATE", 'motion = { translation = [0.0, 0.0, -0.001] }') + """
-[[stages]]
-name = "unload"
-steps = { count = 4 }
-release = ["touch"]
-"""
     path = tmp_path / "rel.toml"
-    path.write_text(text)
+    path.write_text(PRESS_RELEASE)
     res = load_problem(path).run(out=tmp_path / "rel")
     assert res.exit_code == 0
     steps = res.summary["steps"]
@@ -372,12 +374,9 @@ remove = ["push", "p"]
     np.testing.assert_allclose(steps[2]["reactions"]["bar.xmin"], 0.0, atol=1e-9)
 
 
-@pytest.mark.parametrize("stop_at", [5, 6])
-def test_resume_across_stages_is_exact(tmp_path, monkeypatch, stop_at):
-    """Stopped at the first step of the release stage (checkpoint: the end of the pull stage) or at its
-    second (checkpoint inside the stage, with the released reactions in the state): resumed, the run
-    ends exactly where the run that was never stopped ends."""
-    problem = _problem(tmp_path, RELEASE)
+def _stop_and_resume(problem, tmp_path: Path, monkeypatch, stop_at: int):
+    """Run ``problem`` once to the end ("ref"), once stopped by a signal at the ``stop_at``-th load step
+    ("cut"), then resume "cut"; returns (ref, stopped, resumed, ref summary, resumed summary)."""
     ref = problem.run(out=tmp_path / "ref")
     advance = run_module.Newton.advance
     calls = {"n": 0}
@@ -390,15 +389,24 @@ def test_resume_across_stages_is_exact(tmp_path, monkeypatch, stop_at):
 
     monkeypatch.setattr(run_module.Newton, "advance", stopping)
     stopped = problem.run(out=tmp_path / "cut")
-    assert stopped.exit_code == 143 and stopped.summary["status"] == "interrupted"
     monkeypatch.setattr(run_module.Newton, "advance", advance)
     resumed = problem.run(out=tmp_path / "cut", resume=True)
+    a = json.loads((tmp_path / "ref" / "summary.json").read_text())
+    b = json.loads((tmp_path / "cut" / "summary.json").read_text())
+    return ref, stopped, resumed, a, b
+
+
+@pytest.mark.parametrize("stop_at", [5, 6])
+def test_resume_across_stages_is_exact(tmp_path, monkeypatch, stop_at):
+    """Stopped at the first step of the release stage (checkpoint: the end of the pull stage) or at its
+    second (checkpoint inside the stage, with the released reactions in the state): resumed, the run
+    ends exactly where the run that was never stopped ends."""
+    ref, stopped, resumed, a, b = _stop_and_resume(_problem(tmp_path, RELEASE), tmp_path, monkeypatch, stop_at)
+    assert stopped.exit_code == 143 and stopped.summary["status"] == "interrupted"
     assert resumed.exit_code == 0
     # the same steps from the same committed state; the direct solver's fresh analysis after the restart
     # may order its pivots differently, hence round-off, not bitwise equality
     np.testing.assert_allclose(resumed.u, ref.u, rtol=1e-10, atol=1e-14)
-    a = json.loads((tmp_path / "ref" / "summary.json").read_text())
-    b = json.loads((tmp_path / "cut" / "summary.json").read_text())
     assert [s["iterations"] for s in a["steps"]] == [s["iterations"] for s in b["steps"]]
     assert [s["stage"] for s in a["steps"]] == [s["stage"] for s in b["steps"]]
     assert a["stages"] == b["stages"]
@@ -450,31 +458,11 @@ def test_resume_inside_a_pair_release_is_exact(tmp_path, monkeypatch, stop_at):
     """A run stopped at the first or third step of a stage that releases a contact pair (the released
     contact forces are part of the committed state) resumes to the end of the run never stopped."""
     path = tmp_path / "rel.toml"
-    path.write_text(PRESS.replace("PLATE", 'motion = { translation = [0.0, 0.0, -0.001] }') + """
-[[stages]]
-name = "unload"
-steps = { count = 4 }
-release = ["touch"]
-""")
-    problem = load_problem(path)
-    ref = problem.run(out=tmp_path / "ref")
-    advance = run_module.Newton.advance
-    calls = {"n": 0}
-
-    def stopping(self, *args, **kwargs):
-        calls["n"] += 1
-        if calls["n"] == stop_at:
-            raise Interrupted(15)
-        return advance(self, *args, **kwargs)
-
-    monkeypatch.setattr(run_module.Newton, "advance", stopping)
-    assert problem.run(out=tmp_path / "cut").exit_code == 143
-    monkeypatch.setattr(run_module.Newton, "advance", advance)
-    resumed = problem.run(out=tmp_path / "cut", resume=True)
+    path.write_text(PRESS_RELEASE)
+    ref, stopped, resumed, a, b = _stop_and_resume(load_problem(path), tmp_path, monkeypatch, stop_at)
+    assert stopped.exit_code == 143
     assert resumed.exit_code == 0
     np.testing.assert_allclose(resumed.u, ref.u, rtol=1e-10, atol=1e-14)
-    a = json.loads((tmp_path / "ref" / "summary.json").read_text())
-    b = json.loads((tmp_path / "cut" / "summary.json").read_text())
     assert [s["iterations"] for s in a["steps"]] == [s["iterations"] for s in b["steps"]]
     assert [s["reactions"]["block.zmin"][2] for s in a["steps"]] == pytest.approx(
         [s["reactions"]["block.zmin"][2] for s in b["steps"]], rel=1e-9, abs=1e-12)
