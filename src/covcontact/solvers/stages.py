@@ -173,8 +173,7 @@ class StagePlan:
             new_contacts.update({n: False for n in pairs_released})
             rel = np.unique(np.concatenate(released)) if released else np.zeros(0, np.int64)
             spec = self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
-                              new_motions, new_contacts, tuple(st.release), st.motions)
-            spec.released_pairs = pairs_released
+                              new_motions, new_contacts, tuple(st.release), st.motions, pairs_released)
             for name, (f0, f1, m0, m1) in prev.rigid_loads.items():
                 f, m = f0 + lam_end * (f1 - f0), m0 + lam_end * (m1 - m0)
                 if name in st.remove:
@@ -192,7 +191,7 @@ class StagePlan:
         self.n_dofs = n_dofs
 
     def _spec(self, index, name, factors, conds, released, loads, start, target, motions, contacts, names,
-              moved=None):
+              moved=None, released_pairs=()):
         sysm = self.system
         f0 = np.zeros(sysm.n_dofs)
         f1 = np.zeros(sysm.n_dofs)
@@ -224,7 +223,8 @@ class StagePlan:
         constrained[parked] = True
         released = released[~constrained[released]] if released.size else released
         return StageSpec(index, name, tuple(factors), conds, released, f0, f1, motions, contacts, names,
-                         constrained, parked=parked, parked_names=tuple(parked_names), parked_moves=parked_moves)
+                         constrained, parked=parked, parked_names=tuple(parked_names), parked_moves=parked_moves,
+                         released_pairs=tuple(released_pairs))
 
     def __len__(self) -> int:
         return len(self.stages)
