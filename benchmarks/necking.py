@@ -28,13 +28,20 @@ import numpy as np
 from _report import emit
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "verification"))
-from necking_setup import IMPERFECTION, NU, RADIUS, E, considere_peak, necking_problem, results
+from necking_setup import (
+    IMPERFECTION,
+    NU,
+    RADIUS,
+    VM318_NECK_RATIO,
+    VM318_U,
+    E,
+    considere_peak,
+    necking_problem,
+    results,
+)
 
 from covcontact.fem.quadrature import gauss_hex
 from covcontact.fem.shapes import shape_functions
-
-VM318_U = -3.740                                               # mm, radial, neck surface node, 7 mm per end
-VM318_NECK_RATIO = (IMPERFECTION * RADIUS + VM318_U) / RADIUS  # 0.3988
 
 
 def _jacobians(cells: np.ndarray, points: np.ndarray, at: np.ndarray) -> np.ndarray:

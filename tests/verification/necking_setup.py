@@ -15,7 +15,13 @@ from scipy.optimize import brentq
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples" / "plasticity"))
 from necking_bar import DELTA, HALF_LENGTH, IMPERFECTION, NU, RADIUS, SIGMA_0, SIGMA_INF, E, H, build
 
-__all__ = ["HALF_LENGTH", "IMPERFECTION", "NU", "RADIUS", "E", "considere_peak", "necking_problem", "results"]
+__all__ = ["HALF_LENGTH", "IMPERFECTION", "NU", "RADIUS", "VM318_NECK_RATIO", "VM318_U", "E", "considere_peak",
+           "necking_problem", "results"]
+
+#: the published neck: ANSYS Verification Manual VM318 (after Simo 1992, CMAME 99, 61-112), radial displacement
+#: of the neck surface node (initial radius 0.982 x 6.413) at 7 mm per end, and the radius ratio it gives (0.3988)
+VM318_U = -3.740
+VM318_NECK_RATIO = (IMPERFECTION * RADIUS + VM318_U) / RADIUS
 
 
 def necking_problem(n: int, nz: int, steps: int, half_elongation: float = 7.0):

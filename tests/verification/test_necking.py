@@ -14,12 +14,19 @@ from __future__ import annotations
 
 import meshio
 import numpy as np
-from necking_setup import HALF_LENGTH, IMPERFECTION, NU, RADIUS, E, considere_peak, necking_problem, results
+from necking_setup import (
+    HALF_LENGTH,
+    IMPERFECTION,
+    NU,
+    RADIUS,
+    VM318_NECK_RATIO,
+    E,
+    considere_peak,
+    necking_problem,
+    results,
+)
 
 from covcontact.fem.shapes import shape_functions
-
-#: VM318 target u_x = -3.740 mm of the neck surface node (initial radius 0.982 x 6.413) at 7 mm per end
-VM318_NECK_RATIO = (IMPERFECTION * RADIUS - 3.740) / RADIUS   # 0.3988
 
 
 def _centroid_jacobians(cells: np.ndarray, points: np.ndarray) -> np.ndarray:
