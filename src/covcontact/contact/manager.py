@@ -114,11 +114,13 @@ class ContactManager:
 
     # -- evaluation -------------------------------------------------------------------------------
     def evaluate(self, x: np.ndarray, lam: float, committed: ContactState, guess: ContactState | None = None,
-                 want_K: bool = True, case: int | None = None, want_parts: bool = False):
+                 want_K: bool = True, case: int | None = None, want_parts: bool = False,
+                 pairs: tuple[str, ...] | None = None):
         """Element blocks and the trial state at deformable positions x (N, 3) and load factor lam.
 
         ``case`` overrides every pass's tangent case; ``want_parts`` also returns the four parts (of the
-        frictionless element, for the contribution norms).
+        frictionless element, for the contribution norms); ``pairs`` limits the evaluation to the named pairs
+        (of those switched on).
         """
         guess = committed if guess is None else guess
         if self.reference:
@@ -130,7 +132,7 @@ class ContactManager:
         for k, p in enumerate(self.passes):
             c, g0 = committed.passes[k], guess.passes[k]
             t = PassState.empty(p.ns)
-            if not self.enabled[k]:
+            if not self.enabled[k] or (pairs is not None and p.pair not in pairs):
                 trial.passes.append(t)
                 continue
             t.multiplier = g0.multiplier.copy()

@@ -75,14 +75,8 @@ class Model:
     def _pair_residual(self, u: np.ndarray, committed: State, names: tuple[str, ...]) -> np.ndarray:
         """The contact residual of the named pairs alone at ``u`` (the current stage's motions), on the
         system's dofs."""
-        enabled = list(self.contact.enabled)
-        try:
-            self.contact.enabled = [e and p.pair in names for e, p in zip(enabled, self.contact.passes)]
-            self.contact.begin_step()
-            ev, _ = self.contact.evaluate(self.positions(u), committed.lam, committed.contact, None, False)
-        finally:
-            self.contact.enabled = enabled
-            self.contact.begin_step()
+        ev, _ = self.contact.evaluate(self.positions(u), committed.lam, committed.contact, None, False,
+                                      pairs=names)
         return ev.blocks.residual()
 
     # delegation -------------------------------------------------------------------------------
