@@ -10,7 +10,12 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import ctypes.util
+import glob
+import os
 import platform
+import site
+import sys
 import warnings
 from functools import lru_cache
 from typing import Any
@@ -44,12 +49,35 @@ _PARDISO_ERRORS = {
 
 
 @lru_cache(maxsize=1)
-def _pardiso_function():
-    """The ``pardiso`` entry point of the MKL runtime located by pypardiso."""
-    import pypardiso
+def _mkl_runtime() -> ctypes.CDLL:
+    """MKL's single dynamic library (mkl_rt), loaded once.
 
-    lib = pypardiso.PyPardisoSolver().libmkl
-    fn = lib["pardiso"]  # a fresh function pointer: our own argtypes
+    Looked for where the ``mkl`` package that ``pypardiso`` depends on puts it (``lib`` under the environment's
+    prefix or the user base), then by the system's library search; ``PYPARDISO_MKL_RT`` names it explicitly.
+    pypardiso's own look-up (a recursive walk of the environment, about 0.2 s each time) is the last resort:
+    a run's start-up is part of its wall time.
+    """
+    explicit = os.environ.get("PYPARDISO_MKL_RT")
+    candidates = [explicit] if explicit else []
+    for base in (sys.prefix, site.USER_BASE):
+        for lib in ("lib", "lib64", "Lib", "Library/bin"):
+            candidates += sorted(glob.glob(os.path.join(base, lib, "*mkl_rt*")), key=len)
+    for path in candidates:
+        with contextlib.suppress(OSError):
+            return ctypes.CDLL(path)
+    found = ctypes.util.find_library("mkl_rt")  # runs ldconfig: only when the environment has none
+    if found:
+        with contextlib.suppress(OSError):
+            return ctypes.CDLL(found)
+    import pypardiso  # its recursive search of the environment
+
+    return pypardiso.PyPardisoSolver().libmkl
+
+
+@lru_cache(maxsize=1)
+def _pardiso_function():
+    """The ``pardiso`` entry point of the MKL runtime."""
+    fn = _mkl_runtime()["pardiso"]  # a fresh function pointer: our own argtypes
     i32p = ctypes.POINTER(ctypes.c_int32)
     fn.argtypes = [ctypes.c_void_p] + [i32p] * 5 + [ctypes.c_void_p] + [i32p] * 6 + [ctypes.c_void_p] * 2 + [i32p]
     fn.restype = None
@@ -60,10 +88,8 @@ def _pardiso_function():
 def _mkl_local_threads():
     """MKL's ``mkl_set_num_threads_local`` (None if the runtime lacks it): sets the calling thread's MKL thread
     count and returns the previous setting (0: the global one)."""
-    import pypardiso
-
     try:
-        fn = pypardiso.PyPardisoSolver().libmkl["MKL_Set_Num_Threads_Local"]
+        fn = _mkl_runtime()["MKL_Set_Num_Threads_Local"]
     except (AttributeError, KeyError, OSError):
         return None
     fn.argtypes = [ctypes.c_int]
@@ -112,10 +138,14 @@ class PardisoSolver(LinearSolver):
     def probe() -> tuple[bool, str, str]:
         if platform.machine().lower() not in ("x86_64", "amd64"):
             return False, "", "MKL PARDISO needs x86-64"
-        import pypardiso
+        from importlib.metadata import PackageNotFoundError, version
 
+        try:
+            ver = version("pypardiso")
+        except PackageNotFoundError as exc:  # MKL alone is not enough: pypardiso is the declared route to it
+            raise ImportError("pypardiso is not installed") from exc
         _pardiso_function()
-        return True, getattr(pypardiso, "__version__", ""), "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
+        return True, ver, "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
 
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, spd: bool = False,
                  matching: bool = False):
