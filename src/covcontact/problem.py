@@ -192,7 +192,7 @@ class SolverOptions:
     divergence_factor: float = 1e4
     #: inexact Newton: corrections by GMRES preconditioned with the last factorisation, refactorising only
     #: when GMRES needs more than ``krylov_max`` iterations or the outer convergence stalls (direct solvers)
-    reuse_factorization: bool = False
+    reuse_factorization: bool = True
     krylov_max: int = 30
     #: first iterate of a step: "tangent" (the tangent at the converged state with the prescribed increment)
     #: or "extrapolate" (the previous step's increment scaled to this one, then Newton)

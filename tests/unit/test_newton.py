@@ -96,7 +96,9 @@ def test_extrapolating_predictor_same_answer_fewer_iterations(tmp_path):
     assert b.summary["total_iterations"] < 0.7 * a.summary["total_iterations"]
     assert np.allclose(a.u, b.u, atol=1e-8 * np.abs(a.u).max())
     for sa, sb in zip(a.summary["steps"], b.summary["steps"], strict=True):
-        np.testing.assert_allclose(sb["contact_force"], sa["contact_force"], rtol=1e-6, atol=1e-9)
+        # components that vanish by symmetry are compared at the solver's tolerance of the force's size
+        scale = float(np.linalg.norm(sa["contact_force"]))
+        np.testing.assert_allclose(sb["contact_force"], sa["contact_force"], rtol=1e-6, atol=1e-8 * scale)
 
 
 class _NoisyLinearModel:

@@ -162,6 +162,7 @@ class System:
         """The dofs whose values are prescribed (a stage may free some)."""
         self.constrained = np.asarray(constrained, dtype=bool).copy()
         self.free = ~self.constrained
+        self._eliminate_cache = None  # (indices, indptr, entries to zero, diagonal entries) of the last pattern
 
     # -- evaluation -----------------------------------------------------------------------------
     def new_state(self) -> list[dict[str, np.ndarray]]:
@@ -201,10 +202,16 @@ class System:
         if not self.constrained.any():
             return K
         K = K.tocsr()
-        rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-        mask = self.constrained[rows] | self.constrained[K.indices]
-        K.data[mask] = 0.0
-        diag = rows[mask] == K.indices[mask]
-        idx = np.flatnonzero(mask)[diag]
-        K.data[idx] = 1.0
+        cached = self._eliminate_cache
+        if cached is not None and cached[0] is K.indices and cached[1] is K.indptr:
+            zero, one = cached[2], cached[3]
+        else:  # once per pattern (the bodies' pattern, or a contact pattern) and set of constraints
+            rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+            mask = self.constrained[rows] | self.constrained[K.indices]
+            zero = np.flatnonzero(mask)
+            one = zero[rows[zero] == K.indices[zero]]
+            # the arrays are held, so their identities cannot be reused by others while cached
+            self._eliminate_cache = (K.indices, K.indptr, zero, one)
+        K.data[zero] = 0.0
+        K.data[one] = 1.0
         return K

@@ -129,6 +129,7 @@ class Newton:
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}
         self.stats = {"factorizations": 0, "krylov_solves": 0, "krylov_iterations": 0}
         self._stalled = False  # the last inexact correction did not reduce the residual enough
+        self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
 
     # ------------------------------------------------------------------------------------------
@@ -151,10 +152,12 @@ class Newton:
 
     def _solve(self, K, rhs, eta: float | None = None):
         if (eta is not None and self.opt.reuse_factorization and self.linear.direct and not self._stalled
+                and not self._failed
                 and getattr(self.linear, "_K", None) is not None and self.linear._K.shape == K.shape):
             du = self._krylov(K, rhs, eta)
             if du is not None:
                 return du
+            self._failed = True
         self._stalled = False
         self.stats["factorizations"] += 1
         t0 = time.perf_counter()
@@ -197,6 +200,7 @@ class Newton:
         m, opt = self.model, self.opt
         out = StepOutcome(converged=False)
         free = m.free
+        self._failed = False
         if trial is None:
             trial = m.start_step(committed)
         else:
@@ -229,7 +233,9 @@ class Newton:
         for it in range(1, opt.max_iterations + 1):
             eta = min(1e-4, 1e-4 * rn_prev / max(r0, 1e-300))
             n_fact, n_kry = self.stats["factorizations"], self.stats["krylov_iterations"]
-            du = self._solve(K, rhs, eta)
+            # the first correction of a step is always made with a new factorisation: a step's iterations then
+            # do not depend on how the run got there (a resumed run has no factorisation to reuse)
+            du = self._solve(K, rhs, eta if it > 1 else None)
             inexact = self.stats["factorizations"] == n_fact
             du[~free] = du_d[~free] if it == 1 else 0.0
             eta = 1.0
