@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
 from _report import emit
-from test_hertz import (
+from hertz_setup import (
     hertz_measures,
     hertz_mesh,
     hertz_problem,

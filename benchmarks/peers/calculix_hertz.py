@@ -47,7 +47,7 @@ sys.path.insert(0, str(HERE))
 
 from ccx_deck import hertz_deck
 from ccx_results import parse_dat, parse_sta, parse_stdout
-from test_hertz import C_HERTZ, D_MAX, E_STAR, NU, E, R, fit_hertz, hertz_measures, hertz_mesh
+from hertz_setup import C_HERTZ, D_MAX, E_STAR, NU, E, R, fit_hertz, hertz_measures, hertz_mesh
 
 from covcontact.contact.surface import tributary_area
 
@@ -78,7 +78,7 @@ def thread_env(threads: int) -> dict:
 # -- covcontact --------------------------------------------------------------------------------------
 def worker(n: int, material: str, steps: int, out: str) -> int:
     """Child process: solve and write the results (VTU per step, summary.json)."""
-    from test_hertz import hertz_problem
+    from hertz_setup import hertz_problem
 
     mesh = hertz_mesh(n=n, nr=n // 2)
     res = hertz_problem(mesh, material, steps=steps, penalty=PENALTY).run(out=Path(out), quiet=True)

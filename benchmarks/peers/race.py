@@ -58,9 +58,9 @@ from _report import emit
 from calculix_hertz import _ccx_version, _covcontact_state, timed
 from ccx_deck import hertz_deck
 from ccx_results import parse_dat, parse_sta, parse_stdout
+from hertz_setup import C_HERTZ, D_MAX, NU, E, hertz_mesh
 from kratos_deck import hertz_case, two_blocks_case, write_case
 from kratos_results import read_results
-from test_hertz import C_HERTZ, D_MAX, NU, E, hertz_mesh
 
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                "CCX_NPROC_EQUATION_SOLVER", "CCX_NPROC_STIFFNESS", "CCX_NPROC_RESULTS", "NUMBER_OF_CPUS")
@@ -145,6 +145,8 @@ class Cell:
         scale = 4.0 if self.problem == "hertz" else 1.0
         return {"converged": bool(s["converged"]), "dofs": s["dofs"], "linear_solver": s["linear_solver"],
                 "iterations": s["total_iterations"], "iterations_per_step": [st["iterations"] for st in s["steps"]],
+                "factorizations": sum(st.get("factorizations", 0) for st in s["steps"]),
+                "krylov_iterations": sum(st.get("krylov_iterations", 0) for st in s["steps"]),
                 "solve_s": s["wall_time_s"], "F": [scale * st["contact_force"][2] for st in s["steps"]]}
 
     # Kratos
@@ -248,7 +250,7 @@ def table(records: list[dict], threads: int) -> str:
 
 def worker_hertz(n: int, penalty: float, out: str) -> int:
     """Child process: the covcontact Hertz run (no VTU, as the peers write no field output here)."""
-    from test_hertz import hertz_problem
+    from hertz_setup import hertz_problem
 
     mesh = hertz_mesh(n=n, nr=n // 2)
     return hertz_problem(mesh, "svk", steps=STEPS, penalty=penalty, vtu=False).run(out=Path(out), quiet=True).exit_code

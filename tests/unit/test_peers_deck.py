@@ -14,7 +14,7 @@ sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
 from ccx_deck import C3D8_FACES, c10_d1, face_numbers, hertz_deck
 from ccx_results import parse_dat, parse_sta, parse_stdout
-from test_hertz import hertz_mesh
+from hertz_setup import hertz_mesh
 
 from covcontact.fem.shapes import NODES
 from covcontact.materials import lame
