@@ -190,9 +190,10 @@ class SolverOptions:
     max_cutbacks: int = 6
     line_search: bool = False
     divergence_factor: float = 1e4
-    #: inexact Newton: corrections by GMRES preconditioned with the last factorisation, refactorising only
-    #: when GMRES needs more than ``krylov_max`` iterations or the outer convergence stalls (direct solvers)
-    reuse_factorization: bool = True
+    #: inexact Newton: a step's later corrections by GMRES preconditioned with the factorisation of its first,
+    #: refactorising when GMRES needs more than ``krylov_max`` iterations or the outer convergence stalls
+    #: (direct solvers); "auto": where the factorisation is expensive enough to pay (PARDISO's flop count)
+    reuse_factorization: bool | str = "auto"
     krylov_max: int = 30
     #: first iterate of a step: "tangent" (the tangent at the converged state with the prescribed increment)
     #: or "extrapolate" (the previous step's increment scaled to this one, then Newton)

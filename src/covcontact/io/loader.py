@@ -204,6 +204,14 @@ def _user_sets(sec: Section | None, mesh) -> None:
         mesh.node_sets[name] = np.unique(ids).astype(np.int64)
 
 
+def _reuse_option(sec: Section, default):
+    """[solver] reuse_factorization: true, false or "auto"."""
+    value = sec.get("reuse_factorization", "any", default)
+    if not (isinstance(value, bool) or value == "auto"):
+        sec.fail(f'must be true, false or "auto", got {value!r}', "reuse_factorization")
+    return value
+
+
 def _split_ref(sec: Section, key: str, value: str) -> tuple[str, str]:
     if "." in value:
         body, name = value.split(".", 1)
@@ -504,7 +512,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             max_cutbacks=s.get("max_cutbacks", "int", solver.max_cutbacks, nonnegative=True),
             line_search=s.get("line_search", "bool", solver.line_search),
             divergence_factor=s.get("divergence_factor", "float", solver.divergence_factor, positive=True),
-            reuse_factorization=s.get("reuse_factorization", "bool", solver.reuse_factorization),
+            reuse_factorization=_reuse_option(s, solver.reuse_factorization),
             krylov_max=s.get("krylov_max", "int", solver.krylov_max, positive=True),
             predictor=s.get("predictor", "str", solver.predictor, choices=("tangent", "extrapolate")),
         )

@@ -97,10 +97,30 @@ def _mkl_local_threads():
     return fn
 
 
+@lru_cache(maxsize=1)
+def _mkl_max_threads() -> int:
+    """The number of threads MKL uses outside covcontact's thread-local settings."""
+    try:
+        fn = _mkl_runtime()["MKL_Get_Max_Threads"]
+    except (AttributeError, KeyError, OSError):
+        return 1
+    fn.argtypes = []
+    fn.restype = ctypes.c_int
+    return int(fn())
+
+
 #: below this many unknowns PARDISO runs on one thread: measured on hex8 block and plate tangents (2 cores,
 #: benchmarks/newton_iteration.py with MKL_NUM_THREADS=1 and 2), two threads factorise 5-40 % slower and
 #: substitute 2-10 times slower up to about 1e4 unknowns and factorise faster from 1.5e4 on (docs/performance.md)
 PARDISO_SERIAL_BELOW = 12_000
+
+#: ``reuse_factorization = "auto"`` reuses a PARDISO factorisation when it needs at least this many times the
+#: floating-point operations of one forward and backward substitution (4 per non-zero of the factor), twice as
+#: many when PARDISO runs on several threads (its factorisation gains from them, its substitution hardly).
+#: Measured on one thread (docs/performance.md, "Factorisation reuse"): reuse saved time on the 5,085-dof Hertz
+#: ball (ratio 112) and cost time on the 1,782- and 3,774-dof plates of the paper study (24 and 39), where
+#: GMRES needs more iterations than a factorisation is worth.
+REUSE_MIN_FLOP_RATIO = 100.0
 
 
 def _upper_structure(K: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -161,6 +181,7 @@ class PardisoSolver(LinearSolver):
         self._pos: np.ndarray | None = None
         self._pad = False
         self.n_perturbed = 0
+        self.flop_ratio = 0.0  # factorisation flops over substitution flops of the last analysis
         self.inertia: tuple[int, int] | None = None
 
     def _set_iparm(self) -> None:
@@ -170,6 +191,7 @@ class PardisoSolver(LinearSolver):
         ip[1] = 2  # METIS nested dissection
         ip[7] = 0  # iterative refinement: automatic (2 steps after perturbed pivots)
         ip[34] = 1  # zero-based indexing
+        ip[17] = ip[18] = -1  # report the factors' non-zeros and the factorisation's Mflop (phase 11)
         if self.mtype == 11:
             ip[9], ip[10], ip[12] = 13, 1, 1  # pivot perturbation 1e-13, scaling, matching
         else:
@@ -223,6 +245,12 @@ class PardisoSolver(LinearSolver):
         if err:
             self._release()
             raise LinearSolverError(f"pardiso analysis failed: {_PARDISO_ERRORS.get(err, err)}")
+        # factorisation Mflop over the flops of one substitution (iparm 18 and 17, reported by phase 11)
+        self.flop_ratio = max(float(self.iparm[18]), 0.0) * 1e6 / (4.0 * max(float(self.iparm[17]), 1.0))
+
+    def reuse_pays(self) -> bool:
+        threaded = self._n >= PARDISO_SERIAL_BELOW and _mkl_max_threads() > 1
+        return self.flop_ratio >= REUSE_MIN_FLOP_RATIO * (2.0 if threaded else 1.0)
 
     def _factor(self, K: sp.csr_matrix) -> None:
         self._a = self._values(K)

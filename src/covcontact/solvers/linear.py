@@ -281,6 +281,12 @@ class LinearSolver:
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name} symmetric={self.symmetric}>"
 
+    def reuse_pays(self) -> bool:
+        """Whether the factorisation of the last analysed pattern costs enough forward and backward
+        substitutions to be worth reusing as a preconditioner (``reuse_factorization = "auto"``). A backend
+        that cannot tell says yes."""
+        return True
+
     def same_pattern(self, K: sp.csr_matrix) -> bool:
         """Whether K has the sparsity pattern of the last analysis."""
         if self._indptr is None or self._indices is None or K.shape[0] + 1 != self._indptr.size:

@@ -21,12 +21,16 @@ relative references are at round-off themselves). A step that diverges, runs out
 iterations, inverts an element or meets a singular matrix is cut back (its increment halved) up to
 ``max_cutbacks`` times in a row.
 
-Factorisation reuse (``SolverOptions.reuse_factorization``, direct solvers): a correction is first sought by
-GMRES on the new tangent, preconditioned by the last factorisation (of an earlier iteration or step), to the
-relative residual eta_k = min(1e-4, 1e-4 ||R_k|| / ||R_0||) (a forcing term that falls with the outer
-residual, so the outer convergence stays quadratic); a new factorisation is made when GMRES does not get
-there in ``krylov_max`` iterations, when the outer residual stalled (||R_k|| > 0.5 ||R_(k-1)||) after an
-inexact correction, or when there is none yet. Counts and times: ``Newton.stats``.
+Factorisation reuse (``SolverOptions.reuse_factorization``; "auto", the default, where the direct solver
+says its factorisation costs enough substitutions to pay, ``LinearSolver.reuse_pays``): the first
+correction of a step is made with a new factorisation; the later ones are first sought by GMRES on the new
+tangent, right-preconditioned by that factorisation, to the relative residual
+eta_k = min(1e-4, 1e-4 ||R_k|| / r_ref, 0.01 tau / ||R_k||) with r_ref = max(||R_0||, ||R_1||) and tau the
+step's convergence threshold: a forcing term that falls with the outer residual (quadratic convergence) and
+keeps the linear error at 1 % of the threshold, so that a step ends after the iteration exact Newton would end
+it. A new factorisation is made when GMRES does not get there in ``krylov_max`` iterations (and then for the
+rest of the step) or when the outer residual stalled (||R_k|| > 0.5 ||R_(k-1)||) after an inexact correction.
+Counts and times: ``Newton.stats``.
 """
 
 from __future__ import annotations
@@ -151,9 +155,10 @@ class Newton:
         return du
 
     def _solve(self, K, rhs, eta: float | None = None):
-        if (eta is not None and self.opt.reuse_factorization and self.linear.direct and not self._stalled
-                and not self._failed
-                and getattr(self.linear, "_K", None) is not None and self.linear._K.shape == K.shape):
+        reuse = self.opt.reuse_factorization
+        if (eta is not None and reuse and self.linear.direct and not self._stalled and not self._failed
+                and getattr(self.linear, "_K", None) is not None and self.linear._K.shape == K.shape
+                and (reuse is True or self.linear.reuse_pays())):
             du = self._krylov(K, rhs, eta)
             if du is not None:
                 return du
@@ -229,13 +234,18 @@ class Newton:
             return out, trial
         e0 = None
         rn_prev = r0
+        r_ref = r0  # max(||R_0||, ||R_1||) once the first correction is made
         inexact = False
         for it in range(1, opt.max_iterations + 1):
-            eta = min(1e-4, 1e-4 * rn_prev / max(r0, 1e-300))
+            eta = None  # the first correction of a step: a new factorisation (see _solve)
+            if it > 1:  # GMRES tolerance relative to ||rhs||: quadratic forcing, and 1 % of the convergence
+                # threshold, so that the iterate is that of exact Newton to well within the test
+                threshold = max(opt.rtol * r_ref, opt.atol * scale)
+                eta = min(1e-4, 1e-4 * rn_prev / r_ref, 1e-2 * threshold / max(rn_prev, 1e-300))
             n_fact, n_kry = self.stats["factorizations"], self.stats["krylov_iterations"]
             # the first correction of a step is always made with a new factorisation: a step's iterations then
             # do not depend on how the run got there (a resumed run has no factorisation to reuse)
-            du = self._solve(K, rhs, eta if it > 1 else None)
+            du = self._solve(K, rhs, eta)
             inexact = self.stats["factorizations"] == n_fact
             du[~free] = du_d[~free] if it == 1 else 0.0
             eta = 1.0

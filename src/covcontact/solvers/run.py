@@ -231,7 +231,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                     _stage_entry(summary, spec)
                 for k in range(state.step + 1, before + len(spec.factors) + 1):
                     lam = spec.factors[k - before - 1]
-                    stats0 = dict(newton.stats)
+                    stats0, time0 = dict(newton.stats), dict(newton.timing)
                     success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
                     conv = [o for o in outcomes if o.converged]
                     iters = sum(o.iterations for o in outcomes)
@@ -244,9 +244,10 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                                            for r in o.residual_norms] if conv else [],
                         "cutbacks": cutbacks,
                         "factorizations": newton.stats["factorizations"] - stats0["factorizations"],
+                        "krylov_iterations": newton.stats["krylov_iterations"] - stats0["krylov_iterations"],
+                        "factor_s": round(newton.timing["factor"] - time0["factor"], 6),
+                        "krylov_s": round(newton.timing["krylov"] - time0["krylov"], 6),
                     }
-                    if problem.solver.reuse_factorization:
-                        entry["krylov_iterations"] = newton.stats["krylov_iterations"] - stats0["krylov_iterations"]
                     if staged:
                         entry["stage"] = spec.name
                         entry["time"] = t_stage + lam
