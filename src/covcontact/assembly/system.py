@@ -203,15 +203,15 @@ class System:
             return K
         K = K.tocsr()
         cached = self._eliminate_cache
-        if cached is not None and cached[0] is K.indices and cached[1] is K.indptr:
+        if (cached is not None and cached[0].shape == K.indices.shape and np.array_equal(cached[1], K.indptr)
+                and np.array_equal(cached[0], K.indices)):
             zero, one = cached[2], cached[3]
         else:  # once per pattern (the bodies' pattern, or a contact pattern) and set of constraints
             rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
             mask = self.constrained[rows] | self.constrained[K.indices]
             zero = np.flatnonzero(mask)
             one = zero[rows[zero] == K.indices[zero]]
-            # the arrays are held, so their identities cannot be reused by others while cached
-            self._eliminate_cache = (K.indices, K.indptr, zero, one)
+            self._eliminate_cache = (K.indices.copy(), K.indptr.copy(), zero, one)
         K.data[zero] = 0.0
         K.data[one] = 1.0
         return K
