@@ -175,3 +175,86 @@ def c10_d1(E: float, nu: float) -> tuple[float, float]:
     lam, mu = lame(E, nu)
     return mu / 2.0, 2.0 / (lam + 2.0 * mu / 3.0)
 
+
+
+def bodies_deck(problem, penalty: float | None = None, sigma_inf: float | None = None,
+                stress_scale: float = 1.0, report: tuple[str, str] = ("punch", "zmax")) -> tuple[str, DeckInfo]:
+    """A covcontact problem of deformable hex8 bodies (St. Venant-Kirchhoff), constant Dirichlet conditions and
+    one node-to-surface contact pair as a CalculiX deck (e.g. the two blocks of benchmarks/problems).
+
+    Bodies are numbered in the problem's order: node and element numbers are covcontact's global indices plus
+    one. Zero Dirichlet values are fixed in the model, non-zero ones ramped over one NLGEOM step of
+    ``len(problem.steps.factors)`` fixed equal increments. ``penalty`` (default: the pair's) is covcontact's
+    area-weighted penalty, the slope of CalculiX's linear pressure-overclosure law; ``sigma_inf`` and
+    ``stress_scale`` as in :func:`hertz_deck`. The total reaction of node set ``report`` (body, set) is printed
+    per increment.
+    """
+    from covcontact.materials import SaintVenantKirchhoff
+
+    if len(problem.contacts) != 1 or problem.contacts[0].weighting != "area":
+        raise ValueError("one contact pair with the area-weighted penalty is written")
+    c = problem.contacts[0]
+    k = float(c.penalty if penalty is None else penalty)
+    sigma_inf = k * 1e-9 if sigma_inf is None else sigma_inf
+    S = float(stress_scale)
+    factors = problem.steps.factors
+    steps = len(factors)
+    if not np.allclose(factors, np.arange(1, steps + 1) / steps):
+        raise ValueError("only equal load steps are written")
+    lines = ["*HEADING", f"{problem.name}: {len(problem.bodies)} bodies, node-to-surface penalty, {steps} increments"]
+    offset, e_offset, n_el = {}, {}, 0
+    n_nodes = 0
+    for b in problem.bodies:
+        if b.mesh.cell_type != "hex8" or not isinstance(b.material, SaintVenantKirchhoff):
+            raise ValueError(f"body {b.name!r}: only hex8 St. Venant-Kirchhoff bodies are written")
+        offset[b.name], e_offset[b.name] = n_nodes, n_el
+        lines.append(f"*NODE, NSET=N{b.name.upper()}")
+        lines += [f"{n_nodes + a + 1}, {x:.12e}, {y:.12e}, {z:.12e}" for a, (x, y, z) in enumerate(b.mesh.points.tolist())]
+        lines.append(f"*ELEMENT, TYPE=C3D8, ELSET=E{b.name.upper()}")
+        lines += [f"{n_el + e + 1}, " + ", ".join(str(n_nodes + a + 1) for a in cell)
+                  for e, cell in enumerate(b.mesh.cells.tolist())]
+        n_nodes += b.mesh.n_nodes
+        n_el += b.mesh.n_cells
+    meshes = {b.name: b.mesh for b in problem.bodies}
+
+    def nset(body: str, name: str) -> str:
+        label = f"N{body.upper()}_{name.upper()}"
+        if label not in written:
+            written.add(label)
+            lines.extend([f"*NSET, NSET={label}", _ids(meshes[body].node_sets[name] + offset[body] + 1)])
+        return label
+
+    def surface(body: str, name: str, label: str) -> int:
+        elems, nums = face_numbers(meshes[body], name)
+        lines.append(f"*SURFACE, NAME={label}, TYPE=ELEMENT")
+        lines.extend(f"{e + e_offset[body] + 1}, S{f}" for e, f in zip(elems.tolist(), nums.tolist(), strict=True))
+        return len(elems)
+
+    written: set[str] = set()
+    n_slave = surface(c.slave[0], c.slave[1], "SSLAVE")
+    n_master = surface(c.master[0], c.master[1], "SMASTER")
+    fixed, moved = [], []
+    for d in problem.dirichlet:
+        label = nset(d.body, d.set)
+        for comp, value in zip(d.components, d.values, strict=True):
+            (moved if value else fixed).append(f"{label}, {comp + 1}, {comp + 1}" + (f", {value:.12e}" if value else ""))
+    report_set = nset(*report)
+    for b in problem.bodies:
+        lines += [f"*MATERIAL, NAME=M{b.name.upper()}", "*ELASTIC", f"{b.material.E * S:.12e}, {b.material.nu:.12e}",
+                  f"*SOLID SECTION, ELSET=E{b.name.upper()}, MATERIAL=M{b.name.upper()}"]
+    lines += ["*SURFACE INTERACTION, NAME=CONTACT",
+              "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR",
+              f"{k * S:.12e}, {sigma_inf * S:.12e}",
+              "*CONTACT PAIR, INTERACTION=CONTACT, TYPE=NODE TO SURFACE",
+              "SSLAVE, SMASTER",
+              "*BOUNDARY", *fixed,
+              f"*STEP, NLGEOM, INC={100 * steps}",
+              "*STATIC, DIRECT",
+              f"{1.0 / steps:.12e}, 1.0",
+              "*BOUNDARY", *moved,
+              f"*NODE PRINT, NSET={report_set}, TOTALS=ONLY",
+              "RF",
+              "*END STEP", ""]
+    info = DeckInfo(n_nodes=n_nodes, n_elements=n_el, ball_nodes=n_nodes, ball_elements=n_el,
+                    slave_faces=n_slave, master_faces=n_master, plane_node0=n_nodes + 1)
+    return "\n".join(lines), info

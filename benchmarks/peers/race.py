@@ -6,7 +6,8 @@ equal load steps, the same mesh written for every code):
 - ``two_blocks``: benchmarks/problems/two_blocks_5k.toml scaled: the base block (2 x 2 x 0.5, E = 1000,
   nu = 0.3) clamped at its bottom, the punch (1 x 1 x 0.5) pressed 0.05 down by its top, sizes "5k" (base
   10 x 10 x 5, punch 11 x 11 x 5: 4,770 dofs), "35k" (21 x 21 x 10, 23 x 23 x 10: 34,980), "200k"
-  (37 x 37 x 19, 41 x 41 x 19: 192,480). Kratos only (no CalculiX deck for it).
+  (37 x 37 x 19, 41 x 41 x 19: 192,480). Kratos and, when ``ccx`` is on the PATH, CalculiX
+  (ccx_deck.bodies_deck).
 - ``hertz``: the quarter ball of tests/verification/test_hertz.py (``hertz_mesh(n, n/2)``, R = 1, E = 1,
   nu = 0.3, flat face moved down to d = 0.01 R onto the plane z = 0), sizes n = 14 (5,085 dofs), 28
   (36,627), 50 (199,053). Kratos and, when ``ccx`` is on the PATH, CalculiX (ccx_deck.hertz_deck).
@@ -56,7 +57,7 @@ sys.path.insert(0, str(HERE.parent))
 
 from _report import emit
 from calculix_hertz import _ccx_version, _covcontact_state, timed
-from ccx_deck import hertz_deck
+from ccx_deck import bodies_deck, hertz_deck
 from ccx_results import parse_dat, parse_sta, parse_stdout
 from hertz_setup import C_HERTZ, D_MAX, NU, E, hertz_mesh
 from kratos_deck import hertz_case, two_blocks_case, write_case
@@ -109,8 +110,13 @@ class Cell:
             self.penalty = args.two_blocks_penalty
             self.toml = self.dir / "problem.toml"
             self.toml.write_text(two_blocks_toml(size, self.penalty))
-            info = write_case(two_blocks_case(load_problem(self.toml)), self.kdir)
+            problem = load_problem(self.toml)
+            info = write_case(two_blocks_case(problem), self.kdir)
             self.dofs, self.label = info.dofs, "base {0}x{0}x{1}, punch {2}x{2}x{3}".format(*TWO_BLOCKS[size])
+            self.force_scale = 1.0  # the whole problem
+            if args.ccx:
+                text, _ = bodies_deck(problem, stress_scale=CCX_STRESS_SCALE)
+                self.ccx_job = self.dir / "ccx" / "two_blocks.inp"
         else:
             self.penalty = args.hertz_penalty
             self.n = HERTZ[size]
@@ -118,12 +124,14 @@ class Cell:
             info = write_case(hertz_case(mesh, E, NU, D_MAX, STEPS, self.penalty), self.kdir)
             self.dofs, self.label = 3 * mesh.n_nodes, f"n={self.n}"
             self.kratos_extra_dofs = info.dofs - self.dofs
+            self.force_scale = 4.0  # a quarter of the ball
             if args.ccx:
                 text, _ = hertz_deck(mesh, "svk", E, NU, D_MAX, STEPS, self.penalty,
                                      stress_scale=CCX_STRESS_SCALE, frd=False)
                 self.ccx_job = self.dir / "ccx" / "hertz.inp"
-                self.ccx_job.parent.mkdir(exist_ok=True)
-                self.ccx_job.write_text(text)
+        if self.ccx_job is not None:
+            self.ccx_job.parent.mkdir(exist_ok=True)
+            self.ccx_job.write_text(text)
         self.ours_out = self.dir / "covcontact"
 
     # covcontact
@@ -142,7 +150,7 @@ class Cell:
 
     def ours_record(self) -> dict:
         s = json.loads((self.ours_out / "summary.json").read_text())
-        scale = 4.0 if self.problem == "hertz" else 1.0
+        scale = self.force_scale
         return {"converged": bool(s["converged"]), "dofs": s["dofs"], "linear_solver": s["linear_solver"],
                 "iterations": s["total_iterations"], "iterations_per_step": [st["iterations"] for st in s["steps"]],
                 "factorizations": sum(st.get("factorizations", 0) for st in s["steps"]),
@@ -180,7 +188,7 @@ class Cell:
         iters = parse_sta(job.with_suffix(".sta").read_text())
         dat = parse_dat(job.with_suffix(".dat").read_text())
         times = [t for t in dat.times if t in dat.rf]
-        F = [-4.0 * dat.rf[t][2] / CCX_STRESS_SCALE for t in times]
+        F = [-self.force_scale * dat.rf[t][2] / CCX_STRESS_SCALE for t in times]
         return {"converged": len(iters) == STEPS and not std["error"], "iterations": sum(iters),
                 "iterations_per_step": iters, "solve_s": std["ccx_time_s"], "linear_solver": std["solver"],
                 "cpus_reported": std["cpus"], "F": F}

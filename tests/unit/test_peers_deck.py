@@ -139,3 +139,42 @@ def test_readers():
                      "Total CalculiX Time: 3.5\n")
     assert s == {"equations": 2934, "ccx_time_s": 3.5, "solver": "symmetric spooles", "cpus": 2,
                  "error": False}
+
+
+def test_two_bodies_deck_matches_the_problem():
+    """bodies_deck: every node and element of both blocks once, numbered globally; the contact surfaces are the
+    faces of the pair's sets; zero supports fixed in the model, the punch's motion ramped in the step; the
+    pair's penalty as the pressure-overclosure slope, scaled with the stress unit."""
+    from ccx_deck import bodies_deck
+
+    from covcontact.io.loader import load_problem
+
+    problem = load_problem(ROOT / "examples" / "contact" / "two_blocks.toml")
+    text, info = bodies_deck(problem, stress_scale=10.0)
+    base, punch = problem.bodies
+    assert info.n_nodes == base.mesh.n_nodes + punch.mesh.n_nodes
+    assert info.n_elements == base.mesh.n_cells + punch.mesh.n_cells
+    node_lines = [ln for ln in text.splitlines() if ln and ln[0].isdigit() and ln.count(",") == 3]
+    ids = [int(ln.split(",")[0]) for ln in node_lines]
+    assert ids == list(range(1, info.n_nodes + 1))
+    X = np.array([[float(v) for v in ln.split(",")[1:]] for ln in node_lines])
+    np.testing.assert_allclose(X, np.vstack([base.mesh.points, punch.mesh.points]), rtol=0, atol=1e-12)
+    assert info.slave_faces == len(punch.mesh.face_sets["zmin"])
+    assert info.master_faces == len(base.mesh.face_sets["zmax"])
+    lines = text.splitlines()
+    slope = lines[lines.index("*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR") + 1].split(",")
+    assert float(slope[0]) == pytest.approx(10.0 * problem.contacts[0].penalty)
+    step = lines.index("*STEP, NLGEOM, INC=200")
+    moved = [ln for ln in lines[step:] if ln.startswith("NPUNCH_ZMAX, 3, 3")]
+    assert len(moved) == 1 and float(moved[0].split(",")[3]) == pytest.approx(-0.02)
+    fixed = lines[lines.index("*BOUNDARY") + 1: step]
+    assert sorted(fixed) == sorted([f"NBASE_ZMIN, {c}, {c}" for c in (1, 2, 3)]
+                                   + [f"NPUNCH_ZMAX, {c}, {c}" for c in (1, 2)])
+    # the slave faces' corner nodes are the punch's zmin nodes (offset by the base's nodes)
+    sl = lines.index("*SURFACE, NAME=SSLAVE, TYPE=ELEMENT")
+    faces = [ln.split(",") for ln in lines[sl + 1: sl + 1 + info.slave_faces]]
+    nodes = set()
+    for e, f in faces:
+        cell = punch.mesh.cells[int(e) - 1 - base.mesh.n_cells]
+        nodes |= {int(cell[a]) for a in C3D8_FACES[int(f.strip()[1:]) - 1]}
+    assert nodes == set(punch.mesh.node_sets["zmin"].tolist())
