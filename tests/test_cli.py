@@ -194,6 +194,20 @@ def test_console_script_runs(tmp_path):
     assert (tmp_path / "o" / "summary.json").exists()
 
 
+def test_module_command_flushes_and_keeps_the_exit_code(tmp_path):
+    """``python -m covcontact`` leaves without tearing the interpreter down: what it printed is all there,
+    its result files are complete and its exit code is main's."""
+    path = write(tmp_path, GOOD)
+    proc = subprocess.run([sys.executable, "-m", "covcontact", "run", str(path), "--out", str(tmp_path / "o")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["status"] == "completed" and f"results in {tmp_path / 'o'}" in proc.stderr
+    bad = subprocess.run([sys.executable, "-m", "covcontact", "run", str(tmp_path / "missing.toml")],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.startswith("covcontact: error:") and "missing.toml" in bad.stderr
+
+
 def test_every_option_has_help():
     """`covcontact CMD --help` explains every option (argparse shows no text for options without help)."""
     from covcontact.cli import _parser

@@ -67,7 +67,7 @@ def test_one_factorisation_per_step_on_the_hertz_ball(tmp_path):
 @pytest.mark.skipif("pardiso" not in available(), reason="pypardiso not installed (the other backends always reuse)")
 def test_auto_reuses_only_expensive_pardiso_factorisations():
     """reuse_factorization = "auto": PARDISO reports the factorisation's flops against one substitution's; a
-    small bulky tangent (3 dofs per node, 10^3 nodes) is not worth reusing, a larger one (14^3) is."""
+    small bulky tangent (3 dofs per node, 8^3 nodes) is not worth reusing, a larger one (14^3) is."""
     import scipy.sparse as sp
 
     from covcontact.solvers.backends import REUSE_MIN_FLOP_RATIO
@@ -80,7 +80,7 @@ def test_auto_reuses_only_expensive_pardiso_factorisations():
         return sp.kron(lap, np.ones((3, 3)) + 3 * np.eye(3)).tocsr()
 
     ratios = []
-    for m in (10, 14):
+    for m in (8, 14):
         solver = make_solver("pardiso")
         solver.factorize(elastic_like(m))
         ratios.append(solver.flop_ratio)

@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import meshio
 import numpy as np
 
 from .atomic import replacing
@@ -62,6 +61,8 @@ class ResultWriter:
                     width = next(np.asarray(c[key]).shape[1:] for _, _, c in blocks if key in c)
                     arr = np.full((len(parent),) + width, np.nan)
                 cdata.setdefault(key, []).append(arr)
+        import meshio  # imported by the first VTU written: runs without VTU output do not pay for it
+
         mesh = meshio.Mesh(points, cells, point_data=point_data, cell_data=cdata)
         name = f"step_{step:04d}.vtu"
         with replacing(self.out / name) as tmp:

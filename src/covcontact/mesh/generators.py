@@ -19,8 +19,6 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from ..fem.shapes import IDX, ORDER
 from .faces import boundary_faces, jacobian_determinants
@@ -89,8 +87,9 @@ def _mirror_perm(cell: str) -> np.ndarray:
     return np.array([np.nonzero((idx == t).all(axis=1))[0][0] for t in target], dtype=np.int64)
 
 
-def _assemble(blocks: list[_Block], cell: str, no_faces: Sequence[str] = ("all",)) -> Mesh:
-    """Join blocks, merge coincident nodes, orient elements, build node and face sets."""
+def _assemble(blocks: list[_Block], cell: str, no_faces: Sequence[str] = ("all",), merge: bool = True) -> Mesh:
+    """Join blocks, merge coincident nodes (``merge``: a lattice has none), orient elements, build node and
+    face sets."""
     X = np.concatenate([b[0] for b in blocks])
     offsets = np.cumsum([0] + [b[0].shape[0] for b in blocks])
     cells = np.concatenate([b[1] + o for b, o in zip(blocks, offsets[:-1], strict=True)])
@@ -99,21 +98,28 @@ def _assemble(blocks: list[_Block], cell: str, no_faces: Sequence[str] = ("all",
         k: np.concatenate([b[2].get(k, np.zeros(b[0].shape[0], dtype=bool)) for b in blocks])
         for k in names
     }
-    tol = 1e-9 * float(np.ptp(X, axis=0).max())
-    pairs = cKDTree(X).query_pairs(tol, output_type="ndarray")
     n = X.shape[0]
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
-    _, first, inv = np.unique(label, return_index=True, return_inverse=True)
-    order = np.argsort(first)
-    rank = np.empty_like(order)
-    rank[order] = np.arange(order.size)
-    new = rank[inv.ravel()]
+    if merge:
+        from scipy.sparse.csgraph import connected_components  # imported where used: start-up time
+        from scipy.spatial import cKDTree
+
+        tol = 1e-9 * float(np.ptp(X, axis=0).max())
+        pairs = cKDTree(X).query_pairs(tol, output_type="ndarray")
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+        _, label = connected_components(graph, directed=False)
+        _, first, inv = np.unique(label, return_index=True, return_inverse=True)
+        order = np.argsort(first)
+        rank = np.empty_like(order)
+        rank[order] = np.arange(order.size)
+        new = rank[inv.ravel()]
+        kept = first[order]
+    else:
+        new = kept = np.arange(n)
     cells = new[cells]
     srt = np.sort(cells, axis=1)
     if np.any(srt[:, 1:] == srt[:, :-1]):
         raise ValueError("mesh generation produced collapsed elements (repeated nodes)")
-    mesh = Mesh(X[first[order]], cell, cells)
+    mesh = Mesh(X[kept], cell, cells)
     flip = jacobian_determinants(mesh, np.zeros((1, 3)))[:, 0] < 0.0
     mesh.cells[flip] = mesh.cells[flip][:, _mirror_perm(cell)]
     faces, _, _ = boundary_faces(mesh)
@@ -154,7 +160,7 @@ def block(
     for d, ax in enumerate("xyz"):
         sets[ax + "min"] = U[:, d] == 0.0
         sets[ax + "max"] = U[:, d] == 1.0
-    return _assemble([(np.asarray(origin, dtype=np.float64) + U * size, cells, sets)], cell)
+    return _assemble([(np.asarray(origin, dtype=np.float64) + U * size, cells, sets)], cell, merge=False)
 
 
 def plate(

@@ -23,14 +23,17 @@ import io
 import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import meshio
 import numpy as np
 
 from ..fem.shapes import NODES
 from ..io.atomic import replacing
 from .faces import match_boundary_faces
 from .mesh import Mesh
+
+if TYPE_CHECKING:
+    import meshio
 
 _VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27"}
 _TO_MESHIO = {"hex8": "hexahedron", "hex27": "hexahedron27"}
@@ -78,6 +81,8 @@ def to_meshio(
     cell_data: Mapping[str, np.ndarray] | None = None,
 ) -> meshio.Mesh:
     """A meshio.Mesh of ``mesh`` with its node and element sets (hex18 becomes hex27, see above)."""
+    import meshio  # here, not at the top: a run that writes no mesh file does not pay for its import
+
     pdata = {k: np.asarray(v) for k, v in (point_data or {}).items()}
     for k, v in pdata.items():
         if v.shape[0] != mesh.n_nodes:
@@ -107,6 +112,8 @@ def write_vtu(
     m = to_meshio(mesh, point_data, cell_data)
     m.point_sets, m.cell_sets = {}, {}
     target = Path(path)
+    import meshio
+
     with replacing(target) as tmp:
         meshio.write(tmp, m, file_format="vtu")
 
@@ -146,6 +153,8 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
     Raises:
         MeshError: the file does not parse or holds no (or an ambiguous) supported volume cell.
     """
+    import meshio
+
     p = Path(path)
     if not p.is_file():
         raise _fail(p, "no such file")
