@@ -199,12 +199,12 @@ def test_module_command_flushes_and_keeps_the_exit_code(tmp_path):
     its result files are complete and its exit code is main's."""
     path = write(tmp_path, GOOD)
     proc = subprocess.run([sys.executable, "-m", "covcontact", "run", str(path), "--out", str(tmp_path / "o")],
-                          capture_output=True, text=True)
+                          capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["status"] == "completed" and f"results in {tmp_path / 'o'}" in proc.stderr
     bad = subprocess.run([sys.executable, "-m", "covcontact", "run", str(tmp_path / "missing.toml")],
-                         capture_output=True, text=True)
+                         capture_output=True, text=True, check=False)
     assert bad.returncode == 2 and bad.stderr.startswith("covcontact: error:") and "missing.toml" in bad.stderr
 
 
