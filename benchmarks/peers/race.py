@@ -12,6 +12,9 @@ equal load steps, the same mesh written for every code):
   nu = 0.3, flat face moved down to d = 0.01 R onto the plane z = 0), sizes n = 14 (5,085 dofs), 28
   (36,627), 50 (199,053). Kratos and, when ``ccx`` is on the PATH, CalculiX (ccx_deck.hertz_deck).
 
+Kratos solves its linear systems with AMGCL (``--kratos-solver amgcl``, the default; ``sparse_lu`` for Eigen's
+SparseLU): of the solvers its wheels carry, the fastest on both problems.
+
 covcontact's area-weighted penalty k (pressure = k x penetration) is given to Kratos as a per-node eps of its
 mortar penalty condition (kratos_deck.nodal_penalties) and to CalculiX as the slope of its linear
 pressure-overclosure law. Default k: 2.5e5 for two_blocks (Kratos's active set does not settle with the problem
@@ -45,6 +48,7 @@ import statistics
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -71,6 +75,9 @@ TWO_BLOCKS = {"5k": (10, 5, 11, 5), "35k": (21, 10, 23, 10), "200k": (37, 19, 41
 HERTZ = {"5k": 14, "35k": 28, "200k": 50}
 STEPS = 10
 CCX_STRESS_SCALE = 1e5  # see peers/README.md, CalculiX: "Stress unit of the deck"
+#: Kratos's linear solvers offered to the race (its wheels have no PARDISO); AMGCL is its fastest here
+KRATOS_SOLVERS = {"amgcl": "amgcl (AMG-preconditioned Krylov, Kratos's defaults)",
+                  "sparse_lu": "sparse_lu (Eigen SparseLU)"}
 
 
 def thread_env(threads: int) -> dict:
@@ -111,7 +118,7 @@ class Cell:
             self.toml = self.dir / "problem.toml"
             self.toml.write_text(two_blocks_toml(size, self.penalty))
             problem = load_problem(self.toml)
-            info = write_case(two_blocks_case(problem), self.kdir)
+            info = write_case(replace(two_blocks_case(problem), linear_solver=args.kratos_solver), self.kdir)
             self.dofs, self.label = info.dofs, "base {0}x{0}x{1}, punch {2}x{2}x{3}".format(*TWO_BLOCKS[size])
             self.force_scale = 1.0  # the whole problem
             if args.ccx:
@@ -121,7 +128,8 @@ class Cell:
             self.penalty = args.hertz_penalty
             self.n = HERTZ[size]
             mesh = hertz_mesh(n=self.n, nr=self.n // 2)
-            info = write_case(hertz_case(mesh, E, NU, D_MAX, STEPS, self.penalty), self.kdir)
+            info = write_case(replace(hertz_case(mesh, E, NU, D_MAX, STEPS, self.penalty),
+                                      linear_solver=args.kratos_solver), self.kdir)
             self.dofs, self.label = 3 * mesh.n_nodes, f"n={self.n}"
             self.kratos_extra_dofs = info.dofs - self.dofs
             self.force_scale = 4.0  # a quarter of the ball
@@ -172,7 +180,7 @@ class Cell:
         part, scale = ("punch_zmax", 1.0) if self.problem == "two_blocks" else ("ball_flat", 4.0)
         return {"converged": r.all_converged, "steps_converged": r.converged, "iterations": sum(r.iterations),
                 "iterations_per_step": r.iterations, "solve_s": r.analysis_s, "threads_reported": r.threads,
-                "version": r.version, "linear_solver": "sparse_lu (Eigen SparseLU)",
+                "version": r.version, "linear_solver": KRATOS_SOLVERS[self.args.kratos_solver],
                 "F": (scale * r.force(part)).tolist()}
 
     # CalculiX
@@ -272,6 +280,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--kratos-python", default=os.environ.get("KRATOS_PYTHON"),
                     help="Python with the Kratos wheels (default: $KRATOS_PYTHON)")
+    ap.add_argument("--kratos-solver", choices=sorted(KRATOS_SOLVERS), default="amgcl",
+                    help="Kratos's linear solver (default amgcl, its fastest on these problems)")
     ap.add_argument("--no-ccx", dest="ccx", action="store_false", help="leave CalculiX out even if installed")
     ap.add_argument("--no-kratos", dest="kratos", action="store_false",
                     help="leave Kratos out (sizes where its runs take too long)")
