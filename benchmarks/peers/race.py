@@ -86,9 +86,10 @@ def thread_env(threads: int) -> dict:
     return env
 
 
-def two_blocks_toml(size: str, penalty: float) -> str:
+def two_blocks_toml(size: str, penalty: float, rtol: float | None = None) -> str:
     """The problem file of one two_blocks size: benchmarks/problems/two_blocks_5k.toml with other element counts
-    and penalty (same material, supports, 10 steps, no VTU)."""
+    and penalty (same material, supports, 10 steps, no VTU); ``rtol``: Newton's relative tolerance if not the
+    default."""
     bn, bz, pn, pz = TWO_BLOCKS[size]
     text = (ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml").read_text()
     for old, new in (('name = "two-blocks-5k"', f'name = "two-blocks-{size}"'),
@@ -98,6 +99,8 @@ def two_blocks_toml(size: str, penalty: float) -> str:
         if old not in text:
             raise RuntimeError(f"two_blocks_5k.toml changed: {old!r} not found")
         text = text.replace(old, new, 1)
+    if rtol is not None:
+        text += f"\n[solver]\nrtol = {rtol!r}\n"
     return f"# two_blocks race problem, size {size} (written by benchmarks/peers/race.py)\n" + text
 
 
@@ -116,7 +119,7 @@ class Cell:
 
             self.penalty = args.two_blocks_penalty
             self.toml = self.dir / "problem.toml"
-            self.toml.write_text(two_blocks_toml(size, self.penalty))
+            self.toml.write_text(two_blocks_toml(size, self.penalty, args.ours_rtol))
             problem = load_problem(self.toml)
             info = write_case(replace(two_blocks_case(problem), linear_solver=args.kratos_solver), self.kdir)
             self.dofs, self.label = info.dofs, "base {0}x{0}x{1}, punch {2}x{2}x{3}".format(*TWO_BLOCKS[size])
@@ -147,7 +150,7 @@ class Cell:
         if self.problem == "two_blocks":
             return [sys.executable, "-m", "covcontact", "run", str(self.toml), "--out", str(self.ours_out), "--quiet"]
         return [sys.executable, str(Path(__file__).resolve()), "--worker-hertz", str(self.n), str(self.penalty),
-                str(self.ours_out)]
+                str(self.ours_out), repr(self.args.ours_rtol)]
 
     def run_ours(self) -> float:
         shutil.rmtree(self.ours_out, ignore_errors=True)
@@ -163,7 +166,8 @@ class Cell:
                 "iterations": s["total_iterations"], "iterations_per_step": [st["iterations"] for st in s["steps"]],
                 "factorizations": sum(st.get("factorizations", 0) for st in s["steps"]),
                 "krylov_iterations": sum(st.get("krylov_iterations", 0) for st in s["steps"]),
-                "solve_s": s["wall_time_s"], "F": [scale * st["contact_force"][2] for st in s["steps"]]}
+                "solve_s": s["wall_time_s"], "timing_s": s.get("timing", {}),
+                "F": [scale * st["contact_force"][2] for st in s["steps"]]}
 
     # Kratos
     def run_kratos(self) -> float:
@@ -264,12 +268,15 @@ def table(records: list[dict], threads: int) -> str:
     return "\n".join(rows)
 
 
-def worker_hertz(n: int, penalty: float, out: str) -> int:
+def worker_hertz(n: int, penalty: float, out: str, rtol: float | None) -> int:
     """Child process: the covcontact Hertz run (no VTU, as the peers write no field output here)."""
     from hertz_setup import hertz_problem
 
     mesh = hertz_mesh(n=n, nr=n // 2)
-    return hertz_problem(mesh, "svk", steps=STEPS, penalty=penalty, vtu=False).run(out=Path(out), quiet=True).exit_code
+    problem = hertz_problem(mesh, "svk", steps=STEPS, penalty=penalty, vtu=False)
+    if rtol is not None:
+        problem.solver.rtol = rtol
+    return problem.run(out=Path(out), quiet=True).exit_code
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -289,11 +296,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--hertz-penalty", type=float, default=1e4)
     ap.add_argument("--keep", type=Path, help="keep inputs and results in this directory")
     ap.add_argument("--out", type=Path, help="JSON file (default: stdout)")
-    ap.add_argument("--worker-hertz", nargs=3, help=argparse.SUPPRESS)
+    ap.add_argument("--ours-rtol", type=float, default=None,
+                    help="covcontact's Newton tolerance [solver] rtol (default: its own, 1e-8); e.g. 1e-5 races it at "
+                         "the accuracy of CalculiX's default controls (peers/README.md)")
+    ap.add_argument("--worker-hertz", nargs=4, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker_hertz:
-        n, penalty, out = args.worker_hertz
-        return worker_hertz(int(n), float(penalty), out)
+        n, penalty, out, rtol = args.worker_hertz
+        return worker_hertz(int(n), float(penalty), out, None if rtol == "None" else float(rtol))
     if args.kratos and not args.kratos_python:
         print("give --kratos-python (or set KRATOS_PYTHON): the Python of an environment with Kratos", file=sys.stderr)
         return 2
@@ -312,6 +322,7 @@ def main(argv: list[str] | None = None) -> int:
                 records.append(race(Cell(problem, size, work, args), args.repeats))
     result = {"benchmark": "peers_race", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "cpus": os.cpu_count(), "threads": args.threads,
+              "covcontact_rtol": args.ours_rtol or 1e-8, "kratos_solver": args.kratos_solver,
               "repeats": args.repeats, "steps": STEPS,
               "kratos_version": records[0]["codes"]["kratos"]["version"] if records and args.kratos else None,
               "ccx_version": _ccx_version() if args.ccx else None, "covcontact": _covcontact_state(),
