@@ -208,6 +208,16 @@ def test_module_command_flushes_and_keeps_the_exit_code(tmp_path):
     assert bad.returncode == 2 and bad.stderr.startswith("covcontact: error:") and "missing.toml" in bad.stderr
 
 
+def test_closed_output_pipe_is_no_traceback():
+    """``covcontact info | head -1``: the reader leaves early; the command stops without a traceback."""
+    proc = subprocess.Popen([sys.executable, "-m", "covcontact", "info"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()  # before the command writes: its first write meets a closed pipe
+    err = proc.stderr.read()
+    proc.stderr.close()
+    assert proc.wait(timeout=120) in (0, 141) and "Traceback" not in err, err
+
+
 def test_every_option_has_help():
     """`covcontact CMD --help` explains every option (argparse shows no text for options without help)."""
     from covcontact.cli import _parser

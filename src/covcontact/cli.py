@@ -177,6 +177,12 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:  # the reader of the standard output left (``covcontact info | head``)
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no error at exit either
+        except OSError:
+            pass
+        return 141  # 128 + SIGPIPE, as the shell reports a program stopped by a closed pipe
     except Exception:
         traceback.print_exc()
         return 3
