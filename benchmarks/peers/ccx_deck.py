@@ -66,6 +66,18 @@ def _ids(values, per_line: int = 12) -> str:
     return "\n".join(", ".join(v[i:i + per_line]) for i in range(0, len(v), per_line))
 
 
+def _node_block(nset: str, first: int, points) -> list[str]:
+    """``*NODE`` lines of ``points`` numbered from ``first``."""
+    return [f"*NODE, NSET={nset}"] + [f"{first + a}, {x:.12e}, {y:.12e}, {z:.12e}"
+                                      for a, (x, y, z) in enumerate(np.asarray(points).tolist())]
+
+
+def _element_block(elset: str, first: int, cells) -> list[str]:
+    """``*ELEMENT`` lines (C3D8) of ``cells``, which hold node numbers, numbered from ``first``."""
+    return [f"*ELEMENT, TYPE=C3D8, ELSET={elset}"] + [f"{first + e}, " + ", ".join(str(a) for a in c)
+                                                      for e, c in enumerate(np.asarray(cells).tolist())]
+
+
 def _plane(n0: int, e0: int, lo: float, hi: float, nxy: int, depth: float):
     """Nodes and C3D8 elements of a slab lo <= x, y <= hi, -depth <= z <= 0 (one layer)."""
     t = np.linspace(lo, hi, nxy + 1)
@@ -113,17 +125,11 @@ def hertz_deck(mesh: Mesh, material: str, E: float, nu: float, d_max: float, ste
     E, penalty, sigma_inf = E * S, penalty * S, sigma_inf * S
     nb, eb = mesh.n_nodes, mesh.n_cells
     P = mesh.points
-    lines = ["*HEADING", f"Hertz quarter ball, {eb} C3D8, {material}, d = {d_max:g} in {steps} increments",
-             "*NODE, NSET=NBALL"]
-    lines += [f"{a + 1}, {x:.12e}, {y:.12e}, {z:.12e}" for a, (x, y, z) in enumerate(P.tolist())]
-    lines.append("*ELEMENT, TYPE=C3D8, ELSET=EBALL")
-    lines += [f"{e + 1}, " + ", ".join(str(a + 1) for a in c) for e, c in enumerate(mesh.cells.tolist())]
+    lines = ["*HEADING", f"Hertz quarter ball, {eb} C3D8, {material}, d = {d_max:g} in {steps} increments"]
+    lines += _node_block("NBALL", 1, P) + _element_block("EBALL", 1, mesh.cells + 1)
     size = float(np.max(np.abs(P[:, :2]))) * 1.25
     pn, pe, ptop = _plane(nb + 1, eb + 1, -0.25 * size, size, plane_n, 0.1 * size)
-    lines.append("*NODE, NSET=NPLANE")
-    lines += [f"{nb + 1 + a}, {x:.12e}, {y:.12e}, {z:.12e}" for a, (x, y, z) in enumerate(pn)]
-    lines.append("*ELEMENT, TYPE=C3D8, ELSET=EPLANE")
-    lines += [f"{eb + 1 + e}, " + ", ".join(str(a) for a in c) for e, c in enumerate(pe)]
+    lines += _node_block("NPLANE", nb + 1, pn) + _element_block("EPLANE", eb + 1, pe)
     for name in ("flat", "symx", "symy", "curved"):
         lines.append(f"*NSET, NSET=N{name.upper()}")
         lines.append(_ids(mesh.node_sets[name] + 1))
@@ -176,7 +182,6 @@ def c10_d1(E: float, nu: float) -> tuple[float, float]:
     return mu / 2.0, 2.0 / (lam + 2.0 * mu / 3.0)
 
 
-
 def bodies_deck(problem, penalty: float | None = None, sigma_inf: float | None = None,
                 stress_scale: float = 1.0, report: tuple[str, str] = ("punch", "zmax")) -> tuple[str, DeckInfo]:
     """A covcontact problem of deformable hex8 bodies (St. Venant-Kirchhoff), constant Dirichlet conditions and
@@ -208,11 +213,8 @@ def bodies_deck(problem, penalty: float | None = None, sigma_inf: float | None =
         if b.mesh.cell_type != "hex8" or not isinstance(b.material, SaintVenantKirchhoff):
             raise ValueError(f"body {b.name!r}: only hex8 St. Venant-Kirchhoff bodies are written")
         offset[b.name], e_offset[b.name] = n_nodes, n_el
-        lines.append(f"*NODE, NSET=N{b.name.upper()}")
-        lines += [f"{n_nodes + a + 1}, {x:.12e}, {y:.12e}, {z:.12e}" for a, (x, y, z) in enumerate(b.mesh.points.tolist())]
-        lines.append(f"*ELEMENT, TYPE=C3D8, ELSET=E{b.name.upper()}")
-        lines += [f"{n_el + e + 1}, " + ", ".join(str(n_nodes + a + 1) for a in cell)
-                  for e, cell in enumerate(b.mesh.cells.tolist())]
+        lines += _node_block(f"N{b.name.upper()}", n_nodes + 1, b.mesh.points)
+        lines += _element_block(f"E{b.name.upper()}", n_el + 1, b.mesh.cells + n_nodes + 1)
         n_nodes += b.mesh.n_nodes
         n_el += b.mesh.n_cells
     meshes = {b.name: b.mesh for b in problem.bodies}

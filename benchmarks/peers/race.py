@@ -67,6 +67,8 @@ from hertz_setup import C_HERTZ, D_MAX, NU, E, hertz_mesh
 from kratos_deck import hertz_case, two_blocks_case, write_case
 from kratos_results import read_results
 
+from covcontact.problem import SolverOptions
+
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                "CCX_NPROC_EQUATION_SOLVER", "CCX_NPROC_STIFFNESS", "CCX_NPROC_RESULTS", "NUMBER_OF_CPUS")
 #: two_blocks sizes: (base nx = ny, base nz, punch nx = ny, punch nz); no punch node lies on a base facet edge
@@ -181,7 +183,7 @@ class Cell:
 
     def kratos_record(self) -> dict:
         r = read_results(self.kdir / "results.json")
-        part, scale = ("punch_zmax", 1.0) if self.problem == "two_blocks" else ("ball_flat", 4.0)
+        part, scale = "punch_zmax" if self.problem == "two_blocks" else "ball_flat", self.force_scale
         return {"converged": r.all_converged, "steps_converged": r.converged, "iterations": sum(r.iterations),
                 "iterations_per_step": r.iterations, "solve_s": r.analysis_s, "threads_reported": r.threads,
                 "version": r.version, "linear_solver": KRATOS_SOLVERS[self.args.kratos_solver],
@@ -322,7 +324,7 @@ def main(argv: list[str] | None = None) -> int:
                 records.append(race(Cell(problem, size, work, args), args.repeats))
     result = {"benchmark": "peers_race", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "cpus": os.cpu_count(), "threads": args.threads,
-              "covcontact_rtol": args.ours_rtol or 1e-8, "kratos_solver": args.kratos_solver,
+              "covcontact_rtol": args.ours_rtol or SolverOptions().rtol, "kratos_solver": args.kratos_solver,
               "repeats": args.repeats, "steps": STEPS,
               "kratos_version": records[0]["codes"]["kratos"]["version"] if records and args.kratos else None,
               "ccx_version": _ccx_version() if args.ccx else None, "covcontact": _covcontact_state(),
