@@ -19,6 +19,7 @@ from . import report
 from .assembly import ElementBlocks
 from .driver import EDGE, FACET, VERTEX, project_slaves
 from .edge import edge_vertex_contact
+from .edgelock import FREE, RELEASED, edge_point, inconsistent, new_locks
 from .element import CASE_A, CASES
 from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, transfer_history
 from .kernels import contact_batch
@@ -163,6 +164,8 @@ class ContactManager:
         t0 = time.perf_counter()
         res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi)
         self.timing["projection"] += time.perf_counter() - t0
+        if p.mu == 0.0:
+            t.edge_lock = self._hold(p, xe, res, g0)
         ok = res.kind != 0
         t.facet = np.where(ok, res.facet, -1).astype(np.int64)
         t.xi = np.where(ok[:, None], res.xi, 0.0)
@@ -217,6 +220,19 @@ class ContactManager:
             self._add(ev.blocks, conn, R, K if want_K else None, xe)
             if want_parts:
                 ev.parts[0].add(conn, np.zeros_like(R), K)
+
+    @staticmethod
+    def _hold(p: Pass, xe: np.ndarray, res, g0: PassState) -> np.ndarray:
+        """Edge locks (:mod:`.edgelock`): new ones (or pending marks) where a slave crossed a valley edge or
+        corner since the last iterate; the contact point of every held slave replaced in ``res`` by its point on
+        the edge or corner. Returns the locks."""
+        lock = g0.edge_lock.copy()
+        xs = xe[p.slaves]
+        idx, codes = new_locks(p.surface, xe, xs, lock, res.facet, res.xi, res.g, res.kind, g0.facet, g0.xi)
+        lock[idx] = codes
+        for s in np.flatnonzero(lock >= 0):
+            res.facet[s], res.xi[s], res.g[s], res.normal[s], res.kind[s] = edge_point(p.surface, xe, lock[s], xs[s])
+        return lock
 
     def _set_poses(self, x: np.ndarray) -> None:
         """The reference bodies' poses at the system positions x: rigid nodes and analytic surfaces follow."""
@@ -291,18 +307,43 @@ class ContactManager:
 
     # -- Uzawa ------------------------------------------------------------------------------------
     def augment(self, trial: ContactState) -> ContactState | None:
-        """Uzawa update lambda <- <lambda + eps_N g> of every augmented pass whose largest penetration
-        exceeds its tolerance (at most ``max_aug`` times per step): the new trial, or None when no pass
-        needs another Newton solve. ``trial`` itself is not changed."""
-        new = None
+        """The edge locks that disagree with the free projection released (:meth:`_release`); else the Uzawa
+        update lambda <- <lambda + eps_N g> of every augmented pass whose largest penetration exceeds its
+        tolerance (at most ``max_aug`` times per step): the new trial, or None when no pass needs another
+        Newton solve. ``trial`` itself is not changed."""
+        new = self._release(trial)
         for k, p in enumerate(self.passes):
             t = trial.passes[k]
+            if new is not None:  # Newton goes on with the released edge locks first
+                break
             if not p.augmented or t.n_aug >= p.max_aug or self._penetration(p, t) <= p.gap_tol:
                 continue
             new = new or trial.copy()
             q = new.passes[k]
             q.multiplier = uzawa_update(t.multiplier, t.gap, p.eps)
             q.n_aug += 1
+        return new
+
+    def _release(self, trial: ContactState) -> ContactState | None:
+        """The trial with the edge locks released that disagree with the free projection at its positions
+        (:func:`.edgelock.inconsistent`), or None when all agree."""
+        new = None
+        for k, p in enumerate(self.passes):
+            t = trial.passes[k]
+            held = np.flatnonzero(t.edge_lock >= 0)
+            if not held.size or p.surface is None or trial.x is None:
+                continue
+            xe = trial.x
+            cand = candidates(xe, p.surface, xe[p.slaves[held]], float(facet_sizes(xe, p.surface.faces).max()))
+            free = project_slaves(xe, p.surface, xe[p.slaves[held]], cand[0], cand[1], t.facet[held], t.xi[held],
+                                  tol_inside=0.0)
+            normal = np.zeros((held.size, 3))
+            for j, s in enumerate(held):
+                normal[j] = edge_point(p.surface, xe, t.edge_lock[s], xe[p.slaves[s]])[3]
+            bad = held[inconsistent(t.edge_lock[held], t.gap[held], normal, free.kind, free.g, free.normal)]
+            if bad.size:
+                new = new or trial.copy()
+                new.passes[k].edge_lock[bad] = RELEASED
         return new
 
     def _penetration(self, p: Pass, t: PassState) -> float:
@@ -314,6 +355,7 @@ class ContactManager:
         t = committed.copy()
         for p in t.passes:
             p.n_aug = 0
+            p.edge_lock[p.edge_lock < FREE] = FREE  # released and pending marks last one step
         return t
 
     # -- queries on a state -----------------------------------------------------------------------

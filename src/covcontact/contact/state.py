@@ -20,6 +20,8 @@ class PassState:
     """Per slave node of one pass (ns nodes).
 
     facet, xi: contact point (facet -1 and xi 0 without one; analytic masters keep facet -1);
+    edge_lock: a slave held on a master edge or corner (see :mod:`.edgelock`), -1 free, -2 released
+    in the current step;
     gap: geometric gap g (+inf without a contact point); force: (ns, 3) contact force on the node;
     status: friction state (0 open, 1 stick, 2 slip, 3 new); multiplier: Uzawa multiplier lam_k <= 0;
     hist, hist_facet: friction history (last converged tangential traction and contact point, on the
@@ -34,13 +36,15 @@ class PassState:
     multiplier: np.ndarray
     hist: np.ndarray
     hist_facet: np.ndarray
+    edge_lock: np.ndarray
     n_aug: int = 0
 
     @classmethod
     def empty(cls, ns: int) -> PassState:
         return cls(facet=np.full(ns, -1, dtype=np.int64), xi=np.zeros((ns, 2)), gap=np.full(ns, np.inf),
                    force=np.zeros((ns, 3)), status=np.zeros(ns, dtype=np.int64), multiplier=np.zeros(ns),
-                   hist=np.zeros((ns, HIST_SIZE)), hist_facet=np.full(ns, -1, dtype=np.int64))
+                   hist=np.zeros((ns, HIST_SIZE)), hist_facet=np.full(ns, -1, dtype=np.int64),
+                   edge_lock=np.full(ns, -1, dtype=np.int64))
 
     def copy(self) -> PassState:
         return PassState(**{f.name: (getattr(self, f.name).copy() if f.name != "n_aug" else self.n_aug)
@@ -51,7 +55,9 @@ class PassState:
 
     @classmethod
     def from_arrays(cls, data, prefix: str) -> PassState:
-        kw = {f.name: np.array(data[f"{prefix}.{f.name}"]) for f in fields(cls)}
+        kw = {f.name: np.array(data[f"{prefix}.{f.name}"]) for f in fields(cls) if f"{prefix}.{f.name}" in data
+              or f.name != "edge_lock"}
+        kw.setdefault("edge_lock", np.full(len(kw["facet"]), -1, dtype=np.int64))  # checkpoints before edge locks
         kw["n_aug"] = int(kw["n_aug"])
         return cls(**kw)
 

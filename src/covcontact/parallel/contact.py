@@ -49,6 +49,13 @@ class DistributedContact(ContactManager):
         """The Uzawa test looks at the slaves of all ranks."""
         return max_all(self.comm, super()._penetration(p, t))
 
+    def _release(self, trial):
+        """Edge locks are released on each rank's slaves; if any rank releases one, every rank solves again."""
+        new = super()._release(trial)
+        if count_all(self.comm, int(new is not None)) and new is None:
+            new = trial.copy()
+        return new
+
     def gather(self, rows: list) -> list[list]:
         return gather_all(self.comm, rows)
 
