@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from covcontact.io.loader import load_problem
+from covcontact.problem import Steps
 from covcontact.solvers.linear import available
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -100,3 +101,25 @@ def test_reuse_option_in_the_input(tmp_path):
 
             with pytest.raises(InputError, match=r"solver\.reuse_factorization: must be true, false or \"auto\""):
                 load_problem(path)
+
+
+@pytest.mark.skipif("cg-amg" not in available(), reason="pyamg not installed")
+def test_amg_stops_cg_at_the_forcing_term(tmp_path):
+    """cg-amg with reuse on: each correction is CG on a new hierarchy stopped at Newton's forcing term; the Newton
+    iterations and the results are those of the solver's own 1e-10 solves."""
+    path = ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml"
+    runs = {}
+    for reuse in (False, True):
+        problem = load_problem(path)
+        problem.solver = dataclasses.replace(problem.solver, reuse_factorization=reuse, linear="cg-amg")
+        problem.steps = Steps((0.1, 0.2, 0.3))  # the first three of its ten steps
+        res = problem.run(out=tmp_path / str(reuse), quiet=True)
+        assert res.exit_code == 0
+        runs[reuse] = res.summary["steps"]
+    plain, reuse = runs[False], runs[True]
+    assert [s["iterations"] for s in reuse] == [s["iterations"] for s in plain]
+    assert [s["factorizations"] for s in reuse] == [s["iterations"] for s in reuse]
+    assert all(s["krylov_iterations"] > 0 for s in reuse) and all(s["krylov_iterations"] == 0 for s in plain)
+    for a, b in zip(plain, reuse, strict=True):
+        np.testing.assert_allclose(b["contact_force"], a["contact_force"], rtol=1e-8,
+                                   atol=1e-8 * np.linalg.norm(a["contact_force"]))

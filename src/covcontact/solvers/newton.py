@@ -44,6 +44,10 @@ from ..assembly.system import InvertedElementError
 from .linear import LinearSolverError, SingularMatrixError, make_solver
 
 
+#: relative residual of the first correction of a step with an AMG solver and reuse on
+AMG_FIRST = 1e-6
+
+
 def gmres_right(A, b: np.ndarray, prec, tol: float, m: int):
     """One cycle of GMRES(m) on A x = b from x = 0 with right preconditioning x = prec(y): the Arnoldi basis
     by classical Gram-Schmidt with one reorthogonalisation, Givens rotations for the least-squares problem.
@@ -154,11 +158,38 @@ class Newton:
         self.stats["krylov_solves"] += 1
         return du
 
-    def _solve(self, K, rhs, eta: float | None = None):
+    def _amg(self, K, rhs, eta: float):
+        """CG (GMRES) preconditioned by the AMG hierarchy just built, to ``eta``; None when it does not converge
+        within the solver's ``maxiter``."""
+        t0 = time.perf_counter()
+        du, its = self.linear.solve_preconditioned(K, rhs, eta)
+        self.timing["krylov"] += time.perf_counter() - t0
+        self.stats["krylov_iterations"] += its
+        if du is None or float(np.linalg.norm(rhs - K @ du)) > 1.01 * eta * float(np.linalg.norm(rhs)):
+            return None
+        self.stats["krylov_solves"] += 1
+        return du
+
+    def _solve(self, K, rhs, eta: float | None = None, loose: float | None = None):
+        """The Newton correction: a new factorisation, or (``eta`` given, reuse on) GMRES on the last one to
+        ``eta``. With an AMG solver and reuse on, each correction builds a new hierarchy and stops CG at
+        ``AMG_FIRST`` (the step's first correction) or at the linear forcing term ``loose`` (a CG iteration on a
+        V-cycle gains far less than a GMRES iteration on an exact factorisation; Newton keeps its iteration
+        count). Keeping one hierarchy for a step was measured too: on the Hertz ball its extra CG iterations
+        cost what the saved set-ups gained (docs/performance.md)."""
         reuse = self.opt.reuse_factorization
-        if (eta is not None and reuse and self.linear.direct and not self._stalled and not self._failed
-                and getattr(self.linear, "_K", None) is not None and self.linear._K.shape == K.shape
-                and (reuse is True or self.linear.reuse_pays())):
+        if reuse and hasattr(self.linear, "solve_preconditioned") and not self._failed:
+            self.stats["factorizations"] += 1
+            t0 = time.perf_counter()
+            self.linear.factorize(K)
+            self.timing["factor"] += time.perf_counter() - t0
+            du = self._amg(K, rhs, AMG_FIRST if eta is None else loose)
+            if du is not None:
+                return du
+            self._failed = True  # the solver's own solve (to its rtol, with GMRES after CG) below
+        ready = (eta is not None and reuse and not self._stalled and not self._failed
+                 and getattr(self.linear, "_K", None) is not None and self.linear._K.shape == K.shape)
+        if ready and self.linear.direct and (reuse is True or self.linear.reuse_pays()):
             du = self._krylov(K, rhs, eta)
             if du is not None:
                 return du
@@ -237,15 +268,16 @@ class Newton:
         r_ref = r0  # max(||R_0||, ||R_1||) once the first correction is made
         inexact = False
         for it in range(1, opt.max_iterations + 1):
-            eta = None  # the first correction of a step: a new factorisation (see _solve)
+            eta = loose = None  # the first correction of a step: a new factorisation (see _solve)
             if it > 1:  # GMRES tolerance relative to ||rhs||: quadratic forcing, and 1 % of the convergence
                 # threshold, so that the iterate is that of exact Newton to well within the test
                 threshold = max(opt.rtol * r_ref, opt.atol * scale)
-                eta = min(1e-4, 1e-4 * rn_prev / r_ref, 1e-2 * threshold / max(rn_prev, 1e-300))
+                loose = min(1e-4, 1e-2 * threshold / max(rn_prev, 1e-300))
+                eta = min(1e-4 * rn_prev / r_ref, loose)
             n_fact, n_kry = self.stats["factorizations"], self.stats["krylov_iterations"]
             # the first correction of a step is always made with a new factorisation: a step's iterations then
             # do not depend on how the run got there (a resumed run has no factorisation to reuse)
-            du = self._solve(K, rhs, eta)
+            du = self._solve(K, rhs, eta, loose)
             inexact = self.stats["factorizations"] == n_fact
             du[~free] = du_d[~free] if it == 1 else 0.0
             eta = 1.0
