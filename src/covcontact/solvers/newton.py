@@ -43,7 +43,6 @@ import numpy as np
 from ..assembly.system import InvertedElementError
 from .linear import LinearSolverError, SingularMatrixError, make_solver
 
-
 #: relative residual of the first correction of a step with an AMG solver and reuse on
 AMG_FIRST = 1e-6
 
