@@ -187,7 +187,7 @@ def race(n: int, material: str, args, work: Path) -> dict:
     F_diff = np.array(ccx["F"]) / np.array(ours["F"]) - 1.0 if len(ccx["F"]) == len(ours["F"]) else [np.nan]
     rec = {"cell": "hex8", "n": n, "nr": n // 2, "material": material,
            "ccx_material": "*ELASTIC (NLGEOM)" if material == "svk" else "*HYPERELASTIC, NEO HOOKE",
-           "nodes": info.ball_nodes, "elements": info.ball_elements, "dofs": 3 * info.ball_nodes,
+           "nodes": info.body_nodes, "elements": info.body_elements, "dofs": 3 * info.body_nodes,
            "ours": ours, "ccx": ccx,
            "wall_median_ours_s": round(mo, 3), "wall_median_ccx_s": round(mc, 3),
            "time_ratio_ccx_over_ours": round(mc / mo, 3),

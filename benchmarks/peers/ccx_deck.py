@@ -36,13 +36,13 @@ C3D8_FACES = ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 
 class DeckInfo:
     """Counts and numbering of a written deck."""
 
-    n_nodes: int          # all nodes (ball + plane)
-    n_elements: int       # all elements (ball + plane)
-    ball_nodes: int
-    ball_elements: int
+    n_nodes: int          # all nodes (deformable bodies + rigid plane)
+    n_elements: int       # all elements (deformable bodies + rigid plane)
+    body_nodes: int       # nodes of the deformable bodies (the ball; both blocks)
+    body_elements: int    # elements of the deformable bodies
     slave_faces: int
     master_faces: int
-    plane_node0: int      # first node number of the plane (1-based)
+    rigid_node0: int      # first node number of the rigid plane (1-based; n_nodes + 1 without one)
 
 
 def face_numbers(mesh: Mesh, set_name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -171,8 +171,8 @@ def hertz_deck(mesh: Mesh, material: str, E: float, nu: float, d_max: float, ste
     if frd:
         lines += ["*NODE FILE", "U", "*CONTACT FILE", "CSTR"]
     lines += ["*END STEP", ""]
-    info = DeckInfo(n_nodes=nb + len(pn), n_elements=eb + len(pe), ball_nodes=nb, ball_elements=eb,
-                    slave_faces=len(se), master_faces=len(ptop), plane_node0=nb + 1)
+    info = DeckInfo(n_nodes=nb + len(pn), n_elements=eb + len(pe), body_nodes=nb, body_elements=eb,
+                    slave_faces=len(se), master_faces=len(ptop), rigid_node0=nb + 1)
     return "\n".join(lines), info
 
 
@@ -257,6 +257,6 @@ def bodies_deck(problem, penalty: float | None = None, sigma_inf: float | None =
               f"*NODE PRINT, NSET={report_set}, TOTALS=ONLY",
               "RF",
               "*END STEP", ""]
-    info = DeckInfo(n_nodes=n_nodes, n_elements=n_el, ball_nodes=n_nodes, ball_elements=n_el,
-                    slave_faces=n_slave, master_faces=n_master, plane_node0=n_nodes + 1)
+    info = DeckInfo(n_nodes=n_nodes, n_elements=n_el, body_nodes=n_nodes, body_elements=n_el,
+                    slave_faces=n_slave, master_faces=n_master, rigid_node0=n_nodes + 1)
     return "\n".join(lines), info

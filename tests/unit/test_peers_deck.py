@@ -42,7 +42,7 @@ def test_counts(mesh, plane_n):
     text, info = hertz_deck(mesh, "svk", 1.0, 0.3, 0.01, 10, 1e4, plane_n=plane_n)
     b = _blocks(text)
     n_plane = 2 * (plane_n + 1) ** 2
-    assert info.ball_nodes == mesh.n_nodes == 175 and info.ball_elements == mesh.n_cells == 108
+    assert info.body_nodes == mesh.n_nodes == 175 and info.body_elements == mesh.n_cells == 108
     assert len(b["*NODE"]) == info.n_nodes == mesh.n_nodes + n_plane
     assert len(b["*ELEMENT"]) == info.n_elements == mesh.n_cells + plane_n**2
     assert all(len(row) == 9 for row in b["*ELEMENT"])
