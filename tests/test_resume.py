@@ -207,3 +207,23 @@ def test_checkpoint_every(tmp_path):
     res = _run(problem, out, "--resume", "--quiet")
     assert res.returncode == 0, res.stderr
     assert [s["step"] for s in _summary(out)["steps"]] == list(range(1, 13))
+
+
+def test_a_signal_inside_compiled_code_is_an_interruption():
+    """A stop signal that lands while compiled code calls back into Python arrives as a SystemError whose cause is
+    the Interrupted of the handler; the run treats it as the stop (exit code 143, resumable), not as a crash."""
+    import signal
+
+    from covcontact.solvers.run import _interruption
+    from covcontact.solvers.signals import Interrupted
+
+    stop = Interrupted(signal.SIGTERM)
+    try:
+        try:
+            raise stop
+        except Interrupted as inner:
+            raise SystemError("returned a result with an exception set") from inner
+    except SystemError as wrapped:
+        assert _interruption(wrapped) is stop
+    assert _interruption(SystemError("something else")) is None
+    assert _interruption(stop).exit_code == 143

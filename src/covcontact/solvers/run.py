@@ -314,12 +314,25 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                                             rank, size)
                 if status == "failed":
                     break
-        except Interrupted as stop:
+        except (Interrupted, SystemError) as exc:
+            stop = _interruption(exc)
+            if stop is None:
+                raise
             status, code = "interrupted", stop.exit_code
             say(f"{stop}: the step in flight is dropped; resume with --resume")
         with stops.critical():
             _finish(problem, model, newton, summary, status, t_before, t_start, t_out, writer, root, quiet, say, out)
     return Result(summary=summary, u=u, out=out, exit_code=code, model=model, state=state)
+
+
+def _interruption(exc: BaseException) -> Interrupted | None:
+    """The Interrupted behind ``exc``: itself, or the cause of a SystemError (a signal that arrived while
+    compiled code called back into Python, e.g. numba loading a cached function, comes out wrapped so)."""
+    while exc is not None:
+        if isinstance(exc, Interrupted):
+            return exc
+        exc = exc.__cause__ or exc.__context__
+    return None
 
 
 def _stage_entry(summary: dict, spec) -> None:
