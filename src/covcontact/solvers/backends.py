@@ -505,10 +505,12 @@ class AMGSolver(LinearSolver):
         )
         self._stale = False
 
-    def solve_preconditioned(self, K, b: np.ndarray, rtol: float) -> tuple[np.ndarray | None, int]:
+    def solve_preconditioned(self, K, b: np.ndarray, rtol: float, maxiter: int | None = None
+                             ) -> tuple[np.ndarray | None, int]:
         """Solve K x = b to the relative residual ``rtol`` by CG (GMRES for a non-symmetric solver) with the
-        hierarchy of the last factorisation (of an earlier K of the same size) as preconditioner: (x, its), x
-        None when it does not converge within ``maxiter`` iterations (the caller then factorises K)."""
+        hierarchy of the last factorisation (of K or an earlier K of the same size) as preconditioner: (x, its),
+        x None when it does not converge within ``maxiter`` iterations (default: the solver's)."""
+        maxiter = self.maxiter if maxiter is None else maxiter
         if self._ml is None or self._stale or self._K is None or K.shape != self._K.shape:
             return None, 0
         M = self._ml.aspreconditioner(cycle="V")
@@ -518,10 +520,10 @@ class AMGSolver(LinearSolver):
             count[0] += 1
 
         if self.symmetric:
-            x, info = sla.cg(K, b, rtol=rtol, atol=0.0, maxiter=self.maxiter, M=M, callback=tick)
+            x, info = sla.cg(K, b, rtol=rtol, atol=0.0, maxiter=maxiter, M=M, callback=tick)
         else:
-            x, info = sla.gmres(K, b, rtol=rtol, atol=0.0, restart=50, M=M, callback=tick,
-                                maxiter=max(1, self.maxiter // 50), callback_type="pr_norm")
+            x, info = sla.gmres(K, b, rtol=rtol, atol=0.0, restart=min(50, maxiter), M=M, callback=tick,
+                                maxiter=max(1, maxiter // 50), callback_type="pr_norm")
         if info != 0 or not np.isfinite(x).all():
             return None, count[0]
         return x, count[0]

@@ -45,6 +45,9 @@ from .linear import LinearSolverError, SingularMatrixError, make_solver
 
 #: relative residual of the first correction of a step with an AMG solver and reuse on
 AMG_FIRST = 1e-6
+#: a later correction of the step keeps its AMG hierarchy if CG converges within this many times the first
+#: correction's iterations (+ 10)
+AMG_REUSE_FACTOR = 2
 
 
 def gmres_right(A, b: np.ndarray, prec, tol: float, m: int):
@@ -135,6 +138,8 @@ class Newton:
         self.scale_seen = 0.0  # the largest force scale of the converged steps so far
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}
         self.stats = {"factorizations": 0, "krylov_solves": 0, "krylov_iterations": 0}
+        self._amg_first = 0  # AMG with reuse: CG iterations of the step's first correction
+        self._amg_fresh = False  # a new hierarchy at every further correction of the step
         self._stalled = False  # the last inexact correction did not reduce the residual enough
         self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
@@ -157,32 +162,43 @@ class Newton:
         self.stats["krylov_solves"] += 1
         return du
 
-    def _amg(self, K, rhs, eta: float):
-        """CG (GMRES) preconditioned by the AMG hierarchy just built, to ``eta``; None when it does not converge
-        within the solver's ``maxiter``."""
+    def _amg(self, K, rhs, eta: float, maxiter: int | None = None):
+        """CG (GMRES) preconditioned by the current AMG hierarchy, to ``eta``: (du or None when it does not
+        converge within ``maxiter``, default the solver's, iterations)."""
         t0 = time.perf_counter()
-        du, its = self.linear.solve_preconditioned(K, rhs, eta)
+        du, its = self.linear.solve_preconditioned(K, rhs, eta, maxiter)
         self.timing["krylov"] += time.perf_counter() - t0
         self.stats["krylov_iterations"] += its
         if du is None or float(np.linalg.norm(rhs - K @ du)) > 1.01 * eta * float(np.linalg.norm(rhs)):
-            return None
+            return None, its
         self.stats["krylov_solves"] += 1
-        return du
+        return du, its
 
     def _solve(self, K, rhs, eta: float | None = None, loose: float | None = None):
         """The Newton correction: a new factorisation, or (``eta`` given, reuse on) GMRES on the last one to
-        ``eta``. With an AMG solver and reuse on, each correction builds a new hierarchy and stops CG at
-        ``AMG_FIRST`` (the step's first correction) or at the linear forcing term ``loose`` (a CG iteration on a
-        V-cycle gains far less than a GMRES iteration on an exact factorisation; Newton keeps its iteration
-        count). Keeping one hierarchy for a step was measured too: on the Hertz ball its extra CG iterations
-        cost what the saved set-ups gained (docs/performance.md)."""
+        ``eta``. With an AMG solver and reuse on, each correction is CG preconditioned by an AMG hierarchy, to
+        ``AMG_FIRST`` at the step's first correction, which builds the hierarchy, and to the linear forcing term
+        ``loose`` afterwards (a CG iteration on a V-cycle gains far less than a GMRES iteration on an exact
+        factorisation; Newton keeps its iteration count). A later correction first tries the step's hierarchy
+        with at most ``AMG_REUSE_FACTOR`` times the first solve's iterations (+ 10); if that is not enough, the
+        tangent has moved too far from it and every further correction of the step builds its own. The rule
+        counts iterations, not seconds, so it decides alike on every run (a resumed run repeats the
+        uninterrupted one)."""
         reuse = self.opt.reuse_factorization
-        if reuse and hasattr(self.linear, "solve_preconditioned") and not self._failed:
+        amg = bool(reuse) and hasattr(self.linear, "solve_preconditioned") and not self._failed
+        if amg and eta is not None and not self._amg_fresh:
+            du, _ = self._amg(K, rhs, loose, AMG_REUSE_FACTOR * self._amg_first + 10)
+            if du is not None:
+                return du
+            self._amg_fresh = True
+        if amg:
             self.stats["factorizations"] += 1
             t0 = time.perf_counter()
             self.linear.factorize(K)
             self.timing["factor"] += time.perf_counter() - t0
-            du = self._amg(K, rhs, AMG_FIRST if eta is None else loose)
+            du, its = self._amg(K, rhs, AMG_FIRST if eta is None else loose)
+            if eta is None:
+                self._amg_first, self._amg_fresh = its, False
             if du is not None:
                 return du
             self._failed = True  # the solver's own solve (to its rtol, with GMRES after CG) below
