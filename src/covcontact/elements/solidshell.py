@@ -25,7 +25,8 @@ plastic materials) adds the EAS modes E_tt P_k(t), k = 2 .. points - 1, so that 
 free at every thickness level (plastic incompressibility at finite strain asks for a thickness strain
 that is not linear in t; without them plastic bending locks).
 
-Kernels: :mod:`covcontact.elements.solidshell_kernels` (element routines) and
+Kernels: :mod:`covcontact.elements.solidshell_kernels` (element routines; :mod:`.solidshell_dense` its small
+dense factorisations) and
 :mod:`covcontact.elements.solidshell_loops` (parallel loops over elements).
 """
 
