@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..fem.shapes import shape_functions
+from .driver import EDGE, FACET, VERTEX
 from .surface import EDGE_DIR, EDGE_START, edge_closest_point, facet_frame
 
 #: largest distance (element coordinates) of both contact points from the shared edge for a lock
@@ -39,12 +40,20 @@ RELEASED = -2
 #: PENDING - f: the slave crossed a valley edge or corner, leaving facet f, at the last iterate
 PENDING = -3
 
-_KIND_EDGE = 2
-_KIND_VERTEX = 3
-
 
 def _edge_xi(e: int, t: float) -> np.ndarray:
     return np.array([EDGE_START[e, 0] + (t + 1.0) * EDGE_DIR[e, 0], EDGE_START[e, 1] + (t + 1.0) * EDGE_DIR[e, 1]])
+
+
+def _across(surface, f: int, e: int, t: float) -> tuple[int, int, float]:
+    """The neighbour of facet f across its local edge e, that edge's number on the neighbour and the parameter
+    there of the point t of edge e (the edges of consistently oriented facets run in opposite directions); the
+    neighbour is -1 at a boundary edge."""
+    nb = int(surface.nbr_facet[f, e])
+    if nb < 0:
+        return nb, -1, t
+    ne = int(surface.nbr_edge[f, e])
+    return nb, ne, -t if surface.faces[nb, ne] == surface.faces[f, (e + 1) % 4] else t
 
 
 def _off_edge(xi: np.ndarray, e: int) -> float:
@@ -95,16 +104,14 @@ def edge_point(surface, x: np.ndarray, code: int, xs: np.ndarray) -> tuple[int, 
         t, _ = edge_closest_point(xyz, e, xs, c)
         xi = _edge_xi(e, t)
         nsum = _normal(xyz, xi)
-        nb = int(surface.nbr_facet[f, e])
+        nb, ne, tn = _across(surface, f, e, t)
         if nb >= 0:
-            ne = int(surface.nbr_edge[f, e])
-            tn = -t if faces[nb, ne] == faces[f, (e + 1) % 4] else t
             nsum = nsum + _normal(np.ascontiguousarray(x[faces[nb]]), _edge_xi(ne, tn))
     d = xs - c
     dist = float(np.linalg.norm(d))
     sign = 1.0 if float(d @ nsum) >= 0.0 else -1.0
     n = sign * d / dist if dist > 0.0 else nsum / max(float(np.linalg.norm(nsum)), 1e-300)
-    kind = _KIND_VERTEX if abs(t) >= 1.0 - 1e-12 else _KIND_EDGE
+    kind = VERTEX if abs(t) >= 1.0 - 1e-12 else EDGE
     return f, xi, sign * dist, n, kind
 
 
@@ -114,12 +121,13 @@ def _valley(xa, xb, na, nb, c, cell) -> bool:
 
 
 def new_locks(surface, x: np.ndarray, xs: np.ndarray, lock: np.ndarray, facet: np.ndarray, xi: np.ndarray,
-              gap: np.ndarray, kind: np.ndarray, prev_facet: np.ndarray, prev_xi: np.ndarray) -> np.ndarray:
+              gap: np.ndarray, kind: np.ndarray, prev_facet: np.ndarray, prev_xi: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
     """New lock values (slave indices and values) of the free or pending, penetrating slaves on a facet that
     shares a valley edge or corner with the facet they had at the previous iterate, both contact points
     within BAND of it: a lock where the slave crossed back to the facet it left at its last crossing (the
     cycle), else a pending mark (a slave that crosses once and stays on its new facet is never held)."""
-    cand = np.flatnonzero(((lock == FREE) | (lock <= PENDING)) & (kind == 1) & (prev_facet >= 0) & (facet >= 0)
+    cand = np.flatnonzero(((lock == FREE) | (lock <= PENDING)) & (kind == FACET) & (prev_facet >= 0) & (facet >= 0)
                           & (facet != prev_facet) & (gap < 0.0))
     idx, codes = [], []
 
@@ -136,12 +144,11 @@ def new_locks(surface, x: np.ndarray, xs: np.ndarray, lock: np.ndarray, facet: n
         hit = np.flatnonzero(surface.nbr_facet[fa] == fb)
         if hit.size == 1:  # across an edge
             e = int(hit[0])
-            eb = int(surface.nbr_edge[fa, e])
-            if _off_edge(prev_xi[s], e) > BAND or _off_edge(xi[s], eb) > BAND:
-                continue
             c = np.empty(3)
             t, _ = edge_closest_point(xa, e, np.ascontiguousarray(xs[s], dtype=np.float64), c)
-            tb = -t if faces[fb, eb] == faces[fa, (e + 1) % 4] else t
+            _, eb, tb = _across(surface, fa, e, t)
+            if _off_edge(prev_xi[s], e) > BAND or _off_edge(xi[s], eb) > BAND:
+                continue
             if _valley(xa, xb, _normal(xa, _edge_xi(e, t)), _normal(xb, _edge_xi(eb, tb)), c, cell):
                 cross(s, 8 * fa + e)
             continue
@@ -163,4 +170,4 @@ def inconsistent(lock: np.ndarray, gap: np.ndarray, normal: np.ndarray, free_kin
     facet point whose gap vector g n differs from the locked one by more than AGREE |g|: the slave rests on a
     facet, not in the wedge of its edge."""
     diff = np.linalg.norm(free_gap[:, None] * free_normal - gap[:, None] * normal, axis=1) if len(gap) else gap
-    return np.flatnonzero((lock >= 0) & (free_kind == 1) & ~(diff <= AGREE * np.abs(gap)))
+    return np.flatnonzero((lock >= 0) & (free_kind == FACET) & ~(diff <= AGREE * np.abs(gap)))

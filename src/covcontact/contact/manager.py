@@ -312,10 +312,10 @@ class ContactManager:
         tolerance (at most ``max_aug`` times per step): the new trial, or None when no pass needs another
         Newton solve. ``trial`` itself is not changed."""
         new = self._release(trial)
+        if new is not None:  # Newton goes on with the released edge locks first
+            return new
         for k, p in enumerate(self.passes):
             t = trial.passes[k]
-            if new is not None:  # Newton goes on with the released edge locks first
-                break
             if not p.augmented or t.n_aug >= p.max_aug or self._penetration(p, t) <= p.gap_tol:
                 continue
             new = new or trial.copy()

@@ -148,31 +148,30 @@ class Newton:
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
         return self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=self.timing)
 
-    def _krylov(self, K, rhs, eta: float):
-        """GMRES on K du = rhs, right-preconditioned by the last factorisation (so that its residual is the
-        true one); None when it needs more than ``krylov_max`` iterations (or breaks down)."""
+    def _inexact(self, K, rhs, eta: float, solve):
+        """An inexact correction ``solve()`` -> (du or None, Krylov iterations), timed and counted: (du, its), du
+        None when the Krylov method gave up or broke down or the true residual misses ``eta`` ||rhs||."""
         t0 = time.perf_counter()
-        du, its = gmres_right(K, rhs, self.linear._solve, eta, self.opt.krylov_max)
+        du, its = solve()
         self.timing["krylov"] += time.perf_counter() - t0
         self.stats["krylov_iterations"] += its
         if du is None or not np.all(np.isfinite(du)):
-            return None
+            return None, its
         if float(np.linalg.norm(rhs - K @ du)) > 1.01 * eta * float(np.linalg.norm(rhs)):
-            return None  # judged on the true residual
+            return None, its  # judged on the true residual
         self.stats["krylov_solves"] += 1
-        return du
+        return du, its
+
+    def _krylov(self, K, rhs, eta: float):
+        """GMRES on K du = rhs, right-preconditioned by the last factorisation (so that its residual is the
+        true one); None when it needs more than ``krylov_max`` iterations (or breaks down)."""
+        return self._inexact(K, rhs, eta, lambda: gmres_right(K, rhs, self.linear._solve, eta,
+                                                               self.opt.krylov_max))[0]
 
     def _amg(self, K, rhs, eta: float, maxiter: int | None = None):
         """CG (GMRES) preconditioned by the current AMG hierarchy, to ``eta``: (du or None when it does not
         converge within ``maxiter``, default the solver's, iterations)."""
-        t0 = time.perf_counter()
-        du, its = self.linear.solve_preconditioned(K, rhs, eta, maxiter)
-        self.timing["krylov"] += time.perf_counter() - t0
-        self.stats["krylov_iterations"] += its
-        if du is None or float(np.linalg.norm(rhs - K @ du)) > 1.01 * eta * float(np.linalg.norm(rhs)):
-            return None, its
-        self.stats["krylov_solves"] += 1
-        return du, its
+        return self._inexact(K, rhs, eta, lambda: self.linear.solve_preconditioned(K, rhs, eta, maxiter))
 
     def _solve(self, K, rhs, eta: float | None = None, loose: float | None = None):
         """The Newton correction: a new factorisation, or (``eta`` given, reuse on) GMRES on the last one to
