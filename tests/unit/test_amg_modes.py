@@ -218,3 +218,57 @@ def test_amg_rebuilds_when_the_modes_change(cube):
     s.set_near_null_space(B[:-3])
     with pytest.raises(ValueError, match="rows"):
         s.solve(K, rhs)
+
+
+needs_gamg = pytest.mark.skipif("petsc-gamg" not in AVAILABLE, reason="petsc4py not installed (the `mpi` extra)")
+
+
+@needs_gamg
+def test_gamg_takes_the_modes_and_node_blocks(cube):
+    """petsc-gamg on a SciPy matrix (one process): ``set_near_null_space`` gives GAMG the rigid-body modes and
+    3 x 3 node blocks, which cut its CG iterations against its default (constants, scalar rows)."""
+    K, rhs, X, constrained = cube
+    plain = make_solver("petsc-gamg")
+    x0 = plain.solve(K, rhs)
+    rbm = make_solver("petsc-gamg")
+    rbm.set_near_null_space(rigid_body_modes(X, constrained))
+    x = rbm.solve(K, rhs)
+    assert rbm._op.A.getBlockSize() == 3 and plain._op.A.getBlockSize() == 1
+    assert rel_residual(K, x, rhs) < 1e-9
+    assert np.linalg.norm(x - x0) <= 1e-7 * np.linalg.norm(x0)
+    print(f"CG iterations: plain {plain.iterations}, rigid-body modes {rbm.iterations}")
+    assert 0 < rbm.iterations and 2 * rbm.iterations <= plain.iterations
+    rbm.set_geometry(X)  # the older interface; the last call wins (every dof a node's: blocks, no zero rows)
+    rbm.solve(K, rhs)
+    assert rbm._op.A.getBlockSize() == 3
+
+
+AMG = [name for name in ("cg-amg", "petsc-gamg") if name in AVAILABLE]
+
+
+@pytest.mark.parametrize("name", AMG)
+def test_hierarchy_preconditions_a_later_matrix_of_the_same_pattern(name, cube):
+    """Newton's inexact corrections: the hierarchy of one tangent preconditions CG on a later one of the same
+    sparsity pattern (to the requested relative residual of the later matrix); a matrix with a new entry
+    (a new contact coupling) does not fit, nor one of another size."""
+    K, rhs, X, constrained = cube
+    s = make_solver(name)
+    s.set_near_null_space(rigid_body_modes(X, constrained))
+    s.factorize(K)
+    x, its = s.solve_preconditioned(K, rhs, 1e-6)
+    assert x is not None and 0 < its and rel_residual(K, x, rhs) <= 1e-6
+    K2 = K.copy()  # same pattern (explicit zeros included), other values: 1.3 K + a positive diagonal
+    K2.data *= 1.3
+    free = ~constrained
+    K2.setdiag(np.where(free, K.diagonal() * 1.3 * (1.0 + 0.5 * np.cos(np.arange(K.shape[0])) ** 2), 1.0))
+    assert s.preconditioner_fits(K2)
+    x2, its2 = s.solve_preconditioned(K2, rhs, 1e-8)
+    assert x2 is not None and rel_residual(K2, x2, rhs) <= 1.01e-8 and its2 > its
+    assert rel_residual(K, x2, rhs) > 1e-3  # it solved K2, not K
+    x3, its3 = s.solve_preconditioned(K2, rhs, 1e-8, maxiter=2)  # too few iterations: no answer
+    assert x3 is None and its3 == 2
+    K3 = K.tolil()
+    i, j = np.flatnonzero(~constrained)[[0, -1]]
+    K3[i, j] = K3[j, i] = 1e-3  # a coupling of two distant free dofs
+    assert not s.preconditioner_fits(K3.tocsr())
+    assert not s.preconditioner_fits(K[:-3, :-3].tocsr())

@@ -103,16 +103,20 @@ def test_reuse_option_in_the_input(tmp_path):
                 load_problem(path)
 
 
-@pytest.mark.skipif("cg-amg" not in available(), reason="pyamg not installed")
-def test_amg_stops_cg_at_the_forcing_term(tmp_path):
-    """cg-amg with reuse on: CG stopped at Newton's forcing term on the step's hierarchy (the two blocks' tangent
-    changes little within a step, so one hierarchy per step); the Newton iterations and the results are those
-    of a hierarchy and a 1e-10 solve per iteration."""
+AMG = [name for name in ("cg-amg", "petsc-gamg") if name in available()]
+
+
+@pytest.mark.parametrize("amg", AMG)
+def test_amg_stops_cg_at_the_forcing_term(tmp_path, amg):
+    """cg-amg (pyamg) and petsc-gamg (PETSc's GAMG, the distributed model on one process) with reuse on: CG
+    stopped at Newton's forcing term on the step's hierarchy (the two blocks' tangent changes little within a
+    step, so one hierarchy per step); the Newton iterations and the results are those of a hierarchy and a
+    1e-10 solve per iteration."""
     path = ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml"
     runs = {}
     for reuse in (False, True):
         problem = load_problem(path)
-        problem.solver = dataclasses.replace(problem.solver, reuse_factorization=reuse, linear="cg-amg")
+        problem.solver = dataclasses.replace(problem.solver, reuse_factorization=reuse, linear=amg)
         problem.steps = Steps((0.1, 0.2, 0.3))  # the first three of its ten steps
         res = problem.run(out=tmp_path / str(reuse), quiet=True)
         assert res.exit_code == 0
@@ -127,11 +131,11 @@ def test_amg_stops_cg_at_the_forcing_term(tmp_path):
                                    atol=1e-8 * np.linalg.norm(a["contact_force"]))
 
 
-@pytest.mark.skipif("cg-amg" not in available(), reason="pyamg not installed")
-def test_amg_builds_a_new_hierarchy_when_the_old_one_is_slow(tmp_path):
-    """On the Hertz ball the contact zone changes the tangent between iterations: CG on the step's hierarchy
-    needs more than twice the first correction's iterations, so the step's later corrections build their own;
-    the Newton iterations stay those of the solver's own solves."""
+@pytest.mark.parametrize("amg", AMG)
+def test_amg_builds_new_hierarchies_on_the_hertz_ball(tmp_path, amg):
+    """On the Hertz ball the contact zone changes the tangent between iterations (new couplings, or CG on the
+    step's hierarchy needing more than twice the first correction's iterations): later corrections build
+    their own hierarchies; the Newton iterations stay those of the solver's own solves."""
     import sys
 
     sys.path.insert(0, str(ROOT / "tests" / "verification"))
@@ -140,7 +144,7 @@ def test_amg_builds_a_new_hierarchy_when_the_old_one_is_slow(tmp_path):
     runs = {}
     for reuse in (False, True):
         problem = hertz_problem(hertz_mesh(10, 5), "svk", steps=2, vtu=False)
-        problem.solver = dataclasses.replace(problem.solver, reuse_factorization=reuse, linear="cg-amg")
+        problem.solver = dataclasses.replace(problem.solver, reuse_factorization=reuse, linear=amg)
         runs[reuse] = problem.run(out=tmp_path / str(reuse), quiet=True).summary["steps"]
     plain, reuse = runs[False], runs[True]
     assert [s["iterations"] for s in reuse] == [s["iterations"] for s in plain]

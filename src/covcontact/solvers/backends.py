@@ -28,9 +28,10 @@ from .linear import (
     LinearSolver,
     LinearSolverError,
     SingularMatrixError,
+    _as_csr,
     available,
     make_solver,
-    rigid_body_modes,
+    near_null_candidates,
 )
 
 # ----------------------------------------------------------------------------- PARDISO
@@ -480,19 +481,10 @@ class AMGSolver(LinearSolver):
         self._geometry = None
         self._stale = True
 
-    def _candidates(self, n: int) -> tuple[np.ndarray | None, bool]:
-        """The near-null space for a matrix of size n, and whether its rows are 3 dofs per node."""
-        B, nodal = self.near_null_space, True
-        if self._geometry is not None:
-            B, nodal = rigid_body_modes(*self._geometry), self._geometry[1] is None
-        if B is not None and B.shape[0] != n:
-            raise ValueError(f"the near-null space has {B.shape[0]} rows, the matrix {n}")
-        return B, nodal
-
     def _factor(self, K: sp.csr_matrix) -> None:
         import pyamg
 
-        B, nodal = self._candidates(K.shape[0])
+        B, nodal = near_null_candidates(self.near_null_space, self._geometry, K.shape[0])
         bs = self.blocksize or (3 if B is not None and nodal else 1)
         if K.shape[0] % bs:
             bs = 1
@@ -507,6 +499,11 @@ class AMGSolver(LinearSolver):
             improve_candidates=None,
         )
         self._stale = False
+
+    def preconditioner_fits(self, K) -> bool:
+        """Whether the hierarchy of the last ``factorize`` can precondition K: same size and sparsity pattern
+        (a new contact coupling needs a new one)."""
+        return self._ml is not None and not self._stale and self._K is not None and self.same_pattern(_as_csr(K))
 
     def solve_preconditioned(self, K, b: np.ndarray, rtol: float, maxiter: int | None = None
                              ) -> tuple[np.ndarray | None, int]:

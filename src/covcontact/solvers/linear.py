@@ -205,6 +205,18 @@ def rigid_body_modes(X: np.ndarray, constrained: np.ndarray | None = None) -> np
     return B
 
 
+def near_null_candidates(B: np.ndarray | None, geometry: tuple | None, n: int) -> tuple[np.ndarray | None, bool]:
+    """The near-null space an AMG backend hands to its set-up for a matrix of size n, and whether its rows
+    are 3 dofs per node: the rigid-body modes of ``geometry`` = (points, dofs) when given (set by
+    ``set_geometry``), else ``B`` (set by ``set_near_null_space``; full size 3 nnode), else (None, True)."""
+    nodal = True
+    if geometry is not None:
+        B, nodal = rigid_body_modes(*geometry), geometry[1] is None
+    if B is not None and B.shape[0] != n:
+        raise ValueError(f"the near-null space has {B.shape[0]} rows, the matrix {n}")
+    return B, nodal
+
+
 # ----------------------------------------------------------------------------- common layer
 
 

@@ -179,13 +179,14 @@ class Newton:
         ``AMG_FIRST`` at the step's first correction, which builds the hierarchy, and to the linear forcing term
         ``loose`` afterwards (a CG iteration on a V-cycle gains far less than a GMRES iteration on an exact
         factorisation; Newton keeps its iteration count). A later correction first tries the step's hierarchy
+        (when it fits: a new contact coupling in the sparsity pattern builds a new one for that correction)
         with at most ``AMG_REUSE_FACTOR`` times the first solve's iterations (+ 10); if that is not enough, the
         tangent has moved too far from it and every further correction of the step builds its own. The rule
         counts iterations, not seconds, so it decides alike on every run (a resumed run repeats the
         uninterrupted one)."""
         reuse = self.opt.reuse_factorization
         amg = bool(reuse) and hasattr(self.linear, "solve_preconditioned") and not self._failed
-        if amg and eta is not None and not self._amg_fresh:
+        if amg and eta is not None and not self._amg_fresh and self.linear.preconditioner_fits(K):
             du, _ = self._amg(K, rhs, loose, AMG_REUSE_FACTOR * self._amg_first + 10)
             if du is not None:
                 return du

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from .linear import LinearSolver, LinearSolverError, SingularMatrixError, rigid_body_modes
+from .linear import LinearSolver, LinearSolverError, SingularMatrixError, _as_csr, near_null_candidates
 
 PREFIX = "covcontact_"
 
@@ -118,6 +118,7 @@ class PetscSolver(LinearSolver):
         self._dist = None  # the DistMatrix of the last factorisation
         self._structure = None
         self._ckey: np.ndarray | None = None
+        self._coo: tuple[np.ndarray, np.ndarray] | None = None  # rows, columns of a distributed matrix
         self.iterations = 0  # Krylov iterations of the last solve
         self.krylov_iterations = 0  # and of all solves
         self.ranks = 1
@@ -147,6 +148,7 @@ class PetscSolver(LinearSolver):
         if op.ksp is None:
             self._setup_ksp(op)
         else:
+            op.ksp.getPC().setReusePreconditioner(False)
             op.ksp.setOperators(op.A)
         err = None
         try:
@@ -188,8 +190,13 @@ class PetscSolver(LinearSolver):
     def _analyze(self, K: sp.csr_matrix) -> None:
         self._release()
         rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-        self._op = _Operator(self.P.COMM_SELF, K.shape[0], K.shape[0], 1, rows, K.indices, self.symmetric)
+        self._op = _Operator(self.P.COMM_SELF, K.shape[0], K.shape[0], self._serial_block(K.shape[0]), rows,
+                             K.indices, self.symmetric)
         self._prepare_serial(K.shape[0])
+
+    def _serial_block(self, n: int) -> int:
+        """The block size of a serial matrix of size n."""
+        return 1
 
     def _prepare_serial(self, n: int) -> None:
         pass
@@ -223,18 +230,9 @@ class PetscSolver(LinearSolver):
         t0 = time.perf_counter()
         self.t_analyze = 0.0
         st, lay = K.structure, K.layout
-        ci, cj, cv = K.contact_triplets()
         n = lay.n_dofs
-        key = ci.astype(np.int64) * n + cj
-        ukey, inv = np.unique(key, return_inverse=True)
-        same = self._op is not None and self._structure is st and self._ckey is not None
-        if same:
-            pos = np.searchsorted(self._ckey, ukey)
-            same = bool(np.all(pos < self._ckey.size)) and bool(np.array_equal(self._ckey[np.minimum(
-                pos, self._ckey.size - 1)], ukey))
+        same, ukey, inv, cv = self._dist_pattern(K)
         comm = K.comm
-        if comm.size > 1:
-            same = comm.allreduce(same, op=_mpi_op("LAND"))
         if not same:
             ckey = ukey
             if self._structure is st and self._ckey is not None:
@@ -245,19 +243,39 @@ class PetscSolver(LinearSolver):
             rows = np.concatenate([st.rows, st.diag, ckey // n])
             cols = np.concatenate([st.cols, st.diag, ckey % n])
             self._op = _Operator(self.P.Comm(comm), lay.hi - lay.lo, n, 3, rows, cols, self.symmetric)
-            self._structure, self._ckey = st, ckey
+            self._structure, self._ckey, self._coo = st, ckey, (rows, cols)
             self._prepare_dist(K)
             self.n_analyses += 1
             self.t_analyze = time.perf_counter() - t0
-            pos = np.searchsorted(ckey, ukey)
-        cvals = np.bincount(pos[inv.ravel()], weights=cv, minlength=self._ckey.size)
         self.ranks = comm.size
         self._K = None
         self._dist = K
-        self._op.set_values(np.concatenate([K.body_values(), np.ones(st.diag.size), cvals]))
+        self._op.set_values(self._dist_values(K, self._ckey, ukey, inv, cv))
         self._factor_op()
         self.n_factorizations += 1
         self.t_factor = time.perf_counter() - t0
+
+    def _dist_pattern(self, K) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:
+        """Whether the DistMatrix K fits the current matrix's structure (on every rank), and its unique
+        contact keys (row n + column), the map of its contact entries onto them and their values."""
+        ci, cj, cv = K.contact_triplets()
+        key = ci.astype(np.int64) * K.layout.n_dofs + cj
+        ukey, inv = np.unique(key, return_inverse=True)
+        same = self._op is not None and self._structure is K.structure and self._ckey is not None
+        if same:
+            pos = np.searchsorted(self._ckey, ukey)
+            same = bool(np.all(pos < self._ckey.size)) and bool(np.array_equal(self._ckey[np.minimum(
+                pos, self._ckey.size - 1)], ukey))
+        if K.comm.size > 1:
+            same = K.comm.allreduce(same, op=_mpi_op("LAND"))
+        return same, ukey, inv, cv
+
+    @staticmethod
+    def _dist_values(K, ckey: np.ndarray, ukey: np.ndarray, inv: np.ndarray, cv: np.ndarray) -> np.ndarray:
+        """The values of K on the COO structure whose contact keys are ``ckey`` (a superset of K's ``ukey``)."""
+        pos = np.searchsorted(ckey, ukey)
+        cvals = np.bincount(pos[inv.ravel()], weights=cv, minlength=ckey.size)
+        return np.concatenate([K.body_values(), np.ones(K.structure.diag.size), cvals])
 
     def _prepare_dist(self, K) -> None:
         pass
@@ -356,18 +374,26 @@ class PetscGAMGSolver(PetscSolver):
 
     def set_geometry(self, points: np.ndarray, dofs: np.ndarray | None = None) -> None:
         self._geometry = (np.asarray(points, dtype=np.float64), dofs)
+        self.near_null_space = None
         self._indptr = None  # a new near-null space: set up again
+
+    def set_near_null_space(self, B: np.ndarray | None) -> None:
+        super().set_near_null_space(B)
+        self._geometry = None
+        self._indptr = None
+
+    def _serial_block(self, n: int) -> int:
+        B, nodal = near_null_candidates(self.near_null_space, self._geometry, n)
+        return 3 if B is not None and nodal and n % 3 == 0 else 1  # aggregates of whole nodes
 
     def _prepare_serial(self, n: int) -> None:
         self._near = None
-        if self._geometry is None:
+        B, _ = near_null_candidates(self.near_null_space, self._geometry, n)
+        if B is None:
             return
         P = self.P
-        B = rigid_body_modes(*self._geometry)
-        if B.shape[0] != n:
-            raise ValueError(f"geometry gives {B.shape[0]} dofs, the matrix has {n}")
         Q, _ = np.linalg.qr(B)
-        vecs = [P.Vec().createWithArray(np.ascontiguousarray(Q[:, k]), comm=P.COMM_SELF) for k in range(6)]
+        vecs = [P.Vec().createWithArray(np.ascontiguousarray(Q[:, k]), comm=P.COMM_SELF) for k in range(Q.shape[1])]
         self._near = P.NullSpace().create(vectors=vecs, comm=P.COMM_SELF)
         self._op.A.setNearNullSpace(self._near)
 
@@ -407,6 +433,70 @@ class PetscGAMGSolver(PetscSolver):
 
     def _pc_failure(self, op: _Operator) -> str:
         return ""
+
+    def preconditioner_fits(self, K) -> bool:
+        """Whether the hierarchy of the last ``factorize`` can precondition K: same size and sparsity pattern
+        (a new contact coupling needs a new one); collective for a distributed K."""
+        if hasattr(K, "structure"):
+            return self._dist is not None and K.shape == self._dist.shape and self._dist_pattern(K)[0]
+        return self._K is not None and self._dist is None and self.same_pattern(_as_csr(K))
+
+    def solve_preconditioned(self, K, b: np.ndarray, rtol: float, maxiter: int | None = None
+                             ) -> tuple[np.ndarray | None, int]:
+        """Solve K x = b (SciPy, one process, or distributed) to the relative residual ``rtol`` by CG (GMRES for a
+        non-symmetric solver) preconditioned by the GAMG hierarchy of the last ``factorize`` (of K or an earlier
+        matrix of the same size, whose hierarchy is kept): (x, its), x None when it does not converge within
+        ``maxiter`` iterations (default: the solver's)."""
+        op, P = self._op, self.P
+        dist = hasattr(K, "structure")
+        last = self._dist if dist else self._K
+        if op is None or op.ksp is None or last is None or K.shape != last.shape:
+            return None, 0
+        A = op.A
+        if K is not last:  # the new matrix for the Krylov method, the old one for the preconditioner
+            if dist:
+                same, ukey, inv, cv = self._dist_pattern(K)
+                if not same:
+                    return None, 0
+                A = P.Mat().create(comm=op.comm)
+                A.setSizes(op.A.getSizes(), bsize=op.A.getBlockSize())
+                A.setType(P.Mat.Type.AIJ)
+                A.setPreallocationCOO(*(a.astype(P.IntType) for a in self._coo))
+                A.setValuesCOO(self._dist_values(K, self._ckey, ukey, inv, cv), addv=P.InsertMode.INSERT_VALUES)
+            else:
+                K = _as_csr(K)
+                A = P.Mat().createAIJ(size=K.shape, bsize=op.A.getBlockSize(), comm=P.COMM_SELF,
+                                      csr=(K.indptr.astype(P.IntType), K.indices.astype(P.IntType), K.data))
+            if self.symmetric:
+                A.setOption(P.Mat.Option.SYMMETRIC, True)
+        ksp = op.ksp
+        try:
+            ksp.getPC().setReusePreconditioner(True)
+            ksp.setOperators(A, op.A)
+            ksp.setTolerances(rtol=rtol, max_it=self.maxiter if maxiter is None else maxiter)
+            if dist:
+                op.b.getArray()[:] = b[K.layout.owned]
+            else:
+                op.b.getArray()[:] = b
+            op.x.set(0.0)
+            ksp.setInitialGuessNonzero(False)
+            ksp.solve(op.b, op.x)
+            its, reason = ksp.getIterationNumber(), ksp.getConvergedReason()
+            if dist:
+                x = np.empty(K.layout.n_dofs)
+                x[K.layout.from_petsc] = op.gather(op.x)
+            else:
+                x = op.x.getArray(readonly=True).copy()
+        finally:
+            ksp.setOperators(op.A, op.A)
+            ksp.setTolerances(rtol=self.rtol, max_it=self.maxiter)
+            if A is not op.A:
+                A.destroy()
+        self.iterations = its
+        self.krylov_iterations += its
+        if reason < 0 or not np.isfinite(x).all():
+            return None, its
+        return x, its
 
     def _ksp_solve(self, op: _Operator) -> None:
         nb = op.b.norm()

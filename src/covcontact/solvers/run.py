@@ -98,11 +98,44 @@ class _NoWriter:
         pass
 
 
-def _make_model(problem, tangent: str | None, linear: str | None) -> Model:
+#: ``linear = "auto"`` hands a frictionless problem of solid (hex/tet) bodies of compressible materials with at
+#: least this many dofs to ``petsc-gamg`` where it is installed (docs/performance.md: 1.7x faster than PARDISO
+#: on the Hertz ball at 199,053 dofs, 2.7x on two deformable blocks at 192,480); else to the direct default
+AUTO_AMG_DOFS = 100_000
+#: the largest Poisson's ratio of such a problem: nearly incompressible bodies slow AMG down
+AUTO_AMG_NU = 0.45
+
+
+def auto_amg(problem) -> bool:
+    """Whether ``linear = "auto"`` picks the AMG-preconditioned CG of ``petsc-gamg`` for ``problem``: at least
+    ``AUTO_AMG_DOFS`` dofs of deformable bodies, all of them ``solid`` (not solid-shell, thin; not F-bar,
+    nearly incompressible) with a material of Poisson's ratio at most ``AUTO_AMG_NU``, no friction (CG needs
+    a symmetric tangent), no rigid body with free components (the distributed model has none yet)."""
+    if 3 * sum(b.mesh.points.shape[0] for b in problem.bodies) < AUTO_AMG_DOFS:
+        return False
+    if any(b.formulation != "solid" or not 0.0 <= float(getattr(b.material, "nu", 1.0)) <= AUTO_AMG_NU
+           for b in problem.bodies):
+        return False
+    return not any(c.friction for c in problem.contacts) and not any(rb.free for rb in problem.rigid)
+
+
+def resolve_linear(problem, linear: str | None) -> str:
+    """The linear solver of a run: ``linear`` (the command line's), else the problem's; ``"auto"`` becomes
+    ``petsc-gamg`` where :func:`auto_amg` says so and it is installed, else stays ``"auto"`` (the first
+    direct backend available)."""
+    from .linear import _probe
+
+    name = (linear or problem.solver.linear or "auto").lower().strip()
+    if name == "auto" and auto_amg(problem) and _probe("petsc-gamg")[0]:
+        return "petsc-gamg"
+    return name
+
+
+def _make_model(problem, tangent: str | None, linear: str) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
     from .linear import REGISTRY, backend_class
 
-    name = (linear or problem.solver.linear or "auto").lower().strip()
+    name = linear
     if name in REGISTRY and getattr(backend_class(name), "distributed", False):
         if any(rb.free for rb in problem.rigid):
             raise InputError(f"{problem.source or problem.name}: rigid bodies with free components (reference "
@@ -138,6 +171,7 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
 def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
     t_start = time.perf_counter()
     out = Path(out) if out is not None else Path("results") / problem.name
+    linear = resolve_linear(problem, linear)
     model = _make_model(problem, tangent, linear)
     if model.size > 1:
         try:
