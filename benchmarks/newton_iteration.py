@@ -68,10 +68,11 @@ def two_blocks_problem(n: int) -> Problem:
         steps=Steps.equal(1), output=OutputOptions(vtu=False), solver=SolverOptions())
 
 
-def measure(prob: Problem, iterations: int | None = None, reuse: bool = False) -> dict:
+def measure(prob: Problem, iterations: int | None = None, reuse: bool | str = False, solver: str = "auto") -> dict:
     if iterations:  # time a fixed number of iterations of the first step (no cutback)
         prob.solver = SolverOptions(max_iterations=iterations, max_cutbacks=0)
     prob.solver.reuse_factorization = reuse
+    prob.solver.linear = solver
     t0 = time.perf_counter()
     model = Model(prob)
     newton = Newton(model, prob.solver)
@@ -102,7 +103,10 @@ def main() -> None:
     ap.add_argument("--iterations", type=int, default=None,
                     help="time only this many Newton iterations of the step (for the largest sizes)")
     ap.add_argument("--reuse", action="store_true",
-                    help="[solver] reuse_factorization = true: GMRES preconditioned by the last factorisation")
+                    help="[solver] reuse_factorization = true: GMRES preconditioned by the last factorisation (with "
+                         "an AMG solver: CG to Newton's forcing term on a kept hierarchy)")
+    ap.add_argument("--solver", default="auto",
+                    help="the linear solver (default auto: the direct one here, as the serial model is used)")
     args = ap.parse_args()
     blocks = [8, 12] if args.quick else [8, 16, 24, 32, 40]
     plates = [20, 40] if args.quick else [40, 80, 120, 160, 200]
@@ -113,13 +117,13 @@ def main() -> None:
     measure(block_problem(4))  # compile
     rows = []
     for n in blocks:
-        rows.append(measure(block_problem(n), args.iterations, args.reuse))
+        rows.append(measure(block_problem(n), args.iterations, args.reuse, args.solver))
         print(json.dumps(rows[-1]))
     for n in plates:
-        rows.append(measure(plate_problem(n), args.iterations, args.reuse))
+        rows.append(measure(plate_problem(n), args.iterations, args.reuse, args.solver))
         print(json.dumps(rows[-1]))
     for n in args.two_blocks:
-        rows.append(measure(two_blocks_problem(n), args.iterations, args.reuse))
+        rows.append(measure(two_blocks_problem(n), args.iterations, args.reuse, args.solver))
         print(json.dumps(rows[-1]))
     result = {"benchmark": "newton_iteration", "machine": platform.machine(), "threads": numba.get_num_threads(),
               "date": time.strftime("%Y-%m-%d"), "rows": rows}

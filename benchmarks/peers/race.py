@@ -26,6 +26,8 @@ kratos_run.py under Kratos's Python; CalculiX: ``ccx -i job``). The codes altern
 the median wall time is kept and the ratio peer / covcontact is formed from the medians of the same race. Every
 code gets ``--threads`` threads (OMP, MKL, NUMBA, OpenBLAS and CalculiX's variables, and Kratos's
 ``ParallelUtilities.SetNumThreads``). One untimed covcontact run first fills numba's on-disk cache.
+``--ours-ranks 2`` runs covcontact instead as two single-threaded MPI ranks with ``petsc-gamg`` (``mpiexec``; the
+distributed model of docs/performance.md, "Distributed runs"), its way of using two cores on one problem.
 
 Accuracy: the total force per step of every code (covcontact: its contact force; Kratos and CalculiX: the
 reaction of the loaded face), each peer's relative difference to covcontact, and for hertz F / F_Hertz per step.
@@ -150,13 +152,21 @@ class Cell:
     # covcontact
     def ours_cmd(self) -> list[str]:
         if self.problem == "two_blocks":
-            return [sys.executable, "-m", "covcontact", "run", str(self.toml), "--out", str(self.ours_out), "--quiet"]
-        return [sys.executable, str(Path(__file__).resolve()), "--worker-hertz", str(self.n), str(self.penalty),
-                str(self.ours_out), repr(self.args.ours_rtol)]
+            cmd = [sys.executable, "-m", "covcontact", "run", str(self.toml), "--out", str(self.ours_out), "--quiet"]
+        else:
+            cmd = [sys.executable, str(Path(__file__).resolve()), "--worker-hertz", str(self.n), str(self.penalty),
+                   str(self.ours_out), repr(self.args.ours_rtol)]
+        if self.args.ours_ranks > 1:  # MPI ranks on the same cores, each single-threaded, petsc-gamg
+            cmd = ["mpiexec", "-n", str(self.args.ours_ranks), "--bind-to", "none", *cmd]
+            cmd += ["--solver", "petsc-gamg"] if self.problem == "two_blocks" else ["petsc-gamg"]
+        return cmd
 
     def run_ours(self) -> float:
         shutil.rmtree(self.ours_out, ignore_errors=True)
-        wall, _, proc = timed(self.ours_cmd(), env=thread_env(self.args.threads))
+        env = thread_env(1 if self.args.ours_ranks > 1 else self.args.threads)
+        if hasattr(os, "geteuid") and os.geteuid() == 0:  # Open MPI refuses root without these
+            env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        wall, _, proc = timed(self.ours_cmd(), env=env)
         if proc.returncode not in (0, 1):
             raise RuntimeError(f"covcontact failed:\n{proc.stderr[-2000:]}")
         return wall
@@ -270,7 +280,7 @@ def table(records: list[dict], threads: int) -> str:
     return "\n".join(rows)
 
 
-def worker_hertz(n: int, penalty: float, out: str, rtol: float | None) -> int:
+def worker_hertz(n: int, penalty: float, out: str, rtol: float | None, solver: str | None = None) -> int:
     """Child process: the covcontact Hertz run (no VTU, as the peers write no field output here)."""
     from hertz_setup import hertz_problem
 
@@ -278,7 +288,7 @@ def worker_hertz(n: int, penalty: float, out: str, rtol: float | None) -> int:
     problem = hertz_problem(mesh, "svk", steps=STEPS, penalty=penalty, vtu=False)
     if rtol is not None:
         problem.solver.rtol = rtol
-    return problem.run(out=Path(out), quiet=True).exit_code
+    return problem.run(out=Path(out), quiet=True, solver=solver).exit_code
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -301,11 +311,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ours-rtol", type=float, default=None,
                     help="covcontact's Newton tolerance [solver] rtol (default: its own, 1e-8); e.g. 1e-5 races it at "
                          "the accuracy of CalculiX's default controls (peers/README.md)")
-    ap.add_argument("--worker-hertz", nargs=4, help=argparse.SUPPRESS)
+    ap.add_argument("--ours-ranks", type=int, default=1,
+                    help="run covcontact as this many MPI ranks of one thread each with petsc-gamg (mpiexec; the `mpi` "
+                         "extra) instead of one process of --threads threads")
+    ap.add_argument("--worker-hertz", nargs="+", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker_hertz:
-        n, penalty, out, rtol = args.worker_hertz
-        return worker_hertz(int(n), float(penalty), out, None if rtol == "None" else float(rtol))
+        n, penalty, out, rtol, *solver = args.worker_hertz
+        return worker_hertz(int(n), float(penalty), out, None if rtol == "None" else float(rtol), *solver)
     if args.kratos and not args.kratos_python:
         print("give --kratos-python (or set KRATOS_PYTHON): the Python of an environment with Kratos", file=sys.stderr)
         return 2
@@ -324,7 +337,8 @@ def main(argv: list[str] | None = None) -> int:
                 records.append(race(Cell(problem, size, work, args), args.repeats))
     result = {"benchmark": "peers_race", "date": time.strftime("%Y-%m-%d"), "python": platform.python_version(),
               "machine": platform.machine(), "cpus": os.cpu_count(), "threads": args.threads,
-              "covcontact_rtol": args.ours_rtol or SolverOptions().rtol, "kratos_solver": args.kratos_solver,
+              "covcontact_rtol": args.ours_rtol or SolverOptions().rtol, "covcontact_ranks": args.ours_ranks,
+              "kratos_solver": args.kratos_solver,
               "repeats": args.repeats, "steps": STEPS,
               "kratos_version": records[0]["codes"]["kratos"]["version"] if records and args.kratos else None,
               "ccx_version": _ccx_version() if args.ccx else None, "covcontact": _covcontact_state(),

@@ -8,7 +8,7 @@ import dataclasses
 import pytest
 
 from covcontact.materials import NeoHooke, SaintVenantKirchhoff
-from covcontact.mesh.generators import block
+from covcontact.mesh.generators import block, plate
 from covcontact.problem import Body, ContactPair, Problem, RigidBody, SolverOptions
 from covcontact.solvers.linear import available
 from covcontact.solvers.run import AUTO_AMG_DOFS, auto_amg, resolve_linear
@@ -33,10 +33,14 @@ def test_the_size_threshold():
     assert not auto_amg(problem(BIG - 1)) and not auto_amg(problem(SMALL))
 
 
-@pytest.mark.parametrize("change", ["friction", "solid-shell", "fbar", "nearly incompressible", "free rigid body"])
+@pytest.mark.parametrize("change", ["friction", "solid-shell", "fbar", "nearly incompressible", "free rigid body",
+                                    "plate"])
 def test_what_keeps_the_direct_default(change):
     p = problem(BIG)
-    if change == "friction":
+    if change == "plate":  # two 92 x 92 hex8 plates, one element through the thickness: 103,788 dofs
+        p.bodies = [dataclasses.replace(b, mesh=plate(1.0, 1.0, 0.01, 92, 92)) for b in p.bodies]
+        assert 3 * sum(b.mesh.n_nodes for b in p.bodies) >= AUTO_AMG_DOFS
+    elif change == "friction":
         p.contacts = [dataclasses.replace(p.contacts[0], friction=0.2)]
     elif change in ("solid-shell", "fbar"):
         p.bodies[0] = dataclasses.replace(p.bodies[0], formulation=change)

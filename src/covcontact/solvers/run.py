@@ -104,19 +104,29 @@ class _NoWriter:
 AUTO_AMG_DOFS = 100_000
 #: the largest Poisson's ratio of such a problem: nearly incompressible bodies slow AMG down
 AUTO_AMG_NU = 0.45
+#: the largest share of nodes on the bodies' boundaries: a bulky mesh (0.11-0.19 for the raced 2e5-dof meshes)
+#: factorises slowly, a plate-like one (1.0 with one element through the thickness) quickly and is hard for AMG
+AUTO_AMG_BOUNDARY = 0.3
 
 
 def auto_amg(problem) -> bool:
     """Whether ``linear = "auto"`` picks the AMG-preconditioned CG of ``petsc-gamg`` for ``problem``: at least
-    ``AUTO_AMG_DOFS`` dofs of deformable bodies, all of them ``solid`` (not solid-shell, thin; not F-bar,
-    nearly incompressible) with a material of Poisson's ratio at most ``AUTO_AMG_NU``, no friction (CG needs
-    a symmetric tangent), no rigid body with free components (the distributed model has none yet)."""
-    if 3 * sum(b.mesh.points.shape[0] for b in problem.bodies) < AUTO_AMG_DOFS:
+    ``AUTO_AMG_DOFS`` dofs of deformable bodies, all of them ``solid`` (not solid-shell or F-bar) with a
+    material of Poisson's ratio at most ``AUTO_AMG_NU``, bulky meshes (at most ``AUTO_AMG_BOUNDARY`` of their
+    nodes on a boundary face), no friction (CG needs a symmetric tangent), no rigid body with free components
+    (the distributed model has none yet)."""
+    from ..mesh.faces import FACES, boundary_faces
+
+    n_nodes = sum(b.mesh.points.shape[0] for b in problem.bodies)
+    if 3 * n_nodes < AUTO_AMG_DOFS:
         return False
     if any(b.formulation != "solid" or not 0.0 <= float(getattr(b.material, "nu", 1.0)) <= AUTO_AMG_NU
-           for b in problem.bodies):
+           or b.mesh.cell_type not in FACES for b in problem.bodies):
         return False
-    return not any(c.friction for c in problem.contacts) and not any(rb.free for rb in problem.rigid)
+    if any(c.friction for c in problem.contacts) or any(rb.free for rb in problem.rigid):
+        return False
+    on_boundary = sum(np.unique(boundary_faces(b.mesh)[0]).size for b in problem.bodies)
+    return on_boundary <= AUTO_AMG_BOUNDARY * n_nodes
 
 
 def resolve_linear(problem, linear: str | None) -> str:
