@@ -181,8 +181,12 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
 def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
     t_start = time.perf_counter()
     out = Path(out) if out is not None else Path("results") / problem.name
+    requested = (linear or problem.solver.linear or "auto").lower().strip()
     linear = resolve_linear(problem, linear)
     model = _make_model(problem, tangent, linear)
+    if linear != requested and not quiet and model.is_root:
+        print(f"linear solver: {linear} (auto: a large frictionless problem of bulky solid bodies; --solver with a "
+              f"direct one, `covcontact info` lists them, to factorise instead)", file=sys.stderr, flush=True)
     if model.size > 1:
         try:
             return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
