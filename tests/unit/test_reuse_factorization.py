@@ -149,6 +149,7 @@ def test_amg_builds_new_hierarchies_on_the_hertz_ball(tmp_path, amg):
     plain, reuse = runs[False], runs[True]
     assert [s["iterations"] for s in reuse] == [s["iterations"] for s in plain]
     assert any(1 < s["factorizations"] for s in reuse)
-    for a, b in zip(plain, reuse, strict=True):
-        np.testing.assert_allclose(b["contact_force"], a["contact_force"], rtol=1e-8,
+    for a, b in zip(plain, reuse, strict=True):  # both within Newton's relative residual of 1e-8
+        assert a["residual_norms"][-1] <= 1e-8 and b["residual_norms"][-1] <= 1e-8
+        np.testing.assert_allclose(b["contact_force"], a["contact_force"], rtol=1e-7,
                                    atol=1e-10 * np.linalg.norm(a["contact_force"]))

@@ -354,7 +354,9 @@ class PetscGAMGSolver(PetscSolver):
     """PETSc CG (GMRES for non-symmetric matrices, or when CG fails) + GAMG (``petsc-gamg``).
 
     The near-null space is the six rigid-body modes: from the node coordinates of a distributed run, or
-    from ``set_geometry`` for a SciPy matrix. ``rtol``: relative residual of each solve; ``maxiter``.
+    from ``set_near_null_space`` / ``set_geometry`` for a SciPy matrix. ``rtol``: relative residual of each
+    solve; ``maxiter``; ``threshold``: GAMG's strength threshold; ``smooths``: smoothing steps of the
+    prolongator (0: plain aggregation). ``PETSC_OPTIONS`` with the prefix ``covcontact_`` overrides both.
     """
 
     name = "petsc-gamg"
@@ -366,9 +368,9 @@ class PetscGAMGSolver(PetscSolver):
         return True, _version(), "iterative: PETSc CG/GMRES + GAMG with rigid-body modes; distributed under mpiexec"
 
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, rtol: float = 1e-10,
-                 maxiter: int = 2000, threshold: float = 0.01):
+                 maxiter: int = 2000, threshold: float = 0.01, smooths: int = 0):
         super().__init__(symmetric, max(check_tol, 10 * rtol))
-        self.rtol, self.maxiter, self.threshold = rtol, maxiter, threshold
+        self.rtol, self.maxiter, self.threshold, self.smooths = rtol, maxiter, threshold, smooths
         self._geometry: tuple[np.ndarray, np.ndarray | None] | None = None
         self._near = None
 
@@ -426,6 +428,8 @@ class PetscGAMGSolver(PetscSolver):
         opts = P.Options()
         if not opts.hasName(f"{PREFIX}pc_gamg_threshold"):
             opts.setValue(f"{PREFIX}pc_gamg_threshold", self.threshold)
+        if not opts.hasName(f"{PREFIX}pc_gamg_agg_nsmooths"):  # plain aggregation: a quarter of the set-up and
+            opts.setValue(f"{PREFIX}pc_gamg_agg_nsmooths", self.smooths)  # cheaper cycles (docs/performance.md)
         ksp.setErrorIfNotConverged(False)
         ksp.setFromOptions()
         op.ksp = ksp
