@@ -83,6 +83,20 @@ class _Operator:
         sc.scatter(x, xall, addv=self.P.InsertMode.INSERT_VALUES, mode=self.P.ScatterMode.FORWARD)
         return xall.getArray(readonly=True).copy()
 
+    def load(self, b: np.ndarray, layout=None) -> None:
+        """The right-hand side b (all dofs, replicated): this rank's rows of it, in PETSc order for a
+        distributed ``layout``."""
+        self.b.getArray()[:] = b if layout is None else b[layout.owned]
+
+    def result(self, layout=None) -> np.ndarray:
+        """The solution x, whole on every rank (in the dof order of a distributed ``layout``)."""
+        xp = self.gather(self.x)
+        if layout is None:
+            return xp
+        x = np.empty(layout.n_dofs)
+        x[layout.from_petsc] = xp
+        return x
+
     def destroy(self) -> None:
         for obj in (self.ksp, self.A, self.b, self.x):
             if obj is not None:
@@ -210,9 +224,9 @@ class PetscSolver(LinearSolver):
         if b.ndim == 2:
             return np.stack([self._solve(b[:, j]) for j in range(b.shape[1])], axis=1)
         op = self._op
-        op.b.getArray()[:] = b
+        op.load(b)
         self._ksp_solve(op)
-        return op.x.getArray(readonly=True).copy()
+        return op.result()
 
     def _release(self) -> None:
         if self._op is not None:
@@ -289,7 +303,7 @@ class PetscSolver(LinearSolver):
             raise ValueError(f"right-hand side of shape {b.shape} for a distributed matrix of size {K.shape[0]}")
         t0 = time.perf_counter()
         op, lay = self._op, K.layout
-        op.b.getArray()[:] = b[lay.owned]
+        op.load(b, lay)
         err = ""
         try:
             self._ksp_solve(op)
@@ -315,9 +329,7 @@ class PetscSolver(LinearSolver):
         err = K.comm.bcast(err, root=0) if K.comm.size > 1 else err  # one decision for all ranks
         if err:
             raise (LinearSolverError if "no convergence" in err else SingularMatrixError)(err)
-        xp = op.gather(op.x)
-        x = np.empty(lay.n_dofs)
-        x[lay.from_petsc] = xp
+        x = op.result(lay)
         self.t_solve = time.perf_counter() - t0
         return x
 
@@ -456,21 +468,21 @@ class PetscGAMGSolver(PetscSolver):
         last = self._dist if dist else self._K
         if op is None or op.ksp is None or last is None or K.shape != last.shape:
             return None, 0
-        A = op.A
-        if K is not last:  # the new matrix for the Krylov method, the old one for the preconditioner
-            if dist:
-                same, ukey, inv, cv = self._dist_pattern(K)
-                if not same:
-                    return None, 0
-                A = P.Mat().create(comm=op.comm)
-                A.setSizes(op.A.getSizes(), bsize=op.A.getBlockSize())
-                A.setType(P.Mat.Type.AIJ)
-                A.setPreallocationCOO(*(a.astype(P.IntType) for a in self._coo))
-                A.setValuesCOO(self._dist_values(K, self._ckey, ukey, inv, cv), addv=P.InsertMode.INSERT_VALUES)
-            else:
-                K = _as_csr(K)
-                A = P.Mat().createAIJ(size=K.shape, bsize=op.A.getBlockSize(), comm=P.COMM_SELF,
-                                      csr=(K.indptr.astype(P.IntType), K.indices.astype(P.IntType), K.data))
+        layout = K.layout if dist else None
+        A = op.A  # K's own matrix for the Krylov method (the preconditioner keeps the old one)
+        new = None
+        if K is not last and dist:
+            same, ukey, inv, cv = self._dist_pattern(K)
+            if not same:
+                return None, 0
+            (n_local, n_global), _ = op.A.getSizes()
+            new = _Operator(op.comm, n_local, n_global, op.A.getBlockSize(), *self._coo, self.symmetric)
+            new.set_values(self._dist_values(K, self._ckey, ukey, inv, cv))
+            A = new.A
+        elif K is not last:  # from CSR directly: half the time of a COO structure (0.03 s at 36,627 dofs)
+            K = _as_csr(K)
+            A = P.Mat().createAIJ(size=K.shape, bsize=op.A.getBlockSize(), comm=P.COMM_SELF,
+                                  csr=(K.indptr.astype(P.IntType), K.indices.astype(P.IntType), K.data))
             if self.symmetric:
                 A.setOption(P.Mat.Option.SYMMETRIC, True)
         ksp = op.ksp
@@ -478,23 +490,18 @@ class PetscGAMGSolver(PetscSolver):
             ksp.getPC().setReusePreconditioner(True)
             ksp.setOperators(A, op.A)
             ksp.setTolerances(rtol=rtol, max_it=self.maxiter if maxiter is None else maxiter)
-            if dist:
-                op.b.getArray()[:] = b[K.layout.owned]
-            else:
-                op.b.getArray()[:] = b
+            op.load(b, layout)
             op.x.set(0.0)
             ksp.setInitialGuessNonzero(False)
             ksp.solve(op.b, op.x)
             its, reason = ksp.getIterationNumber(), ksp.getConvergedReason()
-            if dist:
-                x = np.empty(K.layout.n_dofs)
-                x[K.layout.from_petsc] = op.gather(op.x)
-            else:
-                x = op.x.getArray(readonly=True).copy()
+            x = op.result(layout)
         finally:
             ksp.setOperators(op.A, op.A)
             ksp.setTolerances(rtol=self.rtol, max_it=self.maxiter)
-            if A is not op.A:
+            if new is not None:
+                new.destroy()
+            elif A is not op.A:
                 A.destroy()
         self.iterations = its
         self.krylov_iterations += its

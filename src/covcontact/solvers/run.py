@@ -99,8 +99,8 @@ class _NoWriter:
 
 
 #: ``linear = "auto"`` hands a frictionless problem of solid (hex/tet) bodies of compressible materials with at
-#: least this many dofs to ``petsc-gamg`` where it is installed (docs/performance.md: 1.7x faster than PARDISO
-#: on the Hertz ball at 199,053 dofs, 2.7x on two deformable blocks at 192,480); else to the direct default
+#: least this many dofs to ``petsc-gamg`` where it is installed (docs/performance.md: 2.0x faster than PARDISO
+#: on the Hertz ball at 199,053 dofs, 3.6x on two deformable blocks at 192,480); else to the direct default
 AUTO_AMG_DOFS = 100_000
 #: the largest Poisson's ratio of such a problem: nearly incompressible bodies slow AMG down
 AUTO_AMG_NU = 0.45
@@ -129,13 +129,17 @@ def auto_amg(problem) -> bool:
     return on_boundary <= AUTO_AMG_BOUNDARY * n_nodes
 
 
+def requested_linear(problem, linear: str | None) -> str:
+    """The linear solver asked for: ``linear`` (the command line's), else the problem's, else ``"auto"``."""
+    return (linear or problem.solver.linear or "auto").lower().strip()
+
+
 def resolve_linear(problem, linear: str | None) -> str:
-    """The linear solver of a run: ``linear`` (the command line's), else the problem's; ``"auto"`` becomes
-    ``petsc-gamg`` where :func:`auto_amg` says so and it is installed, else stays ``"auto"`` (the first
-    direct backend available)."""
+    """The linear solver of a run: :func:`requested_linear`, whose ``"auto"`` becomes ``petsc-gamg`` where
+    :func:`auto_amg` says so and it is installed, else stays ``"auto"`` (the first direct backend available)."""
     from .linear import _probe
 
-    name = (linear or problem.solver.linear or "auto").lower().strip()
+    name = requested_linear(problem, linear)
     if name == "auto" and auto_amg(problem) and _probe("petsc-gamg")[0]:
         return "petsc-gamg"
     return name
@@ -145,11 +149,10 @@ def _make_model(problem, tangent: str | None, linear: str) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
     from .linear import REGISTRY, backend_class
 
-    name = linear
-    if name in REGISTRY and getattr(backend_class(name), "distributed", False):
+    if linear in REGISTRY and getattr(backend_class(linear), "distributed", False):
         if any(rb.free for rb in problem.rigid):
             raise InputError(f"{problem.source or problem.name}: rigid bodies with free components (reference "
-                             f"nodes) are not available with the distributed solver {name!r} yet; use a serial "
+                             f"nodes) are not available with the distributed solver {linear!r} yet; use a serial "
                              f"solver")
         from ..parallel.model import DistributedModel
 
@@ -181,7 +184,7 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
 def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
     t_start = time.perf_counter()
     out = Path(out) if out is not None else Path("results") / problem.name
-    requested = (linear or problem.solver.linear or "auto").lower().strip()
+    requested = requested_linear(problem, linear)
     linear = resolve_linear(problem, linear)
     model = _make_model(problem, tangent, linear)
     if linear != requested and not quiet and model.is_root:
