@@ -145,3 +145,21 @@ def test_candidates_edge_cases():
     assert ptr[1] == 0 and ptr[2] == ptr[1] and ptr[3] > ptr[2]
     with pytest.raises(ValueError):
         candidates(x, s, xs, -1.0)
+
+
+@pytest.mark.parametrize("case", ["hashed", "crowded"])
+def test_candidates_exact_on_hashed_and_crowded_grids(case):
+    # hashed: two patches far apart, far more cells than entries, so the cell table is a sorted hashed list;
+    # crowded: one cell holding all 144 facets, past the first pass's 64-bit mask
+    rng = np.random.default_rng(7)
+    x, faces = wavy_grid(12, 12, amp=0.15)
+    xs = rng.uniform([-0.1, -0.1, -0.3], [1.1, 1.1, 0.3], (800, 3))
+    if case == "hashed":
+        x, faces = np.vstack([x, x + 1e3]), np.vstack([faces, faces + len(x)])
+        xs = np.vstack([xs, xs + 1e3])
+    s = MeshSurface(faces)
+    ptr, fac = candidates(x, s, xs, 0.05, cell_factor=40.0 if case == "crowded" else 1.0)
+    ref = candidates_brute(x, s, xs, 0.05)
+    assert ptr[-1] == sum(len(r) for r in ref) > 0
+    for i, r in enumerate(ref):
+        assert sorted(fac[ptr[i] : ptr[i + 1]]) == sorted(r)

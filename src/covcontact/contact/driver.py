@@ -67,7 +67,7 @@ def _kkt_ok(d, t, sgn, tol):
     return sgn * (d[0] * t[0] + d[1] * t[1] + d[2] * t[2]) <= tol * np.sqrt(t[0] ** 2 + t[1] ** 2 + t[2] ** 2)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _walk(f, xi, xs, x, topo, prm, use_dir, ndir, scr, pw, vis, nvis, edges, nedge):
     """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge).
 
@@ -228,33 +228,35 @@ def _hull_dist2(xyz, xs, cp):
                 cp[4 + a, p] = 2.0 * xyz[4 + a, p] - 0.5 * (xyz[a, p] + xyz[(a + 1) % 4, p])
             cp[8, p] = (4.0 * xyz[8, p] - (xyz[4, p] + xyz[5, p] + xyz[6, p] + xyz[7, p])
                         + 0.25 * (xyz[0, p] + xyz[1, p] + xyz[2, p] + xyz[3, p]))
-    t1 = np.empty(3)
-    t2 = np.empty(3)
-    for p in range(3):
-        t1[p] = xyz[1, p] + xyz[2, p] - xyz[0, p] - xyz[3, p]
-        t2[p] = xyz[2, p] + xyz[3, p] - xyz[0, p] - xyz[1, p]
-    n0 = t1[1] * t2[2] - t1[2] * t2[1]
-    n1 = t1[2] * t2[0] - t1[0] * t2[2]
-    n2 = t1[0] * t2[1] - t1[1] * t2[0]
+    t10 = xyz[1, 0] + xyz[2, 0] - xyz[0, 0] - xyz[3, 0]
+    t11 = xyz[1, 1] + xyz[2, 1] - xyz[0, 1] - xyz[3, 1]
+    t12 = xyz[1, 2] + xyz[2, 2] - xyz[0, 2] - xyz[3, 2]
+    t20 = xyz[2, 0] + xyz[3, 0] - xyz[0, 0] - xyz[1, 0]
+    t21 = xyz[2, 1] + xyz[3, 1] - xyz[0, 1] - xyz[1, 1]
+    t22 = xyz[2, 2] + xyz[3, 2] - xyz[0, 2] - xyz[1, 2]
+    n0 = t11 * t22 - t12 * t21
+    n1 = t12 * t20 - t10 * t22
+    n2 = t10 * t21 - t11 * t20
     ln = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-    l1 = np.sqrt(t1[0] ** 2 + t1[1] ** 2 + t1[2] ** 2)
+    l1 = np.sqrt(t10 * t10 + t11 * t11 + t12 * t12)
     if not (ln > 0.0 and l1 > 0.0):
         return 0.0
     n0 /= ln
     n1 /= ln
     n2 /= ln
-    for p in range(3):
-        t1[p] /= l1
+    t10 /= l1
+    t11 /= l1
+    t12 /= l1
     # t2 := n x t1 (t1 is normal to n by construction)
-    t2[0] = n1 * t1[2] - n2 * t1[1]
-    t2[1] = n2 * t1[0] - n0 * t1[2]
-    t2[2] = n0 * t1[1] - n1 * t1[0]
+    t20 = n1 * t12 - n2 * t11
+    t21 = n2 * t10 - n0 * t12
+    t22 = n0 * t11 - n1 * t10
     d2 = 0.0
     for ax in range(3):
         if ax == 0:
-            e0, e1, e2 = t1[0], t1[1], t1[2]
+            e0, e1, e2 = t10, t11, t12
         elif ax == 1:
-            e0, e1, e2 = t2[0], t2[1], t2[2]
+            e0, e1, e2 = t20, t21, t22
         else:
             e0, e1, e2 = n0, n1, n2
         lo = np.inf
@@ -271,7 +273,7 @@ def _hull_dist2(xyz, xs, cp):
     return d2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _project_one(xs, x, topo, lo, hi, nat, cands, pf, pxi_in, prm, scr, pw, wrk, vis, edges, xi_out, n_out):
     """Contact point of one slave; returns (kind, facet, g) and writes xi_out (2,), n_out (3,)."""
     faces = topo[0]
@@ -301,7 +303,7 @@ def _project_one(xs, x, topo, lo, hi, nat, cands, pf, pxi_in, prm, scr, pw, wrk,
                 pxi[:] = xi
     for f0 in cands:
         # boxes bound the facets: one farther than the best |g| cannot do better
-        if best_f >= 0 and _box_dist2(xs, lo[f0], hi[f0]) > best_g * best_g:
+        if best_f >= 0 and _box_dist2(xs[0], xs[1], xs[2], lo, hi, f0) > best_g * best_g:
             break
         if best_f >= 0:  # a tighter bound: the facet's own oriented box
             gather_facet(x, faces, f0, xyz)
@@ -335,14 +337,18 @@ def project_slaves_kernel(xs, x, topo, lo, hi, nat, cand_ptr, cand_fac, prev_fac
                           out_facet, out_xi, out_g, out_kind, out_n):  # fmt: skip
     """Contact point of every slave (see the module docstring); writes the out arrays.
 
+    The per-slave arrays (xs, prev_facet, prev_xi and the outputs) are in visiting order: entry q belongs to
+    slave order[q], whose candidates are cand_fac[cand_ptr[order[q]]:cand_ptr[order[q] + 1]]. The caller
+    permutes them (sequential memory traffic in the kernel whatever the slave numbering).
+
     Args:
         xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
             node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. nat: (nen, 2) element
-            coordinates of the facet nodes. cand_ptr, cand_fac: candidate CSR. prev_facet (ns,),
-            prev_xi (ns, 2): last converged contact point, facet -1 for none.
+            coordinates of the facet nodes. cand_ptr, cand_fac: candidate CSR (by slave number).
+            prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
         prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops).
         nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
-        order: (ns,) the order in which slaves are visited (spatially coherent for cache use).
+        order: (ns,) the slave numbers in visiting order (spatially coherent for cache use).
     """
     ns = xs.shape[0]
     nen = topo[0].shape[1]
@@ -355,16 +361,16 @@ def project_slaves_kernel(xs, x, topo, lo, hi, nat, cand_ptr, cand_fac, prev_fac
         for q in range(ch * ns // nchunk, (ch + 1) * ns // nchunk):
             s = order[q]
             cands = cand_fac[cand_ptr[s] : cand_ptr[s + 1]]
-            kind, f, g = _project_one(xs[s], x, topo, lo, hi, nat, cands, prev_facet[s], prev_xi[s], prm, scr,
-                                      pw, wrk, vis, edges, out_xi[s], out_n[s])  # fmt: skip
-            out_kind[s] = kind
-            out_facet[s] = f
+            kind, f, g = _project_one(xs[q], x, topo, lo, hi, nat, cands, prev_facet[q], prev_xi[q], prm, scr,
+                                      pw, wrk, vis, edges, out_xi[q], out_n[q])  # fmt: skip
+            out_kind[q] = kind
+            out_facet[q] = f
             if kind == NO_CONTACT:
-                out_g[s] = np.inf
-                out_xi[s, :] = 0.0
-                out_n[s, :] = 0.0
+                out_g[q] = np.inf
+                out_xi[q, :] = 0.0
+                out_n[q, :] = 0.0
             else:
-                out_g[s] = g
+                out_g[q] = g
 
 
 @njit(cache=True)
@@ -479,11 +485,15 @@ def project_slaves(
     cp = np.ascontiguousarray(cand_ptr, np.int64)
     cf = np.ascontiguousarray(cand_facets, np.int64)
     lo, hi = np.ascontiguousarray(lo), np.ascontiguousarray(hi)
-    o = out
     order = visit_order(pf, cp, cf, nf)
+    o = ProjectionResult(facet=np.empty(ns, np.int64), xi=np.empty((ns, 2)), g=np.empty(ns),
+                         kind=np.empty(ns, np.int8), normal=np.empty((ns, 3)))  # fmt: skip
     project_slaves_kernel(
-        xs, x, topo, lo, hi, nat, cp, cf, pf, pxi, prm, nchunk, order, o.facet, o.xi, o.g, o.kind, o.normal
-    )
+        xs[order], x, topo, lo, hi, nat, cp, cf, pf[order], pxi[order], prm, nchunk, order, o.facet, o.xi, o.g,
+        o.kind, o.normal,
+    )  # fmt: skip
+    for name in ("facet", "xi", "g", "kind", "normal"):
+        getattr(out, name)[order] = getattr(o, name)
     return out
 
 

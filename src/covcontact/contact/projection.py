@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from covcontact.contact.geometry import facet_geometry, facet_point
+from covcontact.contact.geometry import DEGENERATE_TOL
+from covcontact.fem.shapes import IDX
 
 #: projection status codes
 CONVERGED = 0
@@ -26,11 +27,106 @@ _MAX_HALVINGS = 40
 _EPS = 2.220446049250313e-16
 
 
+# Lagrange basis -> monomials: row k holds the coefficients of quadratic 1D basis function k (node -1, +1, 0)
+# in 1, x, x^2
+_MONO2 = np.array([[0.0, -0.5, 0.5], [0.0, 0.5, 0.5], [1.0, 0.0, -1.0]])
+_IDX9 = IDX["quad9"]
+
+
+@njit(cache=True)
+def facet_monomials(xyz, c):
+    """The facet as a polynomial: rho(xi) = sum_mq c[m, q] xi1^m xi2^q, c (3, 3, 3) out (quad4: m, q <= 1).
+
+    Evaluating the monomial form costs a few dozen flops per point, against the shape-function sums of
+    ``facet_geometry``; the projection's Newton loop runs on it.
+    """
+    if xyz.shape[0] == 4:
+        for p in range(3):
+            x0 = xyz[0, p]
+            x1 = xyz[1, p]
+            x2 = xyz[2, p]
+            x3 = xyz[3, p]
+            c[0, 0, p] = 0.25 * (x0 + x1 + x2 + x3)
+            c[1, 0, p] = 0.25 * (x1 + x2 - x0 - x3)
+            c[0, 1, p] = 0.25 * (x2 + x3 - x0 - x1)
+            c[1, 1, p] = 0.25 * (x0 + x2 - x1 - x3)
+            c[2, 0, p] = 0.0
+            c[2, 1, p] = 0.0
+            c[0, 2, p] = 0.0
+            c[1, 2, p] = 0.0
+            c[2, 2, p] = 0.0
+        return
+    # quad9: node values on the 3 x 3 grid (1D index -1, +1, 0), then the 1D transform in each direction
+    for p in range(3):
+        for m in range(3):
+            for q in range(3):
+                c[m, q, p] = 0.0
+    for a in range(9):
+        i = _IDX9[a, 0]
+        j = _IDX9[a, 1]
+        for m in range(3):
+            wi = _MONO2[i, m]
+            if wi != 0.0:
+                for q in range(3):
+                    w = wi * _MONO2[j, q]
+                    if w != 0.0:
+                        for p in range(3):
+                            c[m, q, p] += w * xyz[a, p]
+
+
+@njit(cache=True, inline="always")
+def _mono_geometry(c, x1, x2, G):
+    """G (6, 3) out: rho, rho_1, rho_2, rho_11, rho_12, rho_22 of the monomial form c at (x1, x2)."""
+    for p in range(3):
+        u0 = c[0, 0, p] + x2 * (c[0, 1, p] + x2 * c[0, 2, p])
+        u1 = c[1, 0, p] + x2 * (c[1, 1, p] + x2 * c[1, 2, p])
+        u2 = c[2, 0, p] + x2 * (c[2, 1, p] + x2 * c[2, 2, p])
+        v0 = c[0, 1, p] + 2.0 * x2 * c[0, 2, p]
+        v1 = c[1, 1, p] + 2.0 * x2 * c[1, 2, p]
+        v2 = c[2, 1, p] + 2.0 * x2 * c[2, 2, p]
+        G[0, p] = u0 + x1 * (u1 + x1 * u2)
+        G[1, p] = u1 + 2.0 * x1 * u2
+        G[2, p] = v0 + x1 * (v1 + x1 * v2)
+        G[3, p] = 2.0 * u2
+        G[4, p] = v1 + 2.0 * x1 * v2
+        G[5, p] = 2.0 * (c[0, 2, p] + x1 * (c[1, 2, p] + x1 * c[2, 2, p]))
+
+
+@njit(cache=True, inline="always")
+def _mono_point(c, x1, x2, p):
+    """Coordinate p of rho(x1, x2)."""
+    u0 = c[0, 0, p] + x2 * (c[0, 1, p] + x2 * c[0, 2, p])
+    u1 = c[1, 0, p] + x2 * (c[1, 1, p] + x2 * c[1, 2, p])
+    u2 = c[2, 0, p] + x2 * (c[2, 1, p] + x2 * c[2, 2, p])
+    return u0 + x1 * (u1 + x1 * u2)
+
+
+@njit(cache=True, inline="always")
+def _mono_frame(G):
+    """(area, n0, n1, n2, a00, a01, a11, h00, h01, h11) from G of ``_mono_geometry``; area 0 (n, h zero) at a
+    degenerate point (as ``facet_geometry``)."""
+    a00 = G[1, 0] * G[1, 0] + G[1, 1] * G[1, 1] + G[1, 2] * G[1, 2]
+    a01 = G[1, 0] * G[2, 0] + G[1, 1] * G[2, 1] + G[1, 2] * G[2, 2]
+    a11 = G[2, 0] * G[2, 0] + G[2, 1] * G[2, 1] + G[2, 2] * G[2, 2]
+    c0 = G[1, 1] * G[2, 2] - G[1, 2] * G[2, 1]
+    c1 = G[1, 2] * G[2, 0] - G[1, 0] * G[2, 2]
+    c2 = G[1, 0] * G[2, 1] - G[1, 1] * G[2, 0]
+    area = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    if not (area > DEGENERATE_TOL * np.sqrt(a00 * a11)) or not np.isfinite(area):
+        return 0.0, 0.0, 0.0, 0.0, a00, a01, a11, 0.0, 0.0, 0.0
+    n0 = c0 / area
+    n1 = c1 / area
+    n2 = c2 / area
+    h00 = G[3, 0] * n0 + G[3, 1] * n1 + G[3, 2] * n2
+    h01 = G[4, 0] * n0 + G[4, 1] * n1 + G[4, 2] * n2
+    h11 = G[5, 0] * n0 + G[5, 1] * n1 + G[5, 2] * n2
+    return area, n0, n1, n2, a00, a01, a11, h00, h01, h11
+
+
 @njit(cache=True)
 def projection_work(nen):
     """Scratch arrays for ``project_on_facet_work`` (allocate once per thread, reuse for every call)."""
-    return (np.empty(nen), np.empty((nen, 2)), np.empty((nen, 2, 2)), np.empty(3), np.empty(3),
-            np.empty((2, 3)), np.empty((2, 2)), np.empty((2, 2)), np.empty(3), np.empty((2, 2)))
+    return np.empty((3, 3, 3)), np.empty((6, 3))
 
 
 @njit(cache=True)
@@ -46,12 +142,12 @@ def project_on_facet_info(xyz, xs, xi, max_iter=30, tol=1e-12):
 @njit(cache=True)
 def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
     """As ``project_on_facet_info`` with the caller's scratch ``work = projection_work(nen)``: no allocation,
-    for hot loops over many slaves.
+    for hot loops over many slaves. The facet is evaluated in its monomial form (``facet_monomials``).
 
     Returns:
         (status, g, nit).
     """
-    N, dN, ddN, rho, rho_t, rho_cov, a_cov, a_con, nrm, h_cov = work
+    c, G = work
 
     # guard against non-finite input: never propagate NaN
     scale = 0.0
@@ -64,6 +160,7 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
             if not np.isfinite(v):
                 return DEGENERATE, 0.0, 0
             scale = max(scale, abs(v))
+    facet_monomials(xyz, c)
     xs_norm = np.sqrt(xs[0] * xs[0] + xs[1] * xs[1] + xs[2] * xs[2])
     # round-off floor of |F| / |rho_i|, i.e. of |dxi| |rho_i|
     floor = 64.0 * _EPS * (scale + xs_norm)
@@ -75,22 +172,22 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
     nit = 0
     for it in range(max_iter):
         nit = it + 1
-        area = facet_geometry(xyz, xi[0], xi[1], N, dN, ddN, rho, rho_cov, a_cov, a_con, nrm, h_cov)
-        d0 = xs[0] - rho[0]
-        d1 = xs[1] - rho[1]
-        d2 = xs[2] - rho[2]
+        _mono_geometry(c, xi[0], xi[1], G)
+        area, n0, n1, n2, a00, a01, a11, h00, h01, h11 = _mono_frame(G)
+        d0 = xs[0] - G[0, 0]
+        d1 = xs[1] - G[0, 1]
+        d2 = xs[2] - G[0, 2]
         f0 = 0.5 * (d0 * d0 + d1 * d1 + d2 * d2)
-        F0 = d0 * rho_cov[0, 0] + d1 * rho_cov[0, 1] + d2 * rho_cov[0, 2]
-        F1 = d0 * rho_cov[1, 0] + d1 * rho_cov[1, 1] + d2 * rho_cov[1, 2]
-        a00 = a_cov[0, 0]
-        a01 = a_cov[0, 1]
-        a11 = a_cov[1, 1]
+        F0 = d0 * G[1, 0] + d1 * G[1, 1] + d2 * G[1, 2]
+        F1 = d0 * G[2, 0] + d1 * G[2, 1] + d2 * G[2, 2]
         newton = False
+        dx0 = 0.0
+        dx1 = 0.0
         if area > 0.0:
-            g = d0 * nrm[0] + d1 * nrm[1] + d2 * nrm[2]
-            c00 = a00 - g * h_cov[0, 0]
-            c01 = a01 - g * h_cov[0, 1]
-            c11 = a11 - g * h_cov[1, 1]
+            g = d0 * n0 + d1 * n1 + d2 * n2
+            c00 = a00 - g * h00
+            c01 = a01 - g * h01
+            c11 = a11 - g * h11
             detc = c00 * c11 - c01 * c01
             if c00 > 0.0 and c11 > 0.0 and detc > 1e-10 * c00 * c11:
                 newton = True
@@ -131,10 +228,9 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
         t = 1.0
         accepted = False
         for k in range(_MAX_HALVINGS):
-            facet_point(xyz, xi[0] + t * dx0, xi[1] + t * dx1, N, dN, ddN, rho_t)
-            e0 = xs[0] - rho_t[0]
-            e1 = xs[1] - rho_t[1]
-            e2 = xs[2] - rho_t[2]
+            e0 = xs[0] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, 0)
+            e1 = xs[1] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, 1)
+            e2 = xs[2] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, 2)
             ft = 0.5 * (e0 * e0 + e1 * e1 + e2 * e2)
             if ft <= f0 + f_tol:
                 accepted = True
@@ -148,10 +244,11 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
         xi[0] += t * dx0
         xi[1] += t * dx1
 
-    area = facet_geometry(xyz, xi[0], xi[1], N, dN, ddN, rho, rho_cov, a_cov, a_con, nrm, h_cov)
+    _mono_geometry(c, xi[0], xi[1], G)
+    area, n0, n1, n2 = _mono_frame(G)[:4]
     if area == 0.0:
         return DEGENERATE, 0.0, nit
-    g = (xs[0] - rho[0]) * nrm[0] + (xs[1] - rho[1]) * nrm[1] + (xs[2] - rho[2]) * nrm[2]
+    g = (xs[0] - G[0, 0]) * n0 + (xs[1] - G[0, 1]) * n1 + (xs[2] - G[0, 2]) * n2
     return status, g, nit
 
 

@@ -28,14 +28,17 @@ from .surface import MeshSurface, facet_boxes
 _MAX_DIM = 1 << 20  # cells per direction; keys fit in int64
 
 
-@njit(cache=True)
-def _box_dist2(p, lo, hi):
+@njit(cache=True, inline="always")
+def _box_dist2(x0, x1, x2, lo, hi, f):
+    """Squared distance from the point (x0, x1, x2) to box f of (lo, hi) (nf, 3) (scalars and indices, no array
+    views: a view costs a reference count in the hot loops)."""
     d2 = 0.0
     for k in range(3):
-        if p[k] < lo[k]:
-            d2 += (lo[k] - p[k]) ** 2
-        elif p[k] > hi[k]:
-            d2 += (p[k] - hi[k]) ** 2
+        v = x0 if k == 0 else (x1 if k == 1 else x2)
+        if v < lo[f, k]:
+            d2 += (lo[f, k] - v) ** 2
+        elif v > hi[f, k]:
+            d2 += (v - hi[f, k]) ** 2
     return d2
 
 
@@ -69,10 +72,10 @@ def _grid_entries(blo, bhi, origin, h, dims):
 
 
 @njit(cache=True)
-def _sort_segment(p, lo, hi, facets, a, b, dist):
-    """Insertion sort of facets[a:b] by box distance to p (lists are short)."""
+def _sort_segment(x0, x1, x2, lo, hi, facets, a, b, dist):
+    """Insertion sort of facets[a:b] by box distance to (x0, x1, x2) (lists are short)."""
     for m in range(a, b):
-        dist[m] = _box_dist2(p, lo[facets[m]], hi[facets[m]])
+        dist[m] = _box_dist2(x0, x1, x2, lo, hi, facets[m])
     for m in range(a + 1, b):
         f = facets[m]
         d = dist[m]
@@ -86,27 +89,37 @@ def _sort_segment(p, lo, hi, facets, a, b, dist):
 
 
 @njit(cache=True)
-def _counting_sort(keys, fac, ncells):
-    """Dense cell lists: (cptr (ncells + 1,), facets grouped by cell) in O(E + ncells)."""
-    cptr = np.zeros(ncells + 1, dtype=np.int64)
-    for m in range(keys.shape[0]):
-        cptr[keys[m] + 1] += 1
-    for c in range(ncells):
-        cptr[c + 1] += cptr[c]
-    pos = cptr[:-1].copy()
-    out = np.empty(keys.shape[0], dtype=np.int64)
-    for m in range(keys.shape[0]):
-        out[pos[keys[m]]] = fac[m]
-        pos[keys[m]] += 1
-    return cptr, out
+def _coherent_order(cell, nbucket):
+    """Slaves ordered by cell (counting sort on nbucket buckets of consecutive cells, O(ns + nbucket)); slaves
+    outside the grid (cell -1) last."""
+    ns = cell.shape[0]
+    cmax = 0
+    for s in range(ns):
+        cmax = max(cmax, cell[s])
+    cnt = np.zeros(nbucket + 2, dtype=np.int64)
+    key = np.empty(ns, dtype=np.int64)
+    for s in range(ns):
+        k = nbucket if cell[s] < 0 else (cell[s] * nbucket) // (cmax + 1)
+        key[s] = k
+        cnt[k + 1] += 1
+    for k in range(nbucket + 1):
+        cnt[k + 1] += cnt[k]
+    order = np.empty(ns, dtype=np.int64)
+    for s in range(ns):
+        order[cnt[key[s]]] = s
+        cnt[key[s]] += 1
+    return order
 
 
 @njit(cache=True, parallel=True)
 def _grid_query(xs, dense, ukeys, cptr, cfac, blo, bhi, lo, hi, origin, h, dims):
     """CSR of the facets whose inflated box holds each slave, nearest box first.
 
-    Slaves are visited in cell order (better cache use for unordered slave sets); the lists are
-    written at each slave's own position.
+    The slaves are first put in cell order (a counting sort) and processed in that order with their
+    coordinates copied alongside, so that the box tests and list writes run through memory in sequence
+    whatever the slave numbering; one final pass moves each list to its slave's position. The first pass
+    keeps, per slave, a bit mask of the hits among the first 64 facets of its cell, so the second tests
+    only the boxes beyond those.
     """
     ns = xs.shape[0]
     cell = np.full(ns, -1, dtype=np.int64)
@@ -126,34 +139,60 @@ def _grid_query(xs, dense, ukeys, cptr, cfac, blo, bhi, lo, hi, origin, h, dims)
             u = np.searchsorted(ukeys, key)
             if u < ukeys.shape[0] and ukeys[u] == key:
                 cell[s] = u
-    order = np.argsort(cell)
-    count = np.zeros(ns + 1, dtype=np.int64)
+    order = _coherent_order(cell, ns)
+    xq = np.empty((ns, 3))
+    cq = np.empty(ns, dtype=np.int64)
+    count_q = np.zeros(ns + 1, dtype=np.int64)
+    mask = np.zeros(ns, dtype=np.uint64)
     for q in prange(ns):
         s = order[q]
         u = cell[s]
+        x0, x1, x2 = xs[s, 0], xs[s, 1], xs[s, 2]
+        xq[q, 0] = x0
+        xq[q, 1] = x1
+        xq[q, 2] = x2
+        cq[q] = u
         if u < 0:
             continue
         n = 0
+        bits = np.uint64(0)
         for m in range(cptr[u], cptr[u + 1]):
-            f = cfac[m]
-            if _box_dist2(xs[s], blo[f], bhi[f]) == 0.0:
+            if _box_dist2(x0, x1, x2, blo, bhi, cfac[m]) == 0.0:
                 n += 1
-        count[s + 1] = n
-    ptr = np.cumsum(count)
-    out = np.empty(ptr[ns], dtype=np.int64)
-    dist = np.empty(ptr[ns])
+                if m - cptr[u] < 64:
+                    bits |= np.uint64(1) << np.uint64(m - cptr[u])
+        count_q[q + 1] = n
+        mask[q] = bits
+    ptr_q = np.cumsum(count_q)
+    out_q = np.empty(ptr_q[ns], dtype=np.int64)
+    dist = np.empty(ptr_q[ns])
     for q in prange(ns):
-        s = order[q]
-        u = cell[s]
+        u = cq[q]
         if u < 0:
             continue
-        n = ptr[s]
-        for m in range(cptr[u], cptr[u + 1]):
-            f = cfac[m]
-            if _box_dist2(xs[s], blo[f], bhi[f]) == 0.0:
-                out[n] = f
+        x0, x1, x2 = xq[q, 0], xq[q, 1], xq[q, 2]
+        n = ptr_q[q]
+        bits = mask[q]
+        c0 = cptr[u]
+        for m in range(c0, min(cptr[u + 1], c0 + 64)):
+            if (bits >> np.uint64(m - c0)) & np.uint64(1):
+                out_q[n] = cfac[m]
                 n += 1
-        _sort_segment(xs[s], lo, hi, out, ptr[s], ptr[s + 1], dist)
+        for m in range(c0 + 64, cptr[u + 1]):
+            if _box_dist2(x0, x1, x2, blo, bhi, cfac[m]) == 0.0:
+                out_q[n] = cfac[m]
+                n += 1
+        _sort_segment(x0, x1, x2, lo, hi, out_q, ptr_q[q], ptr_q[q + 1], dist)
+    count = np.zeros(ns + 1, dtype=np.int64)
+    for q in range(ns):
+        count[order[q] + 1] = count_q[q + 1]
+    ptr = np.cumsum(count)
+    out = np.empty(ptr[ns], dtype=np.int64)
+    for q in prange(ns):
+        n = ptr[order[q]]
+        for m in range(ptr_q[q], ptr_q[q + 1]):
+            out[n] = out_q[m]
+            n += 1
     return ptr, out
 
 
@@ -165,7 +204,7 @@ def _filter_pairs(xs, ptr_in, fac_in, blo, bhi, lo, hi):
     for s in prange(ns):
         n = 0
         for m in range(ptr_in[s], ptr_in[s + 1]):
-            if _box_dist2(xs[s], blo[fac_in[m]], bhi[fac_in[m]]) == 0.0:
+            if _box_dist2(xs[s, 0], xs[s, 1], xs[s, 2], blo, bhi, fac_in[m]) == 0.0:
                 n += 1
         count[s + 1] = n
     ptr = np.cumsum(count)
@@ -174,31 +213,91 @@ def _filter_pairs(xs, ptr_in, fac_in, blo, bhi, lo, hi):
     for s in prange(ns):
         n = ptr[s]
         for m in range(ptr_in[s], ptr_in[s + 1]):
-            if _box_dist2(xs[s], blo[fac_in[m]], bhi[fac_in[m]]) == 0.0:
+            if _box_dist2(xs[s, 0], xs[s, 1], xs[s, 2], blo, bhi, fac_in[m]) == 0.0:
                 out[n] = fac_in[m]
                 n += 1
-        _sort_segment(xs[s], lo, hi, out, ptr[s], ptr[s + 1], dist)
+        _sort_segment(xs[s, 0], xs[s, 1], xs[s, 2], lo, hi, out, ptr[s], ptr[s + 1], dist)
     return ptr, out
 
 
-def _grid(xs, lo, hi, blo, bhi, cell_factor):
-    ext = bhi - blo
-    h = cell_factor * float(np.mean(ext.max(axis=1)))
-    origin = blo.min(axis=0)
-    span = float((bhi.max(axis=0) - origin).max())
-    h = max(h, span / (_MAX_DIM - 2), 1e-300)
-    # a few very large boxes among small ones would fill many cells: coarsen until the table is small
+@njit(cache=True)
+def _grid_plan(blo, bhi, cell_factor, max_dim):
+    """Cell size h, origin and dims of the bucket grid, and its number of (cell, facet) entries.
+
+    h starts at cell_factor times the mean largest box extent; a few very large boxes among small ones
+    would fill many cells, so h doubles until the table holds at most 16 entries per box (+ 1e6).
+    """
+    nf = blo.shape[0]
+    origin = np.empty(3)
+    top = np.empty(3)
+    mean_ext = 0.0
+    for k in range(3):
+        origin[k] = np.inf
+        top[k] = -np.inf
+    for f in range(nf):
+        e = 0.0
+        for k in range(3):
+            origin[k] = min(origin[k], blo[f, k])
+            top[k] = max(top[k], bhi[f, k])
+            e = max(e, bhi[f, k] - blo[f, k])
+        mean_ext += e
+    h = cell_factor * mean_ext / nf
+    span = max(top[0] - origin[0], top[1] - origin[1], top[2] - origin[2])
+    h = max(h, span / (max_dim - 2), 1e-300)
     while True:
-        per_box = np.prod(np.floor((bhi - origin) / h) - np.floor((blo - origin) / h) + 1.0, axis=1)
-        if per_box.sum() <= 16.0 * len(blo) + 1e6:
+        total = 0.0
+        for f in range(nf):
+            c = 1.0
+            for k in range(3):
+                c *= np.floor((bhi[f, k] - origin[k]) / h) - np.floor((blo[f, k] - origin[k]) / h) + 1.0
+            total += c
+        if total <= 16.0 * nf + 1e6:
             break
         h *= 2.0
-    dims = (np.floor((bhi.max(axis=0) - origin) / h).astype(np.int64) + 1).astype(np.int64)
-    keys, fac = _grid_entries(blo, bhi, origin, h, dims)
+    dims = np.empty(3, dtype=np.int64)
+    for k in range(3):
+        dims[k] = int(np.floor((top[k] - origin[k]) / h)) + 1
+    return h, origin, dims, int(total)
+
+
+@njit(cache=True)
+def _dense_cells(blo, bhi, origin, h, dims):
+    """Cell lists of a dense grid, (cptr (ncells + 1,), facets by cell, ascending within a cell): the boxes
+    are counted per cell, then entered, without an intermediate (key, facet) list."""
+    nf = blo.shape[0]
+    ncells = dims[0] * dims[1] * dims[2]
+    cptr = np.zeros(ncells + 1, dtype=np.int64)
+    lo_c = np.empty((nf, 3), dtype=np.int64)
+    hi_c = np.empty((nf, 3), dtype=np.int64)
+    for f in range(nf):
+        for k in range(3):
+            lo_c[f, k] = int(np.floor((blo[f, k] - origin[k]) / h))
+            hi_c[f, k] = int(np.floor((bhi[f, k] - origin[k]) / h))
+        for i in range(lo_c[f, 0], hi_c[f, 0] + 1):
+            for j in range(lo_c[f, 1], hi_c[f, 1] + 1):
+                for k in range(lo_c[f, 2], hi_c[f, 2] + 1):
+                    cptr[(i * dims[1] + j) * dims[2] + k + 1] += 1
+    for c in range(ncells):
+        cptr[c + 1] += cptr[c]
+    pos = cptr[:-1].copy()
+    out = np.empty(cptr[ncells], dtype=np.int64)
+    for f in range(nf):
+        for i in range(lo_c[f, 0], hi_c[f, 0] + 1):
+            for j in range(lo_c[f, 1], hi_c[f, 1] + 1):
+                for k in range(lo_c[f, 2], hi_c[f, 2] + 1):
+                    key = (i * dims[1] + j) * dims[2] + k
+                    out[pos[key]] = f
+                    pos[key] += 1
+    return cptr, out
+
+
+def _grid(xs, lo, hi, blo, bhi, cell_factor):
+    h, origin, dims, total = _grid_plan(blo, bhi, float(cell_factor), float(_MAX_DIM))
     ncells = int(dims[0]) * int(dims[1]) * int(dims[2])
-    if ncells <= max(4 * keys.size, 1 << 20):
-        cptr, fac = _counting_sort(keys, fac, ncells)
-        return _grid_query(xs, True, keys[:0], cptr, fac, blo, bhi, lo, hi, origin, h, dims)
+    if ncells <= max(4 * total, 1 << 20):
+        cptr, fac = _dense_cells(blo, bhi, origin, h, dims)
+        return _grid_query(xs, True, np.zeros(0, np.int64), cptr, fac, blo, bhi, lo, hi, origin, h, dims)
+    keys, fac = _grid_entries(blo, bhi, origin, h, dims)
     order = np.argsort(keys, kind="stable")
     keys, fac = keys[order], fac[order]
     starts = np.flatnonzero(np.concatenate(([True], keys[1:] != keys[:-1])))
