@@ -35,8 +35,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from ..fem.shapes import NODES
-from .projection import project_on_facet_work, projection_work
+from .projection import planar_start, project_on_facet_scratch
 from .search import _box_dist2, candidates
 from .surface import (
     EDGE_DIR,
@@ -60,22 +59,21 @@ _ES = EDGE_START
 _ED = EDGE_DIR
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _kkt_ok(d, t, sgn, tol):
     """The distance does not decrease into the facet along the inward tangent sgn * t:
     (r_s - c) . (sgn t) <= tol |t|."""
     return sgn * (d[0] * t[0] + d[1] * t[1] + d[2] * t[2]) <= tol * np.sqrt(t[0] ** 2 + t[1] ** 2 + t[2] ** 2)
 
 
-@njit(cache=True, inline="always")
-def _walk(f, xi, xs, x, topo, prm, use_dir, ndir, scr, pw, vis, nvis, edges, nedge):
+@njit(cache=True, error_model="numpy", inline="always")
+def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir, ndir, xyz, rho, t1,
+          t2, nrm, pc, pG, vis, nvis, edges, nedge):  # fmt: skip
     """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge).
 
-    Records every edge a projection left through in ``edges`` (for the blind-spot rule).
+    Records every edge a projection left through in ``edges`` (for the blind-spot rule). Arrays come one by one,
+    not in tuples: unpacking a tuple of arrays costs reference counts in this hottest loop.
     """
-    faces, nbr_facet, nbr_edge = topo[0], topo[1], topo[2]
-    gmax, tol_in, min_cos, max_hops = prm[0], prm[1], prm[3], prm[4]
-    xyz, rho, t1, t2, nrm = scr
     for hop in range(max_hops + 1):
         for k in range(nvis):
             if vis[k] == f:
@@ -84,7 +82,7 @@ def _walk(f, xi, xs, x, topo, prm, use_dir, ndir, scr, pw, vis, nvis, edges, ned
             vis[nvis] = f
             nvis += 1
         gather_facet(x, faces, f, xyz)
-        status, g, _nit = project_on_facet_work(xyz, xs, xi, pw)
+        status, g, _nit = project_on_facet_scratch(xyz, xs, xi, pc, pG)
         if status == 2 or not (np.isfinite(xi[0]) and np.isfinite(xi[1]) and np.isfinite(g)):
             return -1, 0.0, nvis, nedge
         o1 = abs(xi[0]) - 1.0
@@ -126,7 +124,7 @@ def _walk(f, xi, xs, x, topo, prm, use_dir, ndir, scr, pw, vis, nvis, edges, ned
     return -1, 0.0, nvis, nedge
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out):
     """Closest interior edge or vertex among the recorded exit edges; returns (kind, facet, g).
 
@@ -214,7 +212,7 @@ def _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out):
     return best_kind, bf, best_sign * np.sqrt(best_d2)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hull_dist2(xyz, xs, cp):
     """Lower bound of the squared distance from xs to the facet xyz: the distance to the box, in the facet's
     corner frame, of its control net (the nodes of a quad4; the Bernstein net of a quad9), which holds the
@@ -273,14 +271,16 @@ def _hull_dist2(xyz, xs, cp):
     return d2
 
 
-@njit(cache=True, inline="always")
-def _project_one(xs, x, topo, lo, hi, nat, cands, pf, pxi_in, prm, scr, pw, wrk, vis, edges, xi_out, n_out):
-    """Contact point of one slave; returns (kind, facet, g) and writes xi_out (2,), n_out (3,)."""
-    faces = topo[0]
-    hyst, min_cos = prm[2], prm[3]
-    xyz, rho, t1, t2, _ = scr
-    xi, pxi, ndir, c, cp = wrk
-    nen = faces.shape[1]
+@njit(cache=True, error_model="numpy", inline="always")
+def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf, gmax, fprm, max_hops, xyz, rho,
+                 t1, t2, nrm, xi, pxi, ndir, cp, pc, pG, vis, edges, xi_out, n_out):  # fmt: skip
+    """Contact point of one slave on its candidates cand_fac[c0:c1]; returns (kind, facet, g, nedge) and writes
+    xi_out (2,), n_out (3,). kind -1: no facet accepts the point, the caller tries the blind spot (``edges``).
+
+    xi holds the previous contact point on pf on entry (when pf >= 0); fprm = (tol_inside, hysteresis, min_cos).
+    At most 30 arguments: beyond that Python passes them as a tuple, which numba cannot inline.
+    """
+    tol_in, hyst, min_cos = fprm
     nvis = 0
     nedge = 0
     best_f = -1
@@ -289,51 +289,57 @@ def _project_one(xs, x, topo, lo, hi, nat, cands, pf, pxi_in, prm, scr, pw, wrk,
     prev_ok = False
     use_dir = False
     if pf >= 0:
-        xi[0] = pxi_in[0] if np.isfinite(pxi_in[0]) else 0.0
-        xi[1] = pxi_in[1] if np.isfinite(pxi_in[1]) else 0.0
+        xi[0] = xi[0] if np.isfinite(xi[0]) else 0.0
+        xi[1] = xi[1] if np.isfinite(xi[1]) else 0.0
         gather_facet(x, faces, pf, xyz)
         facet_frame(xyz, min(max(xi[0], -1.0), 1.0), min(max(xi[1], -1.0), 1.0), rho, t1, t2, ndir)
         use_dir = min_cos > -1.0
-        f, g, nvis, nedge = _walk(pf, xi, xs, x, topo, prm, use_dir, ndir, scr, pw, vis, nvis, edges, nedge)
+        f, g, nvis, nedge = _walk(pf, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir,
+                                  ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
         if f >= 0:
             best_f, best_g = f, g
-            xi_out[:] = xi
+            xi_out[0] = xi[0]
+            xi_out[1] = xi[1]
             if f == pf:
                 prev_ok, prev_g = True, g
-                pxi[:] = xi
-    for f0 in cands:
+                pxi[0] = xi[0]
+                pxi[1] = xi[1]
+    for m in range(c0, c1):
+        f0 = cand_fac[m]
         # boxes bound the facets: one farther than the best |g| cannot do better
         if best_f >= 0 and _box_dist2(xs[0], xs[1], xs[2], lo, hi, f0) > best_g * best_g:
             break
+        seen = False  # already projected on (a walk's hand-over, or the previous facet)
+        for k in range(nvis):
+            if vis[k] == f0:
+                seen = True
+                break
+        if seen:
+            continue
         if best_f >= 0:  # a tighter bound: the facet's own oriented box
             gather_facet(x, faces, f0, xyz)
             if _hull_dist2(xyz, xs, cp) > best_g * best_g:
                 continue
-        dmin = np.inf  # start from the facet node nearest to the slave
-        for a in range(nen):
-            d2 = 0.0
-            for p in range(3):
-                d2 += (x[faces[f0, a], p] - xs[p]) ** 2
-            if d2 < dmin:
-                dmin = d2
-                xi[0] = nat[a, 0]
-                xi[1] = nat[a, 1]
-        f, g, nvis, nedge = _walk(f0, xi, xs, x, topo, prm, use_dir, ndir, scr, pw, vis, nvis, edges, nedge)
+        planar_start(x, faces, f0, xs, xi)
+        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir,
+                                  ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
         if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
             best_f, best_g = f, g
-            xi_out[:] = xi
+            xi_out[0] = xi[0]
+            xi_out[1] = xi[1]
     if prev_ok and not (abs(best_g) < (1.0 - hyst) * abs(prev_g)):
         best_f, best_g = pf, prev_g
-        xi_out[:] = pxi
+        xi_out[0] = pxi[0]
+        xi_out[1] = pxi[1]
     if best_f >= 0:
         gather_facet(x, faces, best_f, xyz)
         facet_frame(xyz, xi_out[0], xi_out[1], rho, t1, t2, n_out)
-        return FACET, best_f, best_g
-    return _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out)
+        return FACET, best_f, best_g, nedge
+    return -1, -1, 0.0, nedge
 
 
-@njit(cache=True, parallel=True)
-def project_slaves_kernel(xs, x, topo, lo, hi, nat, cand_ptr, cand_fac, prev_facet, prev_xi, prm, nchunk, order,
+@njit(cache=True, error_model="numpy", parallel=True)
+def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, prev_xi, prm, nchunk, order,
                           out_facet, out_xi, out_g, out_kind, out_n):  # fmt: skip
     """Contact point of every slave (see the module docstring); writes the out arrays.
 
@@ -343,37 +349,64 @@ def project_slaves_kernel(xs, x, topo, lo, hi, nat, cand_ptr, cand_fac, prev_fac
 
     Args:
         xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
-            node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. nat: (nen, 2) element
-            coordinates of the facet nodes. cand_ptr, cand_fac: candidate CSR (by slave number).
-            prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
+            node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. cand_ptr, cand_fac:
+            candidate CSR (by slave number). prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
         prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops).
         nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
         order: (ns,) the slave numbers in visiting order (spatially coherent for cache use).
     """
     ns = xs.shape[0]
-    nen = topo[0].shape[1]
+    faces, nbr_facet, nbr_edge = topo[0], topo[1], topo[2]
+    gmax, tol_in, hyst, min_cos, max_hops = prm
+    fprm = (tol_in, hyst, min_cos)
+    nen = faces.shape[1]
     for ch in prange(nchunk):
-        scr = (np.empty((nen, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3))
-        wrk = (np.empty(2), np.empty(2), np.zeros(3), np.empty(3), np.empty((9, 3)))
-        pw = projection_work(nen)
+        xyz = np.empty((nen, 3))
+        rho = np.empty(3)
+        t1 = np.empty(3)
+        t2 = np.empty(3)
+        nrm = np.empty(3)
+        xi = np.empty(2)
+        pxi = np.empty(2)
+        ndir = np.zeros(3)
+        c = np.empty(3)
+        cp = np.empty((9, 3))
+        pc = np.empty((3, 3, 3))
+        pG = np.empty((6, 3))
         vis = np.empty(_MAX_VISITED, dtype=np.int64)
         edges = np.empty((_MAX_EDGES, 2), dtype=np.int64)
+        xsv = np.empty(3)
+        xo = np.empty(2)
+        no = np.empty(3)
         for q in range(ch * ns // nchunk, (ch + 1) * ns // nchunk):
             s = order[q]
-            cands = cand_fac[cand_ptr[s] : cand_ptr[s + 1]]
-            kind, f, g = _project_one(xs[q], x, topo, lo, hi, nat, cands, prev_facet[q], prev_xi[q], prm, scr,
-                                      pw, wrk, vis, edges, out_xi[q], out_n[q])  # fmt: skip
+            xsv[0] = xs[q, 0]
+            xsv[1] = xs[q, 1]
+            xsv[2] = xs[q, 2]
+            xi[0] = prev_xi[q, 0]
+            xi[1] = prev_xi[q, 1]
+            kind, f, g, nedge = _project_one(xsv, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, cand_ptr[s],
+                                             cand_ptr[s + 1], prev_facet[q], gmax, fprm, max_hops, xyz, rho, t1, t2,
+                                             nrm, xi, pxi, ndir, cp, pc, pG, vis, edges, xo, no)  # fmt: skip
+            if kind < 0:
+                kind, f, g = _blind_spot(xsv, x, topo, prm, edges, nedge, (xyz, rho, t1, t2, nrm), c, xo, no)
             out_kind[q] = kind
             out_facet[q] = f
             if kind == NO_CONTACT:
                 out_g[q] = np.inf
-                out_xi[q, :] = 0.0
-                out_n[q, :] = 0.0
+                for p in range(2):
+                    out_xi[q, p] = 0.0
+                for p in range(3):
+                    out_n[q, p] = 0.0
             else:
                 out_g[q] = g
+                out_xi[q, 0] = xo[0]
+                out_xi[q, 1] = xo[1]
+                for p in range(3):
+                    out_n[q, p] = no[p]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def visit_order(prev_facet, cand_ptr, cand_fac, nf):
     """Slaves grouped by their previous (else first candidate) facet, a counting sort in O(ns + nf): neighbouring
     slaves then share facet data in cache whatever the slave numbering."""
@@ -481,7 +514,6 @@ def project_slaves(
         surface.node_facets,
     )
     prm = (gm, float(tol_inside), float(hysteresis), float(min_cos), int(max_hops))
-    nat = np.ascontiguousarray(NODES[surface.cell_type])
     cp = np.ascontiguousarray(cand_ptr, np.int64)
     cf = np.ascontiguousarray(cand_facets, np.int64)
     lo, hi = np.ascontiguousarray(lo), np.ascontiguousarray(hi)
@@ -489,7 +521,7 @@ def project_slaves(
     o = ProjectionResult(facet=np.empty(ns, np.int64), xi=np.empty((ns, 2)), g=np.empty(ns),
                          kind=np.empty(ns, np.int8), normal=np.empty((ns, 3)))  # fmt: skip
     project_slaves_kernel(
-        xs[order], x, topo, lo, hi, nat, cp, cf, pf[order], pxi[order], prm, nchunk, order, o.facet, o.xi, o.g,
+        xs[order], x, topo, lo, hi, cp, cf, pf[order], pxi[order], prm, nchunk, order, o.facet, o.xi, o.g,
         o.kind, o.normal,
     )  # fmt: skip
     for name in ("facet", "xi", "g", "kind", "normal"):

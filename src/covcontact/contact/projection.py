@@ -33,7 +33,7 @@ _MONO2 = np.array([[0.0, -0.5, 0.5], [0.0, 0.5, 0.5], [1.0, 0.0, -1.0]])
 _IDX9 = IDX["quad9"]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def facet_monomials(xyz, c):
     """The facet as a polynomial: rho(xi) = sum_mq c[m, q] xi1^m xi2^q, c (3, 3, 3) out (quad4: m, q <= 1).
 
@@ -74,7 +74,7 @@ def facet_monomials(xyz, c):
                             c[m, q, p] += w * xyz[a, p]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _mono_geometry(c, x1, x2, G):
     """G (6, 3) out: rho, rho_1, rho_2, rho_11, rho_12, rho_22 of the monomial form c at (x1, x2)."""
     for p in range(3):
@@ -92,7 +92,7 @@ def _mono_geometry(c, x1, x2, G):
         G[5, p] = 2.0 * (c[0, 2, p] + x1 * (c[1, 2, p] + x1 * c[2, 2, p]))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _mono_point(c, x1, x2, p):
     """Coordinate p of rho(x1, x2)."""
     u0 = c[0, 0, p] + x2 * (c[0, 1, p] + x2 * c[0, 2, p])
@@ -101,7 +101,7 @@ def _mono_point(c, x1, x2, p):
     return u0 + x1 * (u1 + x1 * u2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _mono_frame(G):
     """(area, n0, n1, n2, a00, a01, a11, h00, h01, h11) from G of ``_mono_geometry``; area 0 (n, h zero) at a
     degenerate point (as ``facet_geometry``)."""
@@ -123,13 +123,47 @@ def _mono_frame(G):
     return area, n0, n1, n2, a00, a01, a11, h00, h01, h11
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
+def planar_start(x, faces, f, xs, xi):
+    """Start of a projection without history: xi where the tangent plane at the centre of the corners' bilinear
+    map comes nearest xs (one uncapped Gauss-Newton step from the centre), clipped to [-1, 1]^2.
+
+    ``x`` (n, 3) node positions, ``faces[f]`` the facet's nodes (its first four are the corners); xi (2,) out.
+    A slave over a mildly warped facet starts within a few per cent of its converged point, instead of at the
+    centre or a node, from which the capped Newton steps take longer.
+    """
+    i0, i1, i2, i3 = faces[f, 0], faces[f, 1], faces[f, 2], faces[f, 3]
+    bb = 0.0
+    bc = 0.0
+    cc = 0.0
+    db = 0.0
+    dc = 0.0
+    for p in range(3):
+        x0, x1, x2, x3 = x[i0, p], x[i1, p], x[i2, p], x[i3, p]
+        b = x1 + x2 - x0 - x3
+        c = x2 + x3 - x0 - x1
+        d = 4.0 * xs[p] - (x0 + x1 + x2 + x3)
+        bb += b * b
+        bc += b * c
+        cc += c * c
+        db += d * b
+        dc += d * c
+    det = bb * cc - bc * bc
+    if det > 1e-12 * bb * cc:
+        xi[0] = min(max((cc * db - bc * dc) / det, -1.0), 1.0)
+        xi[1] = min(max((bb * dc - bc * db) / det, -1.0), 1.0)
+    else:
+        xi[0] = 0.0
+        xi[1] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def projection_work(nen):
     """Scratch arrays for ``project_on_facet_work`` (allocate once per thread, reuse for every call)."""
     return np.empty((3, 3, 3)), np.empty((6, 3))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def project_on_facet_info(xyz, xs, xi, max_iter=30, tol=1e-12):
     """As ``project_on_facet``, and also returns the number of Newton iterations used.
 
@@ -139,15 +173,27 @@ def project_on_facet_info(xyz, xs, xi, max_iter=30, tol=1e-12):
     return project_on_facet_work(xyz, xs, xi, projection_work(xyz.shape[0]), max_iter, tol)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
     """As ``project_on_facet_info`` with the caller's scratch ``work = projection_work(nen)``: no allocation,
-    for hot loops over many slaves. The facet is evaluated in its monomial form (``facet_monomials``).
+    for hot loops over many slaves.
 
     Returns:
         (status, g, nit).
     """
     c, G = work
+    return project_on_facet_scratch(xyz, xs, xi, c, G, max_iter, tol)
+
+
+@njit(cache=True, error_model="numpy")
+def project_on_facet_scratch(xyz, xs, xi, c, G, max_iter=30, tol=1e-12):
+    """The projection itself, scratch c (3, 3, 3) and G (6, 3) passed one by one (the hot loops avoid tuples of
+    arrays, whose unpacking costs reference counts). The facet is evaluated in its monomial form
+    (``facet_monomials``).
+
+    Returns:
+        (status, g, nit).
+    """
 
     # guard against non-finite input: never propagate NaN
     scale = 0.0
@@ -252,7 +298,7 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
     return status, g, nit
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def project_on_facet(xyz, xs, xi, max_iter=30, tol=1e-12):
     """Closest point projection of ``xs`` onto the facet ``xyz``.
 

@@ -28,7 +28,7 @@ from .surface import MeshSurface, facet_boxes
 _MAX_DIM = 1 << 20  # cells per direction; keys fit in int64
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _box_dist2(x0, x1, x2, lo, hi, f):
     """Squared distance from the point (x0, x1, x2) to box f of (lo, hi) (nf, 3) (scalars and indices, no array
     views: a view costs a reference count in the hot loops)."""
@@ -42,7 +42,7 @@ def _box_dist2(x0, x1, x2, lo, hi, f):
     return d2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _grid_entries(blo, bhi, origin, h, dims):
     """(cell key, facet) pairs of every cell that an inflated box overlaps."""
     nf = blo.shape[0]
@@ -71,7 +71,7 @@ def _grid_entries(blo, bhi, origin, h, dims):
     return keys, fac
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _sort_segment(x0, x1, x2, lo, hi, facets, a, b, dist):
     """Insertion sort of facets[a:b] by box distance to (x0, x1, x2) (lists are short)."""
     for m in range(a, b):
@@ -88,7 +88,7 @@ def _sort_segment(x0, x1, x2, lo, hi, facets, a, b, dist):
         dist[q + 1] = d
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _coherent_order(cell, nbucket):
     """Slaves ordered by cell (counting sort on nbucket buckets of consecutive cells, O(ns + nbucket)); slaves
     outside the grid (cell -1) last."""
@@ -111,7 +111,7 @@ def _coherent_order(cell, nbucket):
     return order
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _grid_query(xs, dense, ukeys, cptr, cfac, blo, bhi, lo, hi, origin, h, dims):
     """CSR of the facets whose inflated box holds each slave, nearest box first.
 
@@ -196,7 +196,7 @@ def _grid_query(xs, dense, ukeys, cptr, cfac, blo, bhi, lo, hi, origin, h, dims)
     return ptr, out
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _filter_pairs(xs, ptr_in, fac_in, blo, bhi, lo, hi):
     """Exact box test and ordering of a superset CSR (from the tree)."""
     ns = xs.shape[0]
@@ -220,7 +220,7 @@ def _filter_pairs(xs, ptr_in, fac_in, blo, bhi, lo, hi):
     return ptr, out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _grid_plan(blo, bhi, cell_factor, max_dim):
     """Cell size h, origin and dims of the bucket grid, and its number of (cell, facet) entries.
 
@@ -260,7 +260,7 @@ def _grid_plan(blo, bhi, cell_factor, max_dim):
     return h, origin, dims, int(total)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _dense_cells(blo, bhi, origin, h, dims):
     """Cell lists of a dense grid, (cptr (ncells + 1,), facets by cell, ascending within a cell): the boxes
     are counted per cell, then entered, without an intermediate (key, facet) list."""

@@ -168,7 +168,7 @@ _L2B = np.array([[1.0, 0.0, 0.0], [-0.5, 2.0, -0.5], [0.0, 0.0, 1.0]])
 _Q9_GRID = np.array([[0, 2, 1][k] for k in IDX["quad9"].ravel()]).reshape(9, 2)
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _boxes_kernel(x, faces, l2b, q9grid, lo, hi):
     nf, nen = faces.shape
     for f in prange(nf):
@@ -221,7 +221,7 @@ def facet_boxes(x_nodes: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.
     return lo, hi
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def _sizes_kernel(x, faces, out):
     for f in prange(faces.shape[0]):
         d1 = 0.0
@@ -248,7 +248,7 @@ _IDX4 = IDX["quad4"]
 _IDX9 = IDX["quad9"]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def gather_facet(x, faces, f, xyz):
     """Copy the node positions of facet f into xyz (nen, 3)."""
     for a in range(faces.shape[1]):
@@ -256,9 +256,32 @@ def gather_facet(x, faces, f, xyz):
             xyz[a, p] = x[faces[f, a], p]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm):
     """rho(xi), rho_1, rho_2 and the unit normal there (zero normal at a degenerate point)."""
+    nen = xyz.shape[0]
+    if nen == 4:  # rho = A + B xi1 + C xi2 + D xi1 xi2 from the corners
+        for p in range(3):
+            x0, x1, x2, x3 = xyz[0, p], xyz[1, p], xyz[2, p], xyz[3, p]
+            b = 0.25 * (x1 + x2 - x0 - x3)
+            c = 0.25 * (x2 + x3 - x0 - x1)
+            d = 0.25 * (x0 + x2 - x1 - x3)
+            t1[p] = b + d * xi2
+            t2[p] = c + d * xi1
+            rho[p] = 0.25 * (x0 + x1 + x2 + x3) + b * xi1 + c * xi2 + d * xi1 * xi2
+    else:
+        _frame_lagrange(xyz, xi1, xi2, rho, t1, t2)
+    nrm[0] = t1[1] * t2[2] - t1[2] * t2[1]
+    nrm[1] = t1[2] * t2[0] - t1[0] * t2[2]
+    nrm[2] = t1[0] * t2[1] - t1[1] * t2[0]
+    ln = np.sqrt(nrm[0] ** 2 + nrm[1] ** 2 + nrm[2] ** 2)
+    for p in range(3):
+        nrm[p] = nrm[p] / ln if ln > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _frame_lagrange(xyz, xi1, xi2, rho, t1, t2):
+    """rho, rho_1, rho_2 by the shape-function sums (any facet type)."""
     nen = xyz.shape[0]
     order = 1 if nen == 4 else 2
     for p in range(3):
@@ -274,15 +297,9 @@ def facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm):
             rho[p] += v1 * v2 * xyz[a, p]
             t1[p] += d1 * v2 * xyz[a, p]
             t2[p] += v1 * d2 * xyz[a, p]
-    nrm[0] = t1[1] * t2[2] - t1[2] * t2[1]
-    nrm[1] = t1[2] * t2[0] - t1[0] * t2[2]
-    nrm[2] = t1[0] * t2[1] - t1[1] * t2[0]
-    ln = np.sqrt(nrm[0] ** 2 + nrm[1] ** 2 + nrm[2] ** 2)
-    for p in range(3):
-        nrm[p] = nrm[p] / ln if ln > 0.0 else 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def _edge_eval(xyz, e, t, r, r1, r2):
     """Point, first and second derivative of the curve of local edge e at parameter t."""
     a0 = e
@@ -302,7 +319,7 @@ def _edge_eval(xyz, e, t, r, r1, r2):
             r2[p] = x0 + x1 - 2.0 * xm
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def edge_closest_point(xyz, e, xs, c):
     """Closest point c on the curve of local edge e of a facet, edge parameter t in [-1, 1].
 
