@@ -122,6 +122,15 @@ def test_many_slaves_warm_cold_and_no_nan():
     assert np.array_equal(warm.kind, cold.kind) and np.array_equal(warm.facet, cold.facet)
     ok = cold.kind > 0
     assert np.allclose(warm.g[ok], cold.g[ok], atol=1e-12)
+    # the slaves' numbering does not matter (the driver visits them in its own order and writes them back)
+    perm = rng.permutation(n)
+    ptr_p, fac_p = candidates(x, CYL_S, xs[perm], margin=0.4)
+    for prev in (None, cold):
+        pf, pxi = (None, None) if prev is None else (prev.facet[perm], prev.xi[perm])
+        shuf = project_slaves(x, CYL_S, xs[perm], ptr_p, fac_p, pf, pxi, gmax=1.0)
+        ref = cold if prev is None else warm
+        for name in ("facet", "kind", "xi", "g", "normal"):
+            assert np.array_equal(getattr(shuf, name), getattr(ref, name)[perm]), name
     # candidates forced to all facets for far points: still bounded, finite, no contact
     far = xs[:50]
     allp = np.arange(51) * len(faces)

@@ -6,7 +6,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from covcontact.contact.geometry import facet_geometry
-from covcontact.contact.projection import project_on_facet, project_on_facet_info
+from covcontact.contact.projection import (
+    _mono_geometry,
+    facet_monomials,
+    project_on_facet,
+    project_on_facet_info,
+)
 from covcontact.fem.shapes import NODES
 
 SETTINGS = settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -148,3 +153,23 @@ def test_degenerate_and_non_finite():
     status, g = project_on_facet(xyz, np.array([0.1, 0.1, 0.1]), xi)
     assert status == 0 and np.all(np.isfinite(xi))  # a NaN start is replaced by the centre
     assert project_on_facet(xyz, np.array([np.inf, 0.0, 0.0]), np.zeros(2))[0] == 2
+
+
+@pytest.mark.parametrize("nen", [4, 9])
+def test_monomial_form_equals_the_shape_functions(nen):
+    # the projection's Newton loop runs on the facet's monomial form: position and first and second derivatives
+    # equal those of the Lagrange shape functions, inside and outside [-1, 1]^2
+    rng = np.random.default_rng(nen)
+    xyz = rng.normal(size=(nen, 3))
+    c = np.empty((3, 3, 3))
+    facet_monomials(xyz, c)
+    G = np.empty((6, 3))
+    N, dN, ddN = np.empty(nen), np.empty((nen, 2)), np.empty((nen, 2, 2))
+    rho, rc, a, ac, n, h = np.empty(3), np.empty((2, 3)), np.empty((2, 2)), np.empty((2, 2)), np.empty(3), np.empty((2, 2))
+    for x1, x2 in rng.uniform(-1.5, 1.5, (10, 2)):
+        _mono_geometry.py_func(c, x1, x2, G)
+        facet_geometry(xyz, x1, x2, N, dN, ddN, rho, rc, a, ac, n, h)
+        dd = np.einsum("aij,ap->ijp", ddN, xyz)
+        assert np.allclose(G[0], rho, atol=1e-13) and np.allclose(G[1:3], rc, atol=1e-13)
+        assert np.allclose(G[3], dd[0, 0], atol=1e-13) and np.allclose(G[4], dd[0, 1], atol=1e-13)
+        assert np.allclose(G[5], dd[1, 1], atol=1e-13)

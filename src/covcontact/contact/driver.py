@@ -35,7 +35,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from .projection import planar_start, project_on_facet_scratch
+from .projection import planar_start, project_inline
 from .search import _box_dist2, candidates
 from .surface import (
     EDGE_DIR,
@@ -82,7 +82,7 @@ def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_h
             vis[nvis] = f
             nvis += 1
         gather_facet(x, faces, f, xyz)
-        status, g, _nit = project_on_facet_scratch(xyz, xs, xi, pc, pG)
+        status, g, _nit = project_inline(xyz, xs, xi, pc, pG, 30, 1e-12)
         if status == 2 or not (np.isfinite(xi[0]) and np.isfinite(xi[1]) and np.isfinite(g)):
             return -1, 0.0, nvis, nedge
         o1 = abs(xi[0]) - 1.0
@@ -212,7 +212,7 @@ def _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out):
     return best_kind, bf, best_sign * np.sqrt(best_d2)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _hull_dist2(xyz, xs, cp):
     """Lower bound of the squared distance from xs to the facet xyz: the distance to the box, in the facet's
     corner frame, of its control net (the nodes of a quad4; the Bernstein net of a quad9), which holds the
@@ -339,13 +339,13 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, prev_xi, prm, nchunk, order,
-                          out_facet, out_xi, out_g, out_kind, out_n):  # fmt: skip
+def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, prev_xi, prm, nchunk, out_facet, out_xi,
+                          out_g, out_kind, out_n):  # fmt: skip
     """Contact point of every slave (see the module docstring); writes the out arrays.
 
-    The per-slave arrays (xs, prev_facet, prev_xi and the outputs) are in visiting order: entry q belongs to
-    slave order[q], whose candidates are cand_fac[cand_ptr[order[q]]:cand_ptr[order[q] + 1]]. The caller
-    permutes them (sequential memory traffic in the kernel whatever the slave numbering).
+    The per-slave arrays (xs, the candidate CSR, prev_facet, prev_xi and the outputs) are in visiting order,
+    permuted by the caller (``visit_order``, ``permute_csr``): sequential memory traffic in the kernel whatever
+    the slave numbering.
 
     Args:
         xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
@@ -353,7 +353,6 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
             candidate CSR (by slave number). prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
         prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops).
         nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
-        order: (ns,) the slave numbers in visiting order (spatially coherent for cache use).
     """
     ns = xs.shape[0]
     faces, nbr_facet, nbr_edge = topo[0], topo[1], topo[2]
@@ -379,14 +378,13 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
         xo = np.empty(2)
         no = np.empty(3)
         for q in range(ch * ns // nchunk, (ch + 1) * ns // nchunk):
-            s = order[q]
             xsv[0] = xs[q, 0]
             xsv[1] = xs[q, 1]
             xsv[2] = xs[q, 2]
             xi[0] = prev_xi[q, 0]
             xi[1] = prev_xi[q, 1]
-            kind, f, g, nedge = _project_one(xsv, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, cand_ptr[s],
-                                             cand_ptr[s + 1], prev_facet[q], gmax, fprm, max_hops, xyz, rho, t1, t2,
+            kind, f, g, nedge = _project_one(xsv, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, cand_ptr[q],
+                                             cand_ptr[q + 1], prev_facet[q], gmax, fprm, max_hops, xyz, rho, t1, t2,
                                              nrm, xi, pxi, ndir, cp, pc, pG, vis, edges, xo, no)  # fmt: skip
             if kind < 0:
                 kind, f, g = _blind_spot(xsv, x, topo, prm, edges, nedge, (xyz, rho, t1, t2, nrm), c, xo, no)
@@ -404,6 +402,23 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
                 out_xi[q, 1] = xo[1]
                 for p in range(3):
                     out_n[q, p] = no[p]
+
+
+@njit(cache=True, error_model="numpy")
+def permute_csr(ptr, fac, order):
+    """The CSR (ptr, fac) with its rows in the order ``order``."""
+    ns = order.shape[0]
+    ptr_o = np.empty(ns + 1, dtype=np.int64)
+    ptr_o[0] = 0
+    for q in range(ns):
+        ptr_o[q + 1] = ptr_o[q] + ptr[order[q] + 1] - ptr[order[q]]
+    fac_o = np.empty(ptr_o[ns], dtype=np.int64)
+    for q in range(ns):
+        m = ptr_o[q]
+        for k in range(ptr[order[q]], ptr[order[q] + 1]):
+            fac_o[m] = fac[k]
+            m += 1
+    return ptr_o, fac_o
 
 
 @njit(cache=True, error_model="numpy")
@@ -520,10 +535,10 @@ def project_slaves(
     order = visit_order(pf, cp, cf, nf)
     o = ProjectionResult(facet=np.empty(ns, np.int64), xi=np.empty((ns, 2)), g=np.empty(ns),
                          kind=np.empty(ns, np.int8), normal=np.empty((ns, 3)))  # fmt: skip
+    cp, cf = permute_csr(cp, cf, order)
     project_slaves_kernel(
-        xs[order], x, topo, lo, hi, cp, cf, pf[order], pxi[order], prm, nchunk, order, o.facet, o.xi, o.g,
-        o.kind, o.normal,
-    )  # fmt: skip
+        xs[order], x, topo, lo, hi, cp, cf, pf[order], pxi[order], prm, nchunk, o.facet, o.xi, o.g, o.kind, o.normal
+    )
     for name in ("facet", "xi", "g", "kind", "normal"):
         getattr(out, name)[order] = getattr(o, name)
     return out

@@ -14,7 +14,6 @@ import numpy as np
 from numba import njit
 
 from covcontact.contact.geometry import DEGENERATE_TOL
-from covcontact.fem.shapes import IDX
 
 #: projection status codes
 CONVERGED = 0
@@ -27,10 +26,6 @@ _MAX_HALVINGS = 40
 _EPS = 2.220446049250313e-16
 
 
-# Lagrange basis -> monomials: row k holds the coefficients of quadratic 1D basis function k (node -1, +1, 0)
-# in 1, x, x^2
-_MONO2 = np.array([[0.0, -0.5, 0.5], [0.0, 0.5, 0.5], [1.0, 0.0, -1.0]])
-_IDX9 = IDX["quad9"]
 
 
 @njit(cache=True, error_model="numpy")
@@ -56,22 +51,24 @@ def facet_monomials(xyz, c):
             c[1, 2, p] = 0.0
             c[2, 2, p] = 0.0
         return
-    # quad9: node values on the 3 x 3 grid (1D index -1, +1, 0), then the 1D transform in each direction
+    # quad9: the 1D transform (values at -1, +1, 0 -> monomials) along xi1 for each row of nodes, then along xi2;
+    # nodes (VTK order) 0 (-1,-1), 1 (1,-1), 2 (1,1), 3 (-1,1), 4 (0,-1), 5 (1,0), 6 (0,1), 7 (-1,0), 8 (0,0)
     for p in range(3):
+        for q in range(3):
+            if q == 0:  # row xi2 = -1
+                a, b, z = xyz[0, p], xyz[1, p], xyz[4, p]
+            elif q == 1:  # row xi2 = +1
+                a, b, z = xyz[3, p], xyz[2, p], xyz[6, p]
+            else:  # row xi2 = 0
+                a, b, z = xyz[7, p], xyz[5, p], xyz[8, p]
+            c[0, q, p] = z
+            c[1, q, p] = 0.5 * (b - a)
+            c[2, q, p] = 0.5 * (a + b) - z
         for m in range(3):
-            for q in range(3):
-                c[m, q, p] = 0.0
-    for a in range(9):
-        i = _IDX9[a, 0]
-        j = _IDX9[a, 1]
-        for m in range(3):
-            wi = _MONO2[i, m]
-            if wi != 0.0:
-                for q in range(3):
-                    w = wi * _MONO2[j, q]
-                    if w != 0.0:
-                        for p in range(3):
-                            c[m, q, p] += w * xyz[a, p]
+            a, b, z = c[m, 0, p], c[m, 1, p], c[m, 2, p]
+            c[m, 0, p] = z
+            c[m, 1, p] = 0.5 * (b - a)
+            c[m, 2, p] = 0.5 * (a + b) - z
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -187,13 +184,19 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
 
 @njit(cache=True, error_model="numpy")
 def project_on_facet_scratch(xyz, xs, xi, c, G, max_iter=30, tol=1e-12):
-    """The projection itself, scratch c (3, 3, 3) and G (6, 3) passed one by one (the hot loops avoid tuples of
-    arrays, whose unpacking costs reference counts). The facet is evaluated in its monomial form
-    (``facet_monomials``).
+    """The projection itself, scratch c (3, 3, 3) and G (6, 3) passed one by one. The facet is evaluated in its
+    monomial form (``facet_monomials``).
 
     Returns:
         (status, g, nit).
     """
+    return project_inline(xyz, xs, xi, c, G, max_iter, tol)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def project_inline(xyz, xs, xi, c, G, max_iter, tol):
+    """``project_on_facet_scratch`` compiled into its caller: the contact driver's hot loop, where a call that
+    passes arrays costs a reference count per array and per call."""
 
     # guard against non-finite input: never propagate NaN
     scale = 0.0

@@ -256,7 +256,7 @@ def gather_facet(x, faces, f, xyz):
             xyz[a, p] = x[faces[f, a], p]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm):
     """rho(xi), rho_1, rho_2 and the unit normal there (zero normal at a degenerate point)."""
     nen = xyz.shape[0]
