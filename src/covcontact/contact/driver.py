@@ -44,6 +44,7 @@ from .surface import (
     edge_closest_point,
     facet_boxes,
     facet_frame,
+    facet_frame_inline,
     facet_sizes,
     gather_facet,
 )
@@ -91,7 +92,7 @@ def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_h
             if status != 0 or not (g > -gmax[f]):
                 return -1, 0.0, nvis, nedge
             if use_dir:
-                facet_frame(xyz, xi[0], xi[1], rho, t1, t2, nrm)
+                facet_frame_inline(xyz, xi[0], xi[1], rho, t1, t2, nrm)
                 if nrm[0] * ndir[0] + nrm[1] * ndir[1] + nrm[2] * ndir[2] < min_cos:
                     return -1, 0.0, nvis, nedge
             return f, g, nvis, nedge
@@ -212,7 +213,7 @@ def _blind_spot(xs, x, topo, prm, edges, nedge, scr, c, xi_out, n_out):
     return best_kind, bf, best_sign * np.sqrt(best_d2)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _hull_dist2(xyz, xs, cp):
     """Lower bound of the squared distance from xs to the facet xyz: the distance to the box, in the facet's
     corner frame, of its control net (the nodes of a quad4; the Bernstein net of a quad9), which holds the
@@ -292,48 +293,47 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
         xi[0] = xi[0] if np.isfinite(xi[0]) else 0.0
         xi[1] = xi[1] if np.isfinite(xi[1]) else 0.0
         gather_facet(x, faces, pf, xyz)
-        facet_frame(xyz, min(max(xi[0], -1.0), 1.0), min(max(xi[1], -1.0), 1.0), rho, t1, t2, ndir)
+        facet_frame_inline(xyz, min(max(xi[0], -1.0), 1.0), min(max(xi[1], -1.0), 1.0), rho, t1, t2, ndir)
         use_dir = min_cos > -1.0
-        f, g, nvis, nedge = _walk(pf, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir,
-                                  ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
-        if f >= 0:
-            best_f, best_g = f, g
-            xi_out[0] = xi[0]
-            xi_out[1] = xi[1]
-            if f == pf:
-                prev_ok, prev_g = True, g
-                pxi[0] = xi[0]
-                pxi[1] = xi[1]
-    for m in range(c0, c1):
-        f0 = cand_fac[m]
-        # boxes bound the facets: one farther than the best |g| cannot do better
-        if best_f >= 0 and _box_dist2(xs[0], xs[1], xs[2], lo, hi, f0) > best_g * best_g:
-            break
-        seen = False  # already projected on (a walk's hand-over, or the previous facet)
-        for k in range(nvis):
-            if vis[k] == f0:
-                seen = True
+    # the previous facet first (from its previous xi), then the candidates; one call site of the walk (it is
+    # compiled in place)
+    for m in range(c0 - 1 if pf >= 0 else c0, c1):
+        if m < c0:
+            f0 = pf
+        else:
+            f0 = cand_fac[m]
+            # boxes bound the facets: one farther than the best |g| cannot do better
+            if best_f >= 0 and _box_dist2(xs[0], xs[1], xs[2], lo, hi, f0) > best_g * best_g:
                 break
-        if seen:
-            continue
-        if best_f >= 0:  # a tighter bound: the facet's own oriented box
-            gather_facet(x, faces, f0, xyz)
-            if _hull_dist2(xyz, xs, cp) > best_g * best_g:
+            seen = False  # already projected on (a walk's hand-over, or the previous facet)
+            for k in range(nvis):
+                if vis[k] == f0:
+                    seen = True
+                    break
+            if seen:
                 continue
-        planar_start(x, faces, f0, xs, xi)
+            if best_f >= 0:  # a tighter bound: the facet's own oriented box
+                gather_facet(x, faces, f0, xyz)
+                if _hull_dist2(xyz, xs, cp) > best_g * best_g:
+                    continue
+            planar_start(x, faces, f0, xs, xi)
         f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir,
                                   ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
         if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
             best_f, best_g = f, g
             xi_out[0] = xi[0]
             xi_out[1] = xi[1]
+        if m < c0 and f >= 0 and f == pf:
+            prev_ok, prev_g = True, g
+            pxi[0] = xi[0]
+            pxi[1] = xi[1]
     if prev_ok and not (abs(best_g) < (1.0 - hyst) * abs(prev_g)):
         best_f, best_g = pf, prev_g
         xi_out[0] = pxi[0]
         xi_out[1] = pxi[1]
     if best_f >= 0:
         gather_facet(x, faces, best_f, xyz)
-        facet_frame(xyz, xi_out[0], xi_out[1], rho, t1, t2, n_out)
+        facet_frame_inline(xyz, xi_out[0], xi_out[1], rho, t1, t2, n_out)
         return FACET, best_f, best_g, nedge
     return -1, -1, 0.0, nedge
 

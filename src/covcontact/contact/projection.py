@@ -71,7 +71,7 @@ def facet_monomials(xyz, c):
             c[m, 2, p] = 0.5 * (a + b) - z
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _mono_geometry(c, x1, x2, G):
     """G (6, 3) out: rho, rho_1, rho_2, rho_11, rho_12, rho_22 of the monomial form c at (x1, x2)."""
     for p in range(3):
@@ -89,7 +89,7 @@ def _mono_geometry(c, x1, x2, G):
         G[5, p] = 2.0 * (c[0, 2, p] + x1 * (c[1, 2, p] + x1 * c[2, 2, p]))
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _mono_point(c, x1, x2, p):
     """Coordinate p of rho(x1, x2)."""
     u0 = c[0, 0, p] + x2 * (c[0, 1, p] + x2 * c[0, 2, p])
@@ -98,7 +98,7 @@ def _mono_point(c, x1, x2, p):
     return u0 + x1 * (u1 + x1 * u2)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _mono_frame(G):
     """(area, n0, n1, n2, a00, a01, a11, h00, h01, h11) from G of ``_mono_geometry``; area 0 (n, h zero) at a
     degenerate point (as ``facet_geometry``)."""

@@ -257,26 +257,38 @@ def gather_facet(x, faces, f, xyz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm):
-    """rho(xi), rho_1, rho_2 and the unit normal there (zero normal at a degenerate point)."""
-    nen = xyz.shape[0]
-    if nen == 4:  # rho = A + B xi1 + C xi2 + D xi1 xi2 from the corners
-        for p in range(3):
-            x0, x1, x2, x3 = xyz[0, p], xyz[1, p], xyz[2, p], xyz[3, p]
-            b = 0.25 * (x1 + x2 - x0 - x3)
-            c = 0.25 * (x2 + x3 - x0 - x1)
-            d = 0.25 * (x0 + x2 - x1 - x3)
-            t1[p] = b + d * xi2
-            t2[p] = c + d * xi1
-            rho[p] = 0.25 * (x0 + x1 + x2 + x3) + b * xi1 + c * xi2 + d * xi1 * xi2
-    else:
-        _frame_lagrange(xyz, xi1, xi2, rho, t1, t2)
+def facet_frame_inline(xyz, xi1, xi2, rho, t1, t2, nrm):
+    """``facet_frame`` for hot loops: a quad4 is evaluated in place from its corners (no call, so no reference
+    counts for the arrays passed), other facets by a call to ``facet_frame``."""
+    if xyz.shape[0] != 4:
+        facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm)
+        return
+    for p in range(3):
+        x0, x1, x2, x3 = xyz[0, p], xyz[1, p], xyz[2, p], xyz[3, p]
+        b = 0.25 * (x1 + x2 - x0 - x3)
+        c = 0.25 * (x2 + x3 - x0 - x1)
+        d = 0.25 * (x0 + x2 - x1 - x3)
+        t1[p] = b + d * xi2
+        t2[p] = c + d * xi1
+        rho[p] = 0.25 * (x0 + x1 + x2 + x3) + b * xi1 + c * xi2 + d * xi1 * xi2
+    _unit_normal(t1, t2, nrm)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _unit_normal(t1, t2, nrm):
     nrm[0] = t1[1] * t2[2] - t1[2] * t2[1]
     nrm[1] = t1[2] * t2[0] - t1[0] * t2[2]
     nrm[2] = t1[0] * t2[1] - t1[1] * t2[0]
     ln = np.sqrt(nrm[0] ** 2 + nrm[1] ** 2 + nrm[2] ** 2)
     for p in range(3):
         nrm[p] = nrm[p] / ln if ln > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm):
+    """rho(xi), rho_1, rho_2 and the unit normal there (zero normal at a degenerate point)."""
+    _frame_lagrange(xyz, xi1, xi2, rho, t1, t2)
+    _unit_normal(t1, t2, nrm)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
