@@ -167,6 +167,15 @@ def test_unknown_solver_and_case(tmp_path, capsys):
     assert code == 2 and "'q'" in err
 
 
+def test_ranks_refused_with_one_line(tmp_path, capsys):
+    # checked before MPI is looked for: a count below 1, more ranks than cores
+    path = write(tmp_path, GOOD)
+    code, _, err = run_cli(["run", path, "--ranks", "0"], capsys)
+    assert code == 2 and err.count("\n") == 1 and "at least 1" in err
+    code, _, err = run_cli(["run", path, "--ranks", "100000"], capsys)
+    assert code == 2 and err.count("\n") == 1 and "cores" in err
+
+
 def test_nonconverging_step_exit_1(tmp_path, capsys):
     # a load far beyond what the tiny budget of iterations and cutbacks can carry
     text = GOOD.replace("value = 1.0", "value = 80.0").replace(

@@ -43,6 +43,10 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     r.add_argument("--resume", action="store_true",
                    help="continue from the last checkpoint in the output folder (same problem, same ranks)")
+    r.add_argument("--ranks", type=int, default=1, metavar="N",
+                   help="run as N MPI ranks of the distributed model (starts mpiexec itself; the `mpi` extra): "
+                        "petsc-gamg where auto picks it, else petsc (MUMPS), or the --solver given (default 1: "
+                        "one process)")
     s = sub.add_parser("study", help="run a problem once per tangent case and tabulate the iterations",
                        description="Run a problem once per tangent case; writes table.md, table.csv "
                        "(the layout of the paper's Table 1) and iterations.png.")
@@ -92,11 +96,67 @@ def cmd_run(args) -> int:
 
     problem = load_problem(args.problem)
     _check_solver(args.solver or problem.solver.linear)
+    if args.ranks != 1:
+        return _run_ranks(args, problem)
     result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver,
                          resume=args.resume)
     if not args.quiet and result.model.is_root:  # one line from a distributed run
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code
+
+
+def _run_ranks(args, problem) -> int:
+    """``covcontact run --ranks N``: the same command under ``mpiexec -n N`` with a distributed solver; returns its
+    exit code. SIGINT and SIGTERM are passed on to mpiexec."""
+    import shutil
+    import signal
+    import subprocess
+
+    from .solvers.linear import available
+    from .solvers.run import check_distributable, mpi_ranks_from_env, requested_linear, resolve_linear
+
+    n = args.ranks
+    if n < 1:
+        raise InputError(f"--ranks: the number of MPI ranks must be at least 1, got {n}")
+    if mpi_ranks_from_env() > 1:
+        raise InputError("--ranks: this command was itself started by mpiexec; use one of the two")
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    if n > cores:
+        raise InputError(f"--ranks {n}: only {cores} cores here; at most one rank per core")
+    if "petsc" not in available():
+        raise InputError(f"--ranks {n}: needs petsc4py and mpi4py (the `mpi` extra; bash tools/install-mpi.sh "
+                         f"installs them)")
+    mpiexec = shutil.which("mpiexec")
+    if mpiexec is None:
+        raise InputError(f"--ranks {n}: mpiexec not found on PATH (it comes with the MPI that mpi4py was built on)")
+    requested = requested_linear(problem, args.solver)
+    solver = resolve_linear(problem, args.solver, ranks=n)
+    check_distributable(problem, solver, n)
+    if solver != requested and not args.quiet:
+        why = "a large frictionless problem of bulky solid bodies" if solver == "petsc-gamg" else "MUMPS, distributed"
+        print(f"linear solver: {solver} (auto, {n} MPI ranks: {why})", file=sys.stderr, flush=True)
+    cmd = [mpiexec, "-n", str(n), sys.executable, "-m", "covcontact.cli", "run", str(args.problem),
+           "--solver", solver]
+    cmd += ["--out", args.out] if args.out else []
+    cmd += ["--tangent", args.tangent] if args.tangent else []
+    cmd += [flag for flag, on in (("--quiet", args.quiet), ("--resume", args.resume)) if on]
+    # each rank takes its share of the cores for numba (parallel.comm.share_cores); the variables by which a
+    # process started in an MPI job (an MPI singleton, as a Python that loaded PETSc) finds its launcher would
+    # make mpiexec join that job instead of starting its own
+    launcher = ("PMIX_", "PMI_", "ORTE_", "HYDRA_", "OMPI_MCA_orte_", "OMPI_MCA_ess", "OMPI_MCA_pmix", "OMPI_APP_CTX",
+                "OMPI_COMM_WORLD", "OMPI_UNIVERSE", "OMPI_FILE_LOCATION", "OMPI_NUM_APP_CTX", "OMPI_FIRST_RANKS")
+    env = {k: v for k, v in os.environ.items() if not k.startswith(launcher)}
+    if hasattr(os, "geteuid") and os.geteuid() == 0:  # Open MPI refuses root unless told
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    proc = subprocess.Popen(cmd, env=env)
+    forward = {sig: signal.signal(sig, lambda s, _f: proc.send_signal(s)) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        code = proc.wait()
+    finally:
+        for sig, old in forward.items():
+            signal.signal(sig, old)
+    return 128 - code if code < 0 else code
 
 
 def cmd_study(args) -> int:

@@ -117,6 +117,42 @@ def test_two_ranks_match_serial(tmp_path, path, solver, tol):
     assert len(list((tmp_path / "mpi").glob("step_*.vtu"))) == len(ref.summary["steps"]) + 1
 
 
+def _ranks(path: Path, out: Path, *extra: str) -> subprocess.CompletedProcess:
+    """``covcontact run --ranks 2``: the command starts mpiexec itself."""
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(path), "--ranks", "2", "--out", str(out), *extra]
+    return subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=300)
+
+
+def test_ranks_option_equals_mpiexec(tmp_path):
+    """``--ranks 2`` is ``mpiexec -n 2 ... run``: the same iterations and displacements; without a solver it picks
+    the distributed direct one (MUMPS) for this small problem and says so."""
+    proc = _ranks(TWO_BLOCKS, tmp_path / "ranks")
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert "linear solver: petsc (auto, 2 MPI ranks" in proc.stderr
+    summary = json.loads((tmp_path / "ranks" / "summary.json").read_text())
+    assert summary["linear_solver"] == "petsc" and summary["parallel"]["ranks"] == 2
+    assert _mpiexec(TWO_BLOCKS, tmp_path / "mpi", "petsc") == 0
+    ref = json.loads((tmp_path / "mpi" / "summary.json").read_text())
+    assert _iterations(summary) == _iterations(ref)
+    u, u_ref = _final_displacement(tmp_path / "ranks"), _final_displacement(tmp_path / "mpi")
+    assert np.abs(u - u_ref).max() <= 1e-12 * np.abs(u_ref).max()
+
+
+def test_serial_solver_refused_under_ranks(tmp_path):
+    """A solver that runs in one process is refused with one line and exit 2, by ``--ranks`` before it starts
+    mpiexec, and by the ranks themselves under ``mpiexec`` (instead of two serial runs writing one folder)."""
+    proc = _ranks(TWO_BLOCKS, tmp_path / "a", "--solver", "superlu")
+    assert proc.returncode == 2 and "runs in one process" in proc.stderr
+    assert proc.stderr.count("covcontact: error") == 1 and not (tmp_path / "a").exists()
+    env = dict(os.environ)
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    cmd = ["mpiexec", "-n", "2", "--oversubscribe", "--bind-to", "none", sys.executable, "-m", "covcontact.cli",
+           "run", str(TWO_BLOCKS), "--solver", "superlu", "--out", str(tmp_path / "b"), "--quiet"]
+    proc = subprocess.run(cmd, check=False, env=env, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2 and "runs in one process" in proc.stderr and not (tmp_path / "b").exists()
+
+
 def test_two_ranks_fail_together(tmp_path):
     """A step that cannot converge: the same cutbacks and exit code 1 as the serial run, no hang."""
     text = TWO_BLOCKS.read_text() + "\n[solver]\nmax_iterations = 2\nmax_cutbacks = 1\n"

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import json
+import os
 import sys
 import time
 import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numba
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
@@ -134,26 +136,51 @@ def requested_linear(problem, linear: str | None) -> str:
     return (linear or problem.solver.linear or "auto").lower().strip()
 
 
-def resolve_linear(problem, linear: str | None) -> str:
+def mpi_ranks_from_env() -> int:
+    """The number of ranks of the MPI job this process was started in by mpiexec (Open MPI, MPICH, PMIx
+    launchers), 1 outside one; read from the launcher's environment, without starting MPI."""
+    for key in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"):
+        value = os.environ.get(key, "")
+        if value.isdigit():
+            return int(value)
+    return 1
+
+
+def resolve_linear(problem, linear: str | None, ranks: int | None = None) -> str:
     """The linear solver of a run: :func:`requested_linear`, whose ``"auto"`` becomes ``petsc-gamg`` where
-    :func:`auto_amg` says so and it is installed, else stays ``"auto"`` (the first direct backend available)."""
+    :func:`auto_amg` says so and it is installed, else stays ``"auto"`` (the first direct backend available).
+    Run as several MPI ranks (``ranks``, by default :func:`mpi_ranks_from_env`), ``"auto"`` becomes
+    ``petsc-gamg`` where :func:`auto_amg` says so, else ``petsc`` (MUMPS): the distributed solvers."""
     from .linear import _probe
 
     name = requested_linear(problem, linear)
-    if name == "auto" and auto_amg(problem) and _probe("petsc-gamg")[0]:
+    if name != "auto":
+        return name
+    if auto_amg(problem) and _probe("petsc-gamg")[0]:
         return "petsc-gamg"
-    return name
+    return "petsc" if (ranks or mpi_ranks_from_env()) > 1 else name
+
+
+def check_distributable(problem, linear: str, ranks: int) -> None:
+    """Raise InputError where ``ranks`` MPI ranks cannot run ``problem`` with the solver ``linear``."""
+    from .linear import REGISTRY, backend_class
+
+    where = problem.source or problem.name
+    if ranks > 1 and not (linear in REGISTRY and getattr(backend_class(linear), "distributed", False)):
+        raise InputError(f"{where}: {ranks} MPI ranks, but the linear solver {linear!r} runs in one process; "
+                         f"use --solver petsc or petsc-gamg (or leave the solver to auto)")
+    if linear in REGISTRY and getattr(backend_class(linear), "distributed", False) and any(
+            rb.free for rb in problem.rigid):
+        raise InputError(f"{where}: rigid bodies with free components (reference nodes) are not available with "
+                         f"the distributed solver {linear!r} yet; use a serial solver")
 
 
 def _make_model(problem, tangent: str | None, linear: str) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
     from .linear import REGISTRY, backend_class
 
+    check_distributable(problem, linear, mpi_ranks_from_env())
     if linear in REGISTRY and getattr(backend_class(linear), "distributed", False):
-        if any(rb.free for rb in problem.rigid):
-            raise InputError(f"{problem.source or problem.name}: rigid bodies with free components (reference "
-                             f"nodes) are not available with the distributed solver {linear!r} yet; use a serial "
-                             f"solver")
         from ..parallel.model import DistributedModel
 
         return DistributedModel(problem, tangent=tangent)
@@ -188,8 +215,15 @@ def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
     linear = resolve_linear(problem, linear)
     model = _make_model(problem, tangent, linear)
     if linear != requested and not quiet and model.is_root:
-        print(f"linear solver: {linear} (auto: a large frictionless problem of bulky solid bodies; --solver with a "
-              f"direct one, `covcontact info` lists them, to factorise instead)", file=sys.stderr, flush=True)
+        if linear == "petsc-gamg":
+            one_core = ("; its solves run on one core, `--ranks 2` runs two MPI ranks"
+                        if model.size == 1 and numba.get_num_threads() > 1 else "")
+            print(f"linear solver: {linear} (auto: a large frictionless problem of bulky solid bodies; --solver with "
+                  f"a direct one, `covcontact info` lists them, to factorise instead{one_core})", file=sys.stderr,
+                  flush=True)
+        else:
+            print(f"linear solver: {linear} (auto, {model.size} MPI ranks: MUMPS, distributed)", file=sys.stderr,
+                  flush=True)
     if model.size > 1:
         try:
             return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
