@@ -344,7 +344,7 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
     """Contact point of every slave (see the module docstring); writes the out arrays.
 
     The per-slave arrays (xs, the candidate CSR, prev_facet, prev_xi and the outputs) are in visiting order,
-    permuted by the caller (``visit_order``, ``permute_csr``): sequential memory traffic in the kernel whatever
+    permuted by the caller (``visit_order``, ``_gather_in_order``): sequential memory traffic in the kernel whatever
     the slave numbering.
 
     Args:
@@ -405,20 +405,46 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
 
 
 @njit(cache=True, error_model="numpy")
-def permute_csr(ptr, fac, order):
-    """The CSR (ptr, fac) with its rows in the order ``order``."""
+def _gather_in_order(order, xs, pf, pxi, ptr, fac):
+    """The slaves' coordinates, previous contact points and candidate lists in the visiting order ``order``, in one
+    pass over the slaves (a randomly numbered slave set costs one memory miss per slave and array)."""
     ns = order.shape[0]
+    xs_o = np.empty((ns, 3))
+    pf_o = np.empty(ns, dtype=np.int64)
+    pxi_o = np.empty((ns, 2))
     ptr_o = np.empty(ns + 1, dtype=np.int64)
     ptr_o[0] = 0
     for q in range(ns):
-        ptr_o[q + 1] = ptr_o[q] + ptr[order[q] + 1] - ptr[order[q]]
+        s = order[q]
+        xs_o[q, 0] = xs[s, 0]
+        xs_o[q, 1] = xs[s, 1]
+        xs_o[q, 2] = xs[s, 2]
+        pf_o[q] = pf[s]
+        pxi_o[q, 0] = pxi[s, 0]
+        pxi_o[q, 1] = pxi[s, 1]
+        ptr_o[q + 1] = ptr_o[q] + ptr[s + 1] - ptr[s]
     fac_o = np.empty(ptr_o[ns], dtype=np.int64)
     for q in range(ns):
         m = ptr_o[q]
         for k in range(ptr[order[q]], ptr[order[q] + 1]):
             fac_o[m] = fac[k]
             m += 1
-    return ptr_o, fac_o
+    return xs_o, pf_o, pxi_o, ptr_o, fac_o
+
+
+@njit(cache=True, error_model="numpy")
+def _scatter_from_order(order, facet, xi, g, kind, normal, out_facet, out_xi, out_g, out_kind, out_normal):
+    """The results in visiting order back to the slaves' numbering, one pass."""
+    for q in range(order.shape[0]):
+        s = order[q]
+        out_facet[s] = facet[q]
+        out_xi[s, 0] = xi[q, 0]
+        out_xi[s, 1] = xi[q, 1]
+        out_g[s] = g[q]
+        out_kind[s] = kind[q]
+        out_normal[s, 0] = normal[q, 0]
+        out_normal[s, 1] = normal[q, 1]
+        out_normal[s, 2] = normal[q, 2]
 
 
 @njit(cache=True, error_model="numpy")
@@ -535,12 +561,9 @@ def project_slaves(
     order = visit_order(pf, cp, cf, nf)
     o = ProjectionResult(facet=np.empty(ns, np.int64), xi=np.empty((ns, 2)), g=np.empty(ns),
                          kind=np.empty(ns, np.int8), normal=np.empty((ns, 3)))  # fmt: skip
-    cp, cf = permute_csr(cp, cf, order)
-    project_slaves_kernel(
-        xs[order], x, topo, lo, hi, cp, cf, pf[order], pxi[order], prm, nchunk, o.facet, o.xi, o.g, o.kind, o.normal
-    )
-    for name in ("facet", "xi", "g", "kind", "normal"):
-        getattr(out, name)[order] = getattr(o, name)
+    xs_o, pf_o, pxi_o, cp, cf = _gather_in_order(order, xs, pf, pxi, cp, cf)
+    project_slaves_kernel(xs_o, x, topo, lo, hi, cp, cf, pf_o, pxi_o, prm, nchunk, o.facet, o.xi, o.g, o.kind, o.normal)
+    _scatter_from_order(order, o.facet, o.xi, o.g, o.kind, o.normal, out.facet, out.xi, out.g, out.kind, out.normal)
     return out
 
 
