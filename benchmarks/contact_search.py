@@ -48,22 +48,21 @@ def wavy_surface(m: int, quad9: bool):
     return pts, np.array(faces, dtype=np.int64)
 
 
-def median_time(fn, repeats=3) -> float:
+def _times(fn, repeats, clock) -> list[float]:
     times = []
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0 = clock()
         fn()
-        times.append(time.perf_counter() - t0)
-    return float(np.median(times))
+        times.append(clock() - t0)
+    return times
+
+
+def median_time(fn, repeats=3) -> float:
+    return float(np.median(_times(fn, repeats, time.perf_counter)))
 
 
 def best_cpu_time(fn, repeats=7) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return float(np.min(times))
+    return float(np.min(_times(fn, repeats, time.process_time)))
 
 
 def problem(n: int, quad9: bool, numbering: str, rng):

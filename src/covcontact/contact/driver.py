@@ -36,7 +36,7 @@ import numpy as np
 from numba import njit, prange
 
 from .projection import planar_start, project_inline
-from .search import _box_dist2, candidates
+from .search import _box_dist2, candidates, counting_order
 from .surface import (
     EDGE_DIR,
     EDGE_START,
@@ -453,20 +453,12 @@ def visit_order(prev_facet, cand_ptr, cand_fac, nf):
     slaves then share facet data in cache whatever the slave numbering."""
     ns = prev_facet.shape[0]
     key = np.empty(ns, dtype=np.int64)
-    cnt = np.zeros(nf + 2, dtype=np.int64)
     for s in range(ns):
         k = prev_facet[s]
         if k < 0:
             k = cand_fac[cand_ptr[s]] if cand_ptr[s + 1] > cand_ptr[s] else nf
         key[s] = k
-        cnt[k + 1] += 1
-    for k in range(nf + 1):
-        cnt[k + 1] += cnt[k]
-    order = np.empty(ns, dtype=np.int64)
-    for s in range(ns):
-        order[cnt[key[s]]] = s
-        cnt[key[s]] += 1
-    return order
+    return counting_order(key, nf)
 
 
 @dataclass

@@ -89,26 +89,32 @@ def _sort_segment(x0, x1, x2, lo, hi, facets, a, b, dist):
 
 
 @njit(cache=True, error_model="numpy")
+def counting_order(key, nkeys):
+    """The indices 0..n-1 ordered by key (ints in [0, nkeys]), stable: a counting sort in O(n + nkeys)."""
+    n = key.shape[0]
+    cnt = np.zeros(nkeys + 2, dtype=np.int64)
+    for s in range(n):
+        cnt[key[s] + 1] += 1
+    for k in range(nkeys + 1):
+        cnt[k + 1] += cnt[k]
+    order = np.empty(n, dtype=np.int64)
+    for s in range(n):
+        order[cnt[key[s]]] = s
+        cnt[key[s]] += 1
+    return order
+
+
+@njit(cache=True, error_model="numpy")
 def _coherent_order(cell, nbucket):
-    """Slaves ordered by cell (counting sort on nbucket buckets of consecutive cells, O(ns + nbucket)); slaves
-    outside the grid (cell -1) last."""
+    """Slaves ordered by cell (nbucket buckets of consecutive cells); slaves outside the grid (cell -1) last."""
     ns = cell.shape[0]
     cmax = 0
     for s in range(ns):
         cmax = max(cmax, cell[s])
-    cnt = np.zeros(nbucket + 2, dtype=np.int64)
     key = np.empty(ns, dtype=np.int64)
     for s in range(ns):
-        k = nbucket if cell[s] < 0 else (cell[s] * nbucket) // (cmax + 1)
-        key[s] = k
-        cnt[k + 1] += 1
-    for k in range(nbucket + 1):
-        cnt[k + 1] += cnt[k]
-    order = np.empty(ns, dtype=np.int64)
-    for s in range(ns):
-        order[cnt[key[s]]] = s
-        cnt[key[s]] += 1
-    return order
+        key[s] = nbucket if cell[s] < 0 else (cell[s] * nbucket) // (cmax + 1)
+    return counting_order(key, nbucket)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
