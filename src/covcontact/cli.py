@@ -150,12 +150,20 @@ def _run_ranks(args, problem) -> int:
         env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
         env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     proc = subprocess.Popen(cmd, env=env)
-    forward = {sig: signal.signal(sig, lambda s, _f: proc.send_signal(s)) for sig in (signal.SIGINT, signal.SIGTERM)}
+    received: list[int] = []
+
+    def forward(sig, _frame):
+        received.append(sig)
+        proc.send_signal(sig)
+
+    previous = {sig: signal.signal(sig, forward) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         code = proc.wait()
     finally:
-        for sig, old in forward.items():
-            signal.signal(sig, old)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if received:  # stopped by a signal: its exit code (130 / 143), whatever mpiexec made of it
+        return 128 + int(received[0])
     return 128 - code if code < 0 else code
 
 

@@ -11,8 +11,10 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import meshio
@@ -21,7 +23,8 @@ import pytest
 
 from covcontact.io.loader import load_problem
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+ROOT = Path(__file__).resolve().parents[2]
+EXAMPLES = ROOT / "examples"
 TWO_BLOCKS = EXAMPLES / "contact" / "two_blocks.toml"
 SLIDING = EXAMPLES / "friction" / "block_sliding.toml"
 
@@ -136,6 +139,37 @@ def test_ranks_option_equals_mpiexec(tmp_path):
     assert _iterations(summary) == _iterations(ref)
     u, u_ref = _final_displacement(tmp_path / "ranks"), _final_displacement(tmp_path / "mpi")
     assert np.abs(u - u_ref).max() <= 1e-12 * np.abs(u_ref).max()
+
+
+def _processes_with(text: str) -> list[str]:
+    """Command lines of the running processes that mention ``text`` (Linux /proc)."""
+    found = []
+    for cmdline in Path("/proc").glob("[0-9]*/cmdline"):
+        try:
+            args = cmdline.read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if text in args:
+            found.append(args)
+    return found
+
+
+def test_ranks_stopped_by_sigterm(tmp_path):
+    """SIGTERM to ``covcontact run --ranks 2`` reaches the ranks through mpiexec: exit code 143, no process left."""
+    out = tmp_path / "stopped"
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(ROOT / "benchmarks" / "problems" / "two_blocks_30k.toml"),
+           "--ranks", "2", "--out", str(out)]
+    proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
+    for line in proc.stderr:
+        if line.startswith("step    1/"):
+            break
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=60) == 143
+    proc.stderr.close()
+    deadline = time.monotonic() + 20
+    while _processes_with(str(out)) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert _processes_with(str(out)) == []
 
 
 def test_serial_solver_refused_under_ranks(tmp_path):
