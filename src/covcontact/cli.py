@@ -121,8 +121,8 @@ def _run_ranks(args, problem) -> int:
     if mpi_ranks_from_env() > 1:
         raise InputError("--ranks: this command was itself started by mpiexec; use one of the two")
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    if n > cores:
-        raise InputError(f"--ranks {n}: only {cores} cores here; at most one rank per core")
+    if n > 8 * cores:
+        raise InputError(f"--ranks {n}: only {cores} cores here; one rank per core is fastest")
     if "petsc" not in available():
         raise InputError(f"--ranks {n}: needs petsc4py and mpi4py (the `mpi` extra; bash tools/install-mpi.sh "
                          f"installs them)")
@@ -135,8 +135,14 @@ def _run_ranks(args, problem) -> int:
     if solver != requested and not args.quiet:
         why = "a large frictionless problem of bulky solid bodies" if solver == "petsc-gamg" else "MUMPS, distributed"
         print(f"linear solver: {solver} (auto, {n} MPI ranks: {why})", file=sys.stderr, flush=True)
-    cmd = [mpiexec, "-n", str(n), sys.executable, "-m", "covcontact.cli", "run", str(args.problem),
-           "--solver", solver]
+    cmd = [mpiexec, "-n", str(n)]
+    if n > cores:  # legal, but the ranks take turns on the cores
+        print(f"covcontact: warning: --ranks {n} on {cores} cores: the ranks will share cores, which is slower than "
+              f"--ranks {cores}", file=sys.stderr, flush=True)
+        version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True, check=False).stdout
+        if "Open MPI" in version or "OpenRTE" in version:  # Open MPI refuses more ranks than cores unless told
+            cmd.append("--oversubscribe")
+    cmd += [sys.executable, "-m", "covcontact.cli", "run", str(args.problem), "--solver", solver]
     cmd += ["--out", args.out] if args.out else []
     cmd += ["--tangent", args.tangent] if args.tangent else []
     cmd += [flag for flag, on in (("--quiet", args.quiet), ("--resume", args.resume)) if on]
