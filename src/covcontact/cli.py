@@ -113,12 +113,13 @@ def _run_ranks(args, problem) -> int:
     import subprocess
 
     from .solvers.linear import available
-    from .solvers.run import check_distributable, mpi_ranks_from_env, requested_linear, resolve_linear
+    from .parallel.launcher import ranks_from_env
+    from .solvers.run import check_distributable, requested_linear, resolve_linear
 
     n = args.ranks
     if n < 1:
         raise InputError(f"--ranks: the number of MPI ranks must be at least 1, got {n}")
-    if mpi_ranks_from_env() > 1:
+    if ranks_from_env() > 1:
         raise InputError("--ranks: this command was itself started by mpiexec; use one of the two")
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     if n > 8 * cores:

@@ -12,11 +12,16 @@ MESSAGE = ("covcontact: compiling the numerical kernels for this installation (o
 
 
 def install(stream=None) -> None:
-    """Print MESSAGE on ``stream`` (default stderr) when numba compiles anything for the first time."""
+    """Print MESSAGE on ``stream`` (default stderr) when numba compiles anything for the first time; under
+    mpiexec only rank 0 says it."""
     global _installed
     if _installed:
         return
     _installed = True
+    from .parallel.launcher import rank_from_env
+
+    if rank_from_env() != 0:
+        return
     from numba.core import event
 
     class _Notice(event.Listener):

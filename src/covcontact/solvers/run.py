@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 import sys
 import time
 import traceback
@@ -17,6 +16,7 @@ from threadpoolctl import ThreadpoolController
 from ..io import checkpoint
 from ..io.output import ResultWriter, _jsonable
 from ..io.validate import InputError
+from ..parallel.launcher import ranks_from_env
 from .model import Model
 from .newton import Newton
 from .signals import Interrupted, StopSignals
@@ -136,20 +136,10 @@ def requested_linear(problem, linear: str | None) -> str:
     return (linear or problem.solver.linear or "auto").lower().strip()
 
 
-def mpi_ranks_from_env() -> int:
-    """The number of ranks of the MPI job this process was started in by mpiexec (Open MPI, MPICH, PMIx
-    launchers), 1 outside one; read from the launcher's environment, without starting MPI."""
-    for key in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE", "MPI_LOCALNRANKS"):
-        value = os.environ.get(key, "")
-        if value.isdigit():
-            return int(value)
-    return 1
-
-
 def resolve_linear(problem, linear: str | None, ranks: int | None = None) -> str:
     """The linear solver of a run: :func:`requested_linear`, whose ``"auto"`` becomes ``petsc-gamg`` where
     :func:`auto_amg` says so and it is installed, else stays ``"auto"`` (the first direct backend available).
-    Run as several MPI ranks (``ranks``, by default :func:`mpi_ranks_from_env`), ``"auto"`` becomes
+    Run as several MPI ranks (``ranks``, by default what the launcher's environment says), ``"auto"`` becomes
     ``petsc-gamg`` where :func:`auto_amg` says so, else ``petsc`` (MUMPS): the distributed solvers."""
     from .linear import _probe
 
@@ -158,7 +148,7 @@ def resolve_linear(problem, linear: str | None, ranks: int | None = None) -> str
         return name
     if auto_amg(problem) and _probe("petsc-gamg")[0]:
         return "petsc-gamg"
-    return "petsc" if (ranks or mpi_ranks_from_env()) > 1 else name
+    return "petsc" if (ranks or ranks_from_env()) > 1 else name
 
 
 def check_distributable(problem, linear: str, ranks: int) -> None:
@@ -179,7 +169,7 @@ def _make_model(problem, tangent: str | None, linear: str) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
     from .linear import REGISTRY, backend_class
 
-    check_distributable(problem, linear, mpi_ranks_from_env())
+    check_distributable(problem, linear, ranks_from_env())
     if linear in REGISTRY and getattr(backend_class(linear), "distributed", False):
         from ..parallel.model import DistributedModel
 
