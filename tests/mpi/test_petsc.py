@@ -132,6 +132,7 @@ def test_ranks_option_equals_mpiexec(tmp_path):
     proc = _ranks(TWO_BLOCKS, tmp_path / "ranks")
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert "linear solver: petsc (auto, 2 MPI ranks" in proc.stderr
+    assert proc.stdout == ""  # plain text: no colour codes from numba under mpiexec
     summary = json.loads((tmp_path / "ranks" / "summary.json").read_text())
     assert summary["linear_solver"] == "petsc" and summary["parallel"]["ranks"] == 2
     assert _mpiexec(TWO_BLOCKS, tmp_path / "mpi", "petsc") == 0

@@ -17,6 +17,11 @@ def _first_int(keys: tuple[str, ...], default: int) -> int:
     return default
 
 
+def under_launcher() -> bool:
+    """Whether this process was started by an MPI launcher (even as its only rank)."""
+    return any(key in os.environ for key in _SIZE)
+
+
 def ranks_from_env() -> int:
     """The number of ranks of the MPI job this process was started in, 1 outside one."""
     return _first_int(_SIZE, 1)
