@@ -101,8 +101,8 @@ class _NoWriter:
 
 
 #: ``linear = "auto"`` hands a frictionless problem of solid (hex/tet) bodies of compressible materials with at
-#: least this many dofs to ``petsc-gamg`` where it is installed (docs/performance.md: 2.0x faster than PARDISO
-#: on the Hertz ball at 199,053 dofs, 3.6x on two deformable blocks at 192,480); else to the direct default
+#: least this many dofs to ``petsc-gamg`` where it is installed (docs/performance.md: 2.5x faster than PARDISO
+#: on the Hertz ball at 199,053 dofs, 3.5x on two deformable blocks at 192,480); else to the direct default
 AUTO_AMG_DOFS = 100_000
 #: the largest Poisson's ratio of such a problem: nearly incompressible bodies slow AMG down
 AUTO_AMG_NU = 0.45
