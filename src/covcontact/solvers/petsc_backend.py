@@ -29,6 +29,17 @@ import scipy.sparse as sp
 from .linear import LinearSolver, LinearSolverError, SingularMatrixError, _as_csr, near_null_candidates
 
 PREFIX = "covcontact_"
+_USER: set[str] | None = None
+
+
+def _user_options(opts) -> set[str]:
+    """The GAMG options (without PREFIX) that PETSC_OPTIONS or the command line set, read before covcontact
+    writes any of them."""
+    global _USER
+    if _USER is None:
+        _USER = {name for name in ("pc_gamg_threshold", "pc_gamg_agg_nsmooths", "mg_levels_pc_type")
+                 if opts.hasName(PREFIX + name)}
+    return _USER
 
 
 def petsc() -> Any:
@@ -440,13 +451,15 @@ class PetscGAMGSolver(PetscSolver):
         ksp.setTolerances(rtol=self.rtol, atol=0.0, max_it=self.maxiter)
         pc = ksp.getPC()
         pc.setType(P.PC.Type.GAMG)
+        # this solver's choices, unless PETSC_OPTIONS sets them (they stay in PETSc's options database until
+        # the hierarchy is built, so each solver writes its own): plain aggregation by default (a quarter of
+        # the set-up, cheaper cycles), Chebyshev on the inverse node blocks (3 x 3; the modes' blocks on
+        # coarse levels): ~20 % fewer CG iterations (docs/performance.md)
         opts = P.Options()
-        if not opts.hasName(f"{PREFIX}pc_gamg_threshold"):
-            opts.setValue(f"{PREFIX}pc_gamg_threshold", self.threshold)
-        if not opts.hasName(f"{PREFIX}pc_gamg_agg_nsmooths"):  # plain aggregation: a quarter of the set-up and
-            opts.setValue(f"{PREFIX}pc_gamg_agg_nsmooths", self.smooths)  # cheaper cycles (docs/performance.md)
-        if not opts.hasName(f"{PREFIX}mg_levels_pc_type"):  # Chebyshev on the inverse node blocks (3 x 3, the
-            opts.setValue(f"{PREFIX}mg_levels_pc_type", self.level_pc)  # modes' blocks below): ~20 % fewer CG iterations
+        for name, value in (("pc_gamg_threshold", self.threshold), ("pc_gamg_agg_nsmooths", self.smooths),
+                            ("mg_levels_pc_type", self.level_pc)):
+            if name not in _user_options(opts):
+                opts.setValue(PREFIX + name, value)
         ksp.setErrorIfNotConverged(False)
         ksp.setFromOptions()
         op.ksp = ksp
