@@ -14,6 +14,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -161,11 +162,14 @@ def test_ranks_stopped_by_sigterm(tmp_path):
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(ROOT / "benchmarks" / "problems" / "two_blocks_30k.toml"),
            "--ranks", "2", "--out", str(out)]
     proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
+    watchdog = threading.Timer(300, proc.kill)  # a hung run fails the test instead of hanging it
+    watchdog.start()
     for line in proc.stderr:
         if line.startswith("step    1/"):
             break
     proc.send_signal(signal.SIGTERM)
     assert proc.wait(timeout=60) == 143
+    watchdog.cancel()
     proc.stderr.close()
     deadline = time.monotonic() + 20
     while _processes_with(str(out)) and time.monotonic() < deadline:
