@@ -168,7 +168,7 @@ def test_unknown_solver_and_case(tmp_path, capsys):
 
 
 def test_ranks_refused_with_one_line(tmp_path, capsys):
-    # checked before MPI is looked for: a count below 1, more ranks than cores
+    # checked before MPI is looked for: a count below 1, more than 8 ranks per core
     path = write(tmp_path, GOOD)
     code, _, err = run_cli(["run", path, "--ranks", "0"], capsys)
     assert code == 2 and err.count("\n") == 1 and "at least 1" in err

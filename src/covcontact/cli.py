@@ -112,16 +112,16 @@ def _run_ranks(args, problem) -> int:
     import signal
     import subprocess
 
+    from .parallel.launcher import cores_here, environment_for_mpiexec, ranks_from_env
     from .solvers.linear import available
-    from .parallel.launcher import ranks_from_env
-    from .solvers.run import check_distributable, requested_linear, resolve_linear
+    from .solvers.run import auto_line, check_distributable, requested_linear, resolve_linear
 
     n = args.ranks
     if n < 1:
         raise InputError(f"--ranks: the number of MPI ranks must be at least 1, got {n}")
     if ranks_from_env() > 1:
         raise InputError("--ranks: this command was itself started by mpiexec; use one of the two")
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    cores = cores_here()
     if n > 8 * cores:
         raise InputError(f"--ranks {n}: only {cores} cores here; one rank per core is fastest")
     if "petsc" not in available():
@@ -134,8 +134,7 @@ def _run_ranks(args, problem) -> int:
     solver = resolve_linear(problem, args.solver, ranks=n)
     check_distributable(problem, solver, n)
     if solver != requested and not args.quiet:
-        why = "a large frictionless problem of bulky solid bodies" if solver == "petsc-gamg" else "MUMPS, distributed"
-        print(f"linear solver: {solver} (auto, {n} MPI ranks: {why})", file=sys.stderr, flush=True)
+        print(auto_line(solver, n), file=sys.stderr, flush=True)
     cmd = [mpiexec, "-n", str(n)]
     if n > cores:  # legal, but the ranks take turns on the cores
         print(f"covcontact: warning: --ranks {n} on {cores} cores: the ranks will share cores, which is slower than "
@@ -147,15 +146,7 @@ def _run_ranks(args, problem) -> int:
     cmd += ["--out", args.out] if args.out else []
     cmd += ["--tangent", args.tangent] if args.tangent else []
     cmd += [flag for flag, on in (("--quiet", args.quiet), ("--resume", args.resume)) if on]
-    # each rank takes its share of the cores for numba (parallel.comm.share_cores); the variables by which a
-    # process started in an MPI job (an MPI singleton, as a Python that loaded PETSc) finds its launcher would
-    # make mpiexec join that job instead of starting its own
-    launcher = ("PMIX_", "PMI_", "ORTE_", "HYDRA_", "OMPI_MCA_orte_", "OMPI_MCA_ess", "OMPI_MCA_pmix", "OMPI_APP_CTX",
-                "OMPI_COMM_WORLD", "OMPI_UNIVERSE", "OMPI_FILE_LOCATION", "OMPI_NUM_APP_CTX", "OMPI_FIRST_RANKS")
-    env = {k: v for k, v in os.environ.items() if not k.startswith(launcher)}
-    if hasattr(os, "geteuid") and os.geteuid() == 0:  # Open MPI refuses root unless told
-        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    env = environment_for_mpiexec()  # each rank takes its share of the cores (parallel.comm.share_cores)
     proc = subprocess.Popen(cmd, env=env)
     received: list[int] = []
 

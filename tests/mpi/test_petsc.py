@@ -61,13 +61,18 @@ def _serial(path: Path, out: Path, solver: str | None = None):
     return problem.run(out=out, quiet=True, solver=solver)
 
 
-def _mpiexec(path: Path, out: Path, solver: str, n: int = 2, extra: tuple[str, ...] = ()) -> int:
+def _mpiexec_proc(path: Path, out: Path, solver: str, n: int = 2, extra: tuple[str, ...] = ()
+                  ) -> subprocess.CompletedProcess:
     env = dict(os.environ)
     if hasattr(os, "geteuid") and os.geteuid() == 0:
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     cmd = ["mpiexec", "-n", str(n), "--oversubscribe", "--bind-to", "none", sys.executable, "-m",
            "covcontact.cli", "run", str(path), "--solver", solver, "--out", str(out), "--quiet", *extra]
-    proc = subprocess.run(cmd, check=False, env=env, capture_output=True, text=True, timeout=300)
+    return subprocess.run(cmd, check=False, env=env, capture_output=True, text=True, timeout=300)
+
+
+def _mpiexec(path: Path, out: Path, solver: str, n: int = 2, extra: tuple[str, ...] = ()) -> int:
+    proc = _mpiexec_proc(path, out, solver, n, extra)
     assert proc.returncode in (0, 1), proc.stderr[-3000:]
     return proc.returncode
 
@@ -183,12 +188,7 @@ def test_serial_solver_refused_under_ranks(tmp_path):
     proc = _ranks(TWO_BLOCKS, tmp_path / "a", "--solver", "superlu")
     assert proc.returncode == 2 and "runs in one process" in proc.stderr
     assert proc.stderr.count("covcontact: error") == 1 and not (tmp_path / "a").exists()
-    env = dict(os.environ)
-    if hasattr(os, "geteuid") and os.geteuid() == 0:
-        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    cmd = ["mpiexec", "-n", "2", "--oversubscribe", "--bind-to", "none", sys.executable, "-m", "covcontact.cli",
-           "run", str(TWO_BLOCKS), "--solver", "superlu", "--out", str(tmp_path / "b"), "--quiet"]
-    proc = subprocess.run(cmd, check=False, env=env, capture_output=True, text=True, timeout=300)
+    proc = _mpiexec_proc(TWO_BLOCKS, tmp_path / "b", "superlu")
     assert proc.returncode == 2 and "runs in one process" in proc.stderr and not (tmp_path / "b").exists()
 
 

@@ -350,7 +350,7 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
     Args:
         xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
             node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. cand_ptr, cand_fac:
-            candidate CSR (by slave number). prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
+            candidate CSR. prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
         prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops).
         nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
     """

@@ -71,10 +71,12 @@ def share_cores(comm) -> int:
         return numba.get_num_threads()
     from mpi4py import MPI
 
+    from .launcher import cores_here
+
     local = comm.Split_type(MPI.COMM_TYPE_SHARED)
     n_local = local.size
     local.Free()
-    mine = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    mine = cores_here()
     total = os.cpu_count() or mine
     threads = mine if mine < total else max(1, total // n_local)
     threads = max(1, min(threads, numba.config.NUMBA_NUM_THREADS))

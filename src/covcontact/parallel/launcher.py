@@ -30,3 +30,25 @@ def ranks_from_env() -> int:
 def rank_from_env() -> int:
     """This process's rank in the MPI job it was started in, 0 outside one."""
     return _first_int(_RANK, 0) if ranks_from_env() > 1 else 0
+
+
+def cores_here() -> int:
+    """The cores this process may run on (its affinity mask where the system has one)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+
+
+#: the variables by which a process started in an MPI job (an MPI singleton too, as a Python that loaded PETSc)
+#: finds its launcher
+_LAUNCHER_VARS = ("PMIX_", "PMI_", "ORTE_", "HYDRA_", "OMPI_MCA_orte_", "OMPI_MCA_ess", "OMPI_MCA_pmix", "OMPI_APP_CTX",
+                  "OMPI_COMM_WORLD", "OMPI_UNIVERSE", "OMPI_FILE_LOCATION", "OMPI_NUM_APP_CTX", "OMPI_FIRST_RANKS")
+
+
+def environment_for_mpiexec() -> dict[str, str]:
+    """This process's environment for an ``mpiexec`` it starts: without the launcher variables of a job it may
+    itself belong to (mpiexec would join that job instead of starting its own), and as root with Open MPI's
+    permission to run as root."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(_LAUNCHER_VARS)}
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return env

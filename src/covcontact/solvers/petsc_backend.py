@@ -29,16 +29,16 @@ import scipy.sparse as sp
 from .linear import LinearSolver, LinearSolverError, SingularMatrixError, _as_csr, near_null_candidates
 
 PREFIX = "covcontact_"
+#: the GAMG options each petsc-gamg solver sets from its parameters (threshold, smooths, level_pc)
+_GAMG_OPTIONS = ("pc_gamg_threshold", "pc_gamg_agg_nsmooths", "mg_levels_pc_type")
 _USER: set[str] | None = None
 
 
 def _user_options(opts) -> set[str]:
-    """The GAMG options (without PREFIX) that PETSC_OPTIONS or the command line set, read before covcontact
-    writes any of them."""
+    """The ``_GAMG_OPTIONS`` that PETSC_OPTIONS or the command line set, read before covcontact writes any."""
     global _USER
     if _USER is None:
-        _USER = {name for name in ("pc_gamg_threshold", "pc_gamg_agg_nsmooths", "mg_levels_pc_type")
-                 if opts.hasName(PREFIX + name)}
+        _USER = {name for name in _GAMG_OPTIONS if opts.hasName(PREFIX + name)}
     return _USER
 
 
@@ -456,8 +456,7 @@ class PetscGAMGSolver(PetscSolver):
         # the set-up, cheaper cycles), Chebyshev on the inverse node blocks (3 x 3; the modes' blocks on
         # coarse levels): ~20 % fewer CG iterations (docs/performance.md)
         opts = P.Options()
-        for name, value in (("pc_gamg_threshold", self.threshold), ("pc_gamg_agg_nsmooths", self.smooths),
-                            ("mg_levels_pc_type", self.level_pc)):
+        for name, value in zip(_GAMG_OPTIONS, (self.threshold, self.smooths, self.level_pc)):
             if name not in _user_options(opts):
                 opts.setValue(PREFIX + name, value)
         ksp.setErrorIfNotConverged(False)

@@ -151,26 +151,40 @@ def resolve_linear(problem, linear: str | None, ranks: int | None = None) -> str
     return "petsc" if (ranks or ranks_from_env()) > 1 else name
 
 
-def check_distributable(problem, linear: str, ranks: int) -> None:
-    """Raise InputError where ``ranks`` MPI ranks cannot run ``problem`` with the solver ``linear``."""
+def _distributes(linear: str) -> bool:
+    """Whether the linear solver ``linear`` runs the distributed model (``petsc*``)."""
     from .linear import REGISTRY, backend_class
 
+    return linear in REGISTRY and getattr(backend_class(linear), "distributed", False)
+
+
+def auto_line(linear: str, ranks: int, one_core_hint: bool = False) -> str:
+    """The line a run prints when ``auto`` picked ``linear`` (``petsc-gamg``, or ``petsc`` on several ranks)."""
+    if linear != "petsc-gamg":
+        return f"linear solver: {linear} (auto, {ranks} MPI ranks: MUMPS, distributed)"
+    why = "a large frictionless problem of bulky solid bodies"
+    if ranks > 1:
+        return f"linear solver: {linear} (auto, {ranks} MPI ranks: {why})"
+    hint = "; its solves run on one core, `--ranks 2` runs two MPI ranks" if one_core_hint else ""
+    return (f"linear solver: {linear} (auto: {why}; --solver with a direct one, `covcontact info` lists them, to "
+            f"factorise instead{hint})")
+
+
+def check_distributable(problem, linear: str, ranks: int) -> None:
+    """Raise InputError where ``ranks`` MPI ranks cannot run ``problem`` with the solver ``linear``."""
     where = problem.source or problem.name
-    if ranks > 1 and not (linear in REGISTRY and getattr(backend_class(linear), "distributed", False)):
+    if ranks > 1 and not _distributes(linear):
         raise InputError(f"{where}: {ranks} MPI ranks, but the linear solver {linear!r} runs in one process; "
                          f"use --solver petsc or petsc-gamg (or leave the solver to auto)")
-    if linear in REGISTRY and getattr(backend_class(linear), "distributed", False) and any(
-            rb.free for rb in problem.rigid):
+    if _distributes(linear) and any(rb.free for rb in problem.rigid):
         raise InputError(f"{where}: rigid bodies with free components (reference nodes) are not available with "
                          f"the distributed solver {linear!r} yet; use a serial solver")
 
 
 def _make_model(problem, tangent: str | None, linear: str) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
-    from .linear import REGISTRY, backend_class
-
     check_distributable(problem, linear, ranks_from_env())
-    if linear in REGISTRY and getattr(backend_class(linear), "distributed", False):
+    if _distributes(linear):
         from ..parallel.model import DistributedModel
 
         return DistributedModel(problem, tangent=tangent)
@@ -205,15 +219,7 @@ def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
     linear = resolve_linear(problem, linear)
     model = _make_model(problem, tangent, linear)
     if linear != requested and not quiet and model.is_root:
-        if linear == "petsc-gamg":
-            one_core = ("; its solves run on one core, `--ranks 2` runs two MPI ranks"
-                        if model.size == 1 and numba.get_num_threads() > 1 else "")
-            print(f"linear solver: {linear} (auto: a large frictionless problem of bulky solid bodies; --solver with "
-                  f"a direct one, `covcontact info` lists them, to factorise instead{one_core})", file=sys.stderr,
-                  flush=True)
-        else:
-            print(f"linear solver: {linear} (auto, {model.size} MPI ranks: MUMPS, distributed)", file=sys.stderr,
-                  flush=True)
+        print(auto_line(linear, model.size, numba.get_num_threads() > 1), file=sys.stderr, flush=True)
     if model.size > 1:
         try:
             return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
