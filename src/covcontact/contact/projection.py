@@ -26,8 +26,6 @@ _MAX_HALVINGS = 40
 _EPS = 2.220446049250313e-16
 
 
-
-
 @njit(cache=True, error_model="numpy")
 def facet_monomials(xyz, c):
     """The facet as a polynomial: rho(xi) = sum_mq c[m, q] xi1^m xi2^q, c (3, 3, 3) out (quad4: m, q <= 1).
@@ -179,24 +177,14 @@ def project_on_facet_work(xyz, xs, xi, work, max_iter=30, tol=1e-12):
         (status, g, nit).
     """
     c, G = work
-    return project_on_facet_scratch(xyz, xs, xi, c, G, max_iter, tol)
-
-
-@njit(cache=True, error_model="numpy")
-def project_on_facet_scratch(xyz, xs, xi, c, G, max_iter=30, tol=1e-12):
-    """The projection itself, scratch c (3, 3, 3) and G (6, 3) passed one by one. The facet is evaluated in its
-    monomial form (``facet_monomials``).
-
-    Returns:
-        (status, g, nit).
-    """
     return project_inline(xyz, xs, xi, c, G, max_iter, tol)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def project_inline(xyz, xs, xi, c, G, max_iter, tol):
-    """``project_on_facet_scratch`` compiled into its caller: the contact driver's hot loop, where a call that
-    passes arrays costs a reference count per array and per call."""
+    """The projection itself, compiled into its caller (the contact driver's hot loop, where a call that passes
+    arrays costs a reference count per array and per call); scratch c (3, 3, 3) and G (6, 3). The facet is
+    evaluated in its monomial form (``facet_monomials``). Returns (status, g, nit)."""
 
     # guard against non-finite input: never propagate NaN
     scale = 0.0

@@ -42,25 +42,26 @@ def _box_dist2(x0, x1, x2, lo, hi, f):
     return d2
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _cell_span(blo, bhi, origin, h, f):
+    """The grid cells (i0, j0, k0, i1, j1, k1), inclusive, that inflated box f overlaps."""
+    return (int(np.floor((blo[f, 0] - origin[0]) / h)), int(np.floor((blo[f, 1] - origin[1]) / h)),
+            int(np.floor((blo[f, 2] - origin[2]) / h)), int(np.floor((bhi[f, 0] - origin[0]) / h)),
+            int(np.floor((bhi[f, 1] - origin[1]) / h)), int(np.floor((bhi[f, 2] - origin[2]) / h)))
+
+
 @njit(cache=True, error_model="numpy")
 def _grid_entries(blo, bhi, origin, h, dims):
     """(cell key, facet) pairs of every cell that an inflated box overlaps."""
     nf = blo.shape[0]
     cnt = np.zeros(nf + 1, dtype=np.int64)
     for f in range(nf):
-        c = 1
-        for k in range(3):
-            c *= int(np.floor((bhi[f, k] - origin[k]) / h)) - int(np.floor((blo[f, k] - origin[k]) / h)) + 1
-        cnt[f + 1] = cnt[f] + c
+        i0, j0, k0, i1, j1, k1 = _cell_span(blo, bhi, origin, h, f)
+        cnt[f + 1] = cnt[f] + (i1 - i0 + 1) * (j1 - j0 + 1) * (k1 - k0 + 1)
     keys = np.empty(cnt[nf], dtype=np.int64)
     fac = np.empty(cnt[nf], dtype=np.int64)
     for f in range(nf):
-        i0 = int(np.floor((blo[f, 0] - origin[0]) / h))
-        j0 = int(np.floor((blo[f, 1] - origin[1]) / h))
-        k0 = int(np.floor((blo[f, 2] - origin[2]) / h))
-        i1 = int(np.floor((bhi[f, 0] - origin[0]) / h))
-        j1 = int(np.floor((bhi[f, 1] - origin[1]) / h))
-        k1 = int(np.floor((bhi[f, 2] - origin[2]) / h))
+        i0, j0, k0, i1, j1, k1 = _cell_span(blo, bhi, origin, h, f)
         m = cnt[f]
         for i in range(i0, i1 + 1):
             for j in range(j0, j1 + 1):
@@ -253,10 +254,8 @@ def _grid_plan(blo, bhi, cell_factor, max_dim):
     while True:
         total = 0.0
         for f in range(nf):
-            c = 1.0
-            for k in range(3):
-                c *= np.floor((bhi[f, k] - origin[k]) / h) - np.floor((blo[f, k] - origin[k]) / h) + 1.0
-            total += c
+            i0, j0, k0, i1, j1, k1 = _cell_span(blo, bhi, origin, h, f)
+            total += float(i1 - i0 + 1) * float(j1 - j0 + 1) * float(k1 - k0 + 1)
         if total <= 16.0 * nf + 1e6:
             break
         h *= 2.0
@@ -273,24 +272,21 @@ def _dense_cells(blo, bhi, origin, h, dims):
     nf = blo.shape[0]
     ncells = dims[0] * dims[1] * dims[2]
     cptr = np.zeros(ncells + 1, dtype=np.int64)
-    lo_c = np.empty((nf, 3), dtype=np.int64)
-    hi_c = np.empty((nf, 3), dtype=np.int64)
     for f in range(nf):
-        for k in range(3):
-            lo_c[f, k] = int(np.floor((blo[f, k] - origin[k]) / h))
-            hi_c[f, k] = int(np.floor((bhi[f, k] - origin[k]) / h))
-        for i in range(lo_c[f, 0], hi_c[f, 0] + 1):
-            for j in range(lo_c[f, 1], hi_c[f, 1] + 1):
-                for k in range(lo_c[f, 2], hi_c[f, 2] + 1):
+        i0, j0, k0, i1, j1, k1 = _cell_span(blo, bhi, origin, h, f)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for k in range(k0, k1 + 1):
                     cptr[(i * dims[1] + j) * dims[2] + k + 1] += 1
     for c in range(ncells):
         cptr[c + 1] += cptr[c]
     pos = cptr[:-1].copy()
     out = np.empty(cptr[ncells], dtype=np.int64)
     for f in range(nf):
-        for i in range(lo_c[f, 0], hi_c[f, 0] + 1):
-            for j in range(lo_c[f, 1], hi_c[f, 1] + 1):
-                for k in range(lo_c[f, 2], hi_c[f, 2] + 1):
+        i0, j0, k0, i1, j1, k1 = _cell_span(blo, bhi, origin, h, f)
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                for k in range(k0, k1 + 1):
                     key = (i * dims[1] + j) * dims[2] + k
                     out[pos[key]] = f
                     pos[key] += 1
