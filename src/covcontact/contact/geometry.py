@@ -23,6 +23,14 @@ _IDX9 = IDX["quad9"]
 DEGENERATE_TOL = 1e-12
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def bilinear_coefficients(x0, x1, x2, x3):
+    """One coordinate of a quad4 facet from its corner values: rho = a + b xi1 + c xi2 + d xi1 xi2; returns
+    (a, b, c, d)."""
+    return (0.25 * (x0 + x1 + x2 + x3), 0.25 * (x1 + x2 - x0 - x3), 0.25 * (x2 + x3 - x0 - x1),
+            0.25 * (x0 + x2 - x1 - x3))
+
+
 @njit(cache=True)
 def surface_shapes(nen, xi1, xi2, N, dN, ddN):
     """Shape functions of a quad4 (nen = 4) or quad9 (nen = 9) facet, non-allocating.

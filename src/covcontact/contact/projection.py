@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from covcontact.contact.geometry import DEGENERATE_TOL
+from covcontact.contact.geometry import DEGENERATE_TOL, bilinear_coefficients
 
 #: projection status codes
 CONVERGED = 0
@@ -35,14 +35,8 @@ def facet_monomials(xyz, c):
     """
     if xyz.shape[0] == 4:
         for p in range(3):
-            x0 = xyz[0, p]
-            x1 = xyz[1, p]
-            x2 = xyz[2, p]
-            x3 = xyz[3, p]
-            c[0, 0, p] = 0.25 * (x0 + x1 + x2 + x3)
-            c[1, 0, p] = 0.25 * (x1 + x2 - x0 - x3)
-            c[0, 1, p] = 0.25 * (x2 + x3 - x0 - x1)
-            c[1, 1, p] = 0.25 * (x0 + x2 - x1 - x3)
+            c[0, 0, p], c[1, 0, p], c[0, 1, p], c[1, 1, p] = bilinear_coefficients(xyz[0, p], xyz[1, p], xyz[2, p],
+                                                                                    xyz[3, p])
             c[2, 0, p] = 0.0
             c[2, 1, p] = 0.0
             c[0, 2, p] = 0.0
@@ -134,10 +128,8 @@ def planar_start(x, faces, f, xs, xi):
     db = 0.0
     dc = 0.0
     for p in range(3):
-        x0, x1, x2, x3 = x[i0, p], x[i1, p], x[i2, p], x[i3, p]
-        b = x1 + x2 - x0 - x3
-        c = x2 + x3 - x0 - x1
-        d = 4.0 * xs[p] - (x0 + x1 + x2 + x3)
+        a, b, c, _ = bilinear_coefficients(x[i0, p], x[i1, p], x[i2, p], x[i3, p])
+        d = xs[p] - a
         bb += b * b
         bc += b * c
         cc += c * c

@@ -23,6 +23,7 @@ from numba import njit, prange
 
 from ..fem.quadrature import gauss_quad
 from ..fem.shapes import IDX, NODES, lagrange1d, shape_functions
+from .geometry import bilinear_coefficients
 
 #: element coordinates of the start of local edge e and its direction (edge parameter t in [-1, 1])
 EDGE_START = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
@@ -264,13 +265,10 @@ def facet_frame_inline(xyz, xi1, xi2, rho, t1, t2, nrm):
         facet_frame(xyz, xi1, xi2, rho, t1, t2, nrm)
         return
     for p in range(3):
-        x0, x1, x2, x3 = xyz[0, p], xyz[1, p], xyz[2, p], xyz[3, p]
-        b = 0.25 * (x1 + x2 - x0 - x3)
-        c = 0.25 * (x2 + x3 - x0 - x1)
-        d = 0.25 * (x0 + x2 - x1 - x3)
+        a, b, c, d = bilinear_coefficients(xyz[0, p], xyz[1, p], xyz[2, p], xyz[3, p])
         t1[p] = b + d * xi2
         t2[p] = c + d * xi1
-        rho[p] = 0.25 * (x0 + x1 + x2 + x3) + b * xi1 + c * xi2 + d * xi1 * xi2
+        rho[p] = a + b * xi1 + c * xi2 + d * xi1 * xi2
     _unit_normal(t1, t2, nrm)
 
 
