@@ -198,6 +198,9 @@ class SolverOptions:
     #: first iterate of a step: "tangent" (the tangent at the converged state with the prescribed increment)
     #: or "extrapolate" (the previous step's increment scaled to this one, then Newton)
     predictor: str = "tangent"
+    #: precision of PARDISO's factorisations: "double", "single" (refined to double-precision accuracy by GMRES),
+    #: or "auto" (single from 20,000 unknowns on); the other solvers factorise in double precision
+    factorization_precision: str = "auto"
 
 
 @dataclass

@@ -515,7 +515,12 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             reuse_factorization=_reuse_option(s, solver.reuse_factorization),
             krylov_max=s.get("krylov_max", "int", solver.krylov_max, positive=True),
             predictor=s.get("predictor", "str", solver.predictor, choices=("tangent", "extrapolate")),
+            factorization_precision=s.get("factorization_precision", "str", solver.factorization_precision,
+                                          choices=("auto", "double", "single")),
         )
+        if solver.factorization_precision == "single" and solver.linear.lower().strip() not in ("auto", "pardiso"):
+            s.fail(f'"single" is PARDISO\'s; linear = {solver.linear!r} factorises in double precision '
+                   f'(use linear = "pardiso", or leave factorization_precision out)', "factorization_precision")
         s.done()
     o = top.get("output", "table", None)
     output = OutputOptions()

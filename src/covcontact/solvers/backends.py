@@ -30,6 +30,7 @@ from .linear import (
     SingularMatrixError,
     _as_csr,
     available,
+    gmres_right,
     make_solver,
     near_null_candidates,
 )
@@ -123,6 +124,21 @@ PARDISO_SERIAL_BELOW = 12_000
 #: paper study (24 and 39), where GMRES needs more iterations than a factorisation is worth.
 REUSE_MIN_FLOP_RATIO = 50.0
 
+#: ``precision = "auto"`` factorises in single precision from this many unknowns on (see PardisoSolver) ...
+PARDISO_SINGLE_FROM = 12_000
+#: ... where the factorisation needs at least this many times the flops of a substitution (``flop_ratio``).
+#: Measured whole runs (benchmarks/newton_iteration.py problems, 2 cores; docs/performance.md): single
+#: precision took 7 % longer on a plate of ratio 83 (39,366 unknowns; each refinement needs 1-2 GMRES
+#: iterations there) and 6-25 % less time on plates of ratio 107 and 155 and blocks of 127 to 328.
+SINGLE_MIN_FLOP_RATIO = 100.0
+#: a single-precision factorisation's solve is refined by GMRES in double precision to this relative residual
+SINGLE_REFINE_RTOL = 1e-10
+#: ... or until the normwise backward error ||K x - b|| / (||K||_F ||x|| + ||b||) is this small (what a
+#: double-precision factorisation leaves on the ill-conditioned tangents of thin shells)
+SINGLE_REFINE_BACKWARD = 1e-15
+#: ... within this many GMRES iterations; else the factorisation is redone in double precision
+SINGLE_REFINE_MAX = 20
+
 
 def _upper_structure(K: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """CSR structure (ia, ja int32) of the upper triangle of K with every diagonal entry present,
@@ -151,6 +167,16 @@ class PardisoSolver(LinearSolver):
     Options: ``spd=True`` uses Cholesky (mtype 2; falls back to -2 if the matrix is not positive
     definite); ``matching=True`` adds weighted matching and scaling to LDL^T (saddle-point
     matrices with zero diagonal blocks).
+
+    ``precision``: ``"double"``; ``"single"``, a symmetric matrix factorised in single precision (PARDISO's
+    iparm[27]: about half the time and half the memory of the factor) and each solve refined in double
+    precision by GMRES preconditioned with that factor, to a relative residual of ``SINGLE_REFINE_RTOL`` (or
+    the backward error of a double-precision solve); or ``"auto"``, single precision from
+    ``PARDISO_SINGLE_FROM`` unknowns on where the analysis finds a factorisation at least
+    ``SINGLE_MIN_FLOP_RATIO`` substitutions dear (else it is analysed again in double precision). If the
+    refinement misses its tolerance in
+    ``SINGLE_REFINE_MAX`` iterations the solver factorises in double precision from then on
+    (``single_given_up`` says why). Non-symmetric matrices and ``matching`` always use double precision.
     """
 
     name = "pardiso"
@@ -169,11 +195,18 @@ class PardisoSolver(LinearSolver):
         return True, ver, "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
 
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, spd: bool = False,
-                 matching: bool = False):
+                 matching: bool = False, precision: str = "double"):
         super().__init__(symmetric, check_tol)
+        if precision not in ("double", "single", "auto"):
+            raise ValueError(f'precision must be "double", "single" or "auto", got {precision!r}')
         self._fn = _pardiso_function()
         self.mtype = (2 if spd else -2) if symmetric else 11
         self.matching = matching
+        self.precision = precision
+        self.single = False  # the current analysis and factorisation are in single precision
+        self.single_given_up = ""  # why single precision was given up for the rest of this solver's life
+        self.refine_iterations = 0  # GMRES iterations of the refinements since the solver was made
+        self.n_single = 0  # factorisations in single precision
         self.pt = np.zeros(64, dtype=np.int64)
         self.iparm = np.zeros(64, dtype=np.int32)
         self._n = 0
@@ -193,6 +226,7 @@ class PardisoSolver(LinearSolver):
         ip[7] = 0  # iterative refinement: automatic (2 steps after perturbed pivots)
         ip[34] = 1  # zero-based indexing
         ip[17] = ip[18] = -1  # report the factors' non-zeros and the factorisation's Mflop (phase 11)
+        ip[27] = 1 if self.single else 0  # single precision: the values and right-hand sides as float32
         if self.mtype == 11:
             ip[9], ip[10], ip[12] = 13, 1, 1  # pivot perturbation 1e-13, scaling, matching
         else:
@@ -225,17 +259,44 @@ class PardisoSolver(LinearSolver):
         return err.value
 
     def _values(self, K: sp.csr_matrix) -> np.ndarray:
-        """Values in PARDISO's structure; kept alive, PARDISO refines with them in phase 33."""
+        """Values in PARDISO's structure (float32 in single precision); kept alive, PARDISO refines with
+        them in phase 33."""
         if self._pos is None:
-            return K.data.copy()
-        if self._pad:
-            return np.append(K.data, 0.0)[self._pos]
-        return K.data[self._pos]
+            a = K.data.copy()
+        elif self._pad:
+            a = np.append(K.data, 0.0)[self._pos]
+        else:
+            a = K.data[self._pos]
+        return a.astype(np.float32) if self.single else a
 
-    def _analyze(self, K: sp.csr_matrix) -> None:
+    def set_precision(self, precision: str) -> None:
+        if precision not in ("double", "single", "auto"):
+            raise ValueError(f'precision must be "double", "single" or "auto", got {precision!r}')
+        self.precision = precision
+
+    def precision_report(self) -> dict | None:
+        if self.mtype == 11 or self.matching:
+            return None
+        report = {"precision": self.precision, "single_factorizations": self.n_single,
+                  "refinement_gmres_iterations": self.refine_iterations}
+        if self.single_given_up:
+            report["single_given_up"] = self.single_given_up
+        return report
+
+    def _wants_single(self, n: int) -> bool:
+        if self.mtype == 11 or self.matching or self.single_given_up:
+            return False
+        return self.precision == "single" or (self.precision == "auto" and n >= PARDISO_SINGLE_FROM)
+
+    def _analyze(self, K: sp.csr_matrix, same_pattern: bool = False, single: bool | None = None) -> None:
+        """Phase 11; ``same_pattern``: K has the pattern of the last analysis (a new mtype or precision), whose
+        PARDISO structure is kept; ``single``: the precision (default: ``_wants_single``)."""
         self._release()
         self._n = K.shape[0]
-        if self.mtype == 11:
+        self.single = self._wants_single(self._n) if single is None else single
+        if same_pattern:
+            pass
+        elif self.mtype == 11:
             self._ia, self._ja, self._pos = K.indptr.astype(np.int32), K.indices.astype(np.int32), None
         else:
             self._ia, self._ja, self._pos = _upper_structure(K)
@@ -248,6 +309,8 @@ class PardisoSolver(LinearSolver):
             raise LinearSolverError(f"pardiso analysis failed: {_PARDISO_ERRORS.get(err, err)}")
         # factorisation Mflop over the flops of one substitution (iparm 18 and 17, reported by phase 11)
         self.flop_ratio = max(float(self.iparm[18]), 0.0) * 1e6 / (4.0 * max(float(self.iparm[17]), 1.0))
+        if self.single and self.precision == "auto" and self.flop_ratio < SINGLE_MIN_FLOP_RATIO:
+            self._analyze(K, same_pattern=True, single=False)  # refinement would cost what single saves
 
     def reuse_pays(self) -> bool:
         threaded = self._n >= PARDISO_SERIAL_BELOW and _mkl_max_threads() > 1
@@ -258,21 +321,57 @@ class PardisoSolver(LinearSolver):
         err = self._call(22)
         if err == -4 and self.mtype == 2:  # not positive definite: continue with LDL^T
             self.mtype = -2
-            self._analyze(K)
+            self._analyze(K, same_pattern=True)
             err = self._call(22)
         if err:
             cls = SingularMatrixError if err in (-4, -7) else LinearSolverError
             raise cls(f"pardiso factorisation failed: {_PARDISO_ERRORS.get(err, err)}")
+        self.n_single += self.single
         self.n_perturbed = int(self.iparm[13])
         self.inertia = (int(self.iparm[21]), int(self.iparm[22])) if self.mtype == -2 else None
 
-    def _solve(self, b: np.ndarray) -> np.ndarray:
-        bf = np.array(b, dtype=np.float64, order="F")
+    def _substitute(self, b: np.ndarray) -> np.ndarray:
+        """Forward and backward substitution with the factor, in its precision; float64 out."""
+        bf = np.array(b, dtype=np.float32 if self.single else np.float64, order="F")
         x = np.zeros_like(bf, order="F")
         err = self._call(33, bf, x)
         if err:
             raise LinearSolverError(f"pardiso solve failed: {_PARDISO_ERRORS.get(err, err)}")
-        return np.ascontiguousarray(x)
+        return np.ascontiguousarray(x, dtype=np.float64)
+
+    def precondition(self, b: np.ndarray) -> np.ndarray:
+        return self._substitute(b)
+
+    def _solve(self, b: np.ndarray) -> np.ndarray:
+        if not self.single:
+            return self._substitute(b)
+        if b.ndim == 2:
+            return np.column_stack([self._solve(b[:, j]) for j in range(b.shape[1])])
+        K = self._K
+        assert K is not None
+        x = self._substitute(b)
+        r = b - K @ x
+        nb, nr = float(np.linalg.norm(b)), float(np.linalg.norm(r))
+        if nr <= SINGLE_REFINE_RTOL * nb:
+            return x
+        d, its = gmres_right(K, r, self._substitute, SINGLE_REFINE_RTOL * nb / nr, SINGLE_REFINE_MAX,
+                             partial=True, flexible=True)
+        self.refine_iterations += its
+        if d is not None and np.isfinite(d).all():
+            x = x + d
+            nr = float(np.linalg.norm(b - K @ x))
+            if self._K_norm is None:
+                self._K_norm = float(np.linalg.norm(K.data))
+            if nr <= SINGLE_REFINE_RTOL * nb or nr <= SINGLE_REFINE_BACKWARD * (
+                    self._K_norm * float(np.linalg.norm(x)) + nb):
+                return x
+        # the single-precision factor is too poor for this matrix: double precision from now on
+        self.single_given_up = (f"refinement of a single-precision solve stopped at a relative residual "
+                                f"{nr / nb:.1e} after {its} GMRES iterations")
+        self.single = False
+        self._analyze(K, same_pattern=True)
+        self._factor(K)
+        return self._substitute(b)
 
     def _diagnosis(self) -> str:
         return f" ({self.n_perturbed} perturbed pivots)" if self.n_perturbed else ""

@@ -41,61 +41,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..assembly.system import InvertedElementError
-from .linear import LinearSolverError, SingularMatrixError, make_solver
+from .linear import LinearSolverError, SingularMatrixError, gmres_right, make_solver
 
 #: relative residual of the first correction of a step with an AMG solver and reuse on
 AMG_FIRST = 1e-6
 #: a later correction of the step keeps its AMG hierarchy if CG converges within this many times the first
 #: correction's iterations (+ 10)
 AMG_REUSE_FACTOR = 2
-
-
-def gmres_right(A, b: np.ndarray, prec, tol: float, m: int):
-    """One cycle of GMRES(m) on A x = b from x = 0 with right preconditioning x = prec(y): the Arnoldi basis
-    by classical Gram-Schmidt with one reorthogonalisation, Givens rotations for the least-squares problem.
-    Returns (x or None if ||b - A x|| > tol ||b|| after m iterations, iterations)."""
-    n = b.shape[0]
-    beta = float(np.linalg.norm(b))
-    if beta == 0.0:
-        return np.zeros(n), 0
-    V = np.empty((m + 1, n))
-    H = np.zeros((m + 1, m))
-    cs = np.zeros(m)
-    sn = np.zeros(m)
-    g = np.zeros(m + 1)
-    g[0] = beta
-    V[0] = b / beta
-    k = 0
-    for j in range(m):
-        w = A @ prec(V[j])
-        h = V[: j + 1] @ w
-        w -= h @ V[: j + 1]
-        h2 = V[: j + 1] @ w  # reorthogonalise once
-        w -= h2 @ V[: j + 1]
-        h += h2
-        hn = float(np.linalg.norm(w))
-        H[: j + 1, j] = h
-        H[j + 1, j] = hn
-        for i in range(j):  # the earlier rotations on the new column
-            a, c = H[i, j], H[i + 1, j]
-            H[i, j], H[i + 1, j] = cs[i] * a + sn[i] * c, -sn[i] * a + cs[i] * c
-        r = float(np.hypot(H[j, j], H[j + 1, j]))
-        if r == 0.0:
-            return None, j + 1
-        cs[j], sn[j] = H[j, j] / r, H[j + 1, j] / r
-        H[j, j], H[j + 1, j] = r, 0.0
-        g[j + 1] = -sn[j] * g[j]
-        g[j] = cs[j] * g[j]
-        k = j + 1
-        if abs(g[j + 1]) <= tol * beta:
-            break
-        if hn == 0.0:
-            return None, k
-        V[j + 1] = w / hn
-    if abs(g[k]) > tol * beta:
-        return None, k
-    y = np.linalg.solve(np.triu(H[:k, :k]), g[:k])
-    return prec(y @ V[:k]), k
 
 
 class StepFailed(RuntimeError):
@@ -134,6 +86,7 @@ class Newton:
         self.model = model
         self.opt = options
         self.linear = make_solver(linear or options.linear, symmetric=model.symmetric)
+        self.linear.set_precision(options.factorization_precision)
         self.linear.set_near_null_space(model.near_null_space())  # rigid-body modes (AMG only)
         self.scale_seen = 0.0  # the largest force scale of the converged steps so far
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}
@@ -165,8 +118,9 @@ class Newton:
     def _krylov(self, K, rhs, eta: float):
         """GMRES on K du = rhs, right-preconditioned by the last factorisation (so that its residual is the
         true one); None when it needs more than ``krylov_max`` iterations (or breaks down)."""
-        return self._inexact(K, rhs, eta, lambda: gmres_right(K, rhs, self.linear._solve, eta,
-                                                               self.opt.krylov_max))[0]
+        flexible = bool(getattr(self.linear, "single", False))  # a single-precision factor: FGMRES
+        return self._inexact(K, rhs, eta, lambda: gmres_right(K, rhs, self.linear.precondition, eta,
+                                                               self.opt.krylov_max, flexible=flexible))[0]
 
     def _amg(self, K, rhs, eta: float, maxiter: int | None = None):
         """CG (GMRES) preconditioned by the current AMG hierarchy, to ``eta``: (du or None when it does not

@@ -442,6 +442,11 @@ def _finish(problem, model, newton, summary, status, t_before, t_start, t_out, w
         lin = newton.linear
         summary["parallel"]["linear"] = {"analyses": lin.n_analyses, "factorizations": lin.n_factorizations,
                                          "krylov_iterations": getattr(lin, "krylov_iterations", 0)}
+    precision = newton.linear.precision_report()
+    if precision is not None and precision["single_factorizations"]:
+        summary["factorization_precision"] = precision
+        if "single_given_up" in precision and not quiet:
+            say(f"note: factorising in double precision after a {precision['single_given_up']}")
     timing = dict(newton.timing)
     split = model.contact.timing
     timing["contact_search"] = split["search"]
