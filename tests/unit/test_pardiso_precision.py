@@ -1,0 +1,171 @@
+"""PARDISO in single precision ([solver] factorization_precision): the factor in float32, every solve refined
+by flexible GMRES in double precision to the accuracy of a double-precision solve; the "auto" rule; the fall
+back to double precision; the same Newton iterations and results as double precision."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from covcontact.io.loader import load_problem
+from covcontact.io.validate import InputError
+from covcontact.solvers.linear import available, gmres_right, make_solver
+
+ROOT = Path(__file__).resolve().parents[2]
+pytestmark = pytest.mark.skipif("pardiso" not in available(), reason="pypardiso not installed")
+
+
+def elastic_like(m: int) -> sp.csr_matrix:
+    """An SPD matrix with the pattern of a 3D stiffness: a 7-point Laplacian on m^3 nodes, 3x3 node blocks."""
+    T = sp.diags([-np.ones(m - 1), 2 * np.ones(m), -np.ones(m - 1)], [-1, 0, 1])
+    eye = sp.identity(m)
+    lap = sp.kron(sp.kron(T, eye), eye) + sp.kron(sp.kron(eye, T), eye) + sp.kron(sp.kron(eye, eye), T)
+    A = sp.kron(lap, np.ones((3, 3)) + 3 * np.eye(3)).tocsr()
+    A.setdiag(A.diagonal() * (1.0 + np.linspace(0.0, 1e3, A.shape[0])))  # condition number ~1e5: refinement works
+    return A.tocsr()
+
+
+def _relres(A, x, b) -> float:
+    return float(np.linalg.norm(A @ x - b) / np.linalg.norm(b))
+
+
+@pytest.fixture(scope="module")
+def system():
+    A = elastic_like(12)  # 5,184 unknowns
+    b = A @ np.random.default_rng(0).standard_normal(A.shape[0])
+    return A, b
+
+
+def test_single_factor_refined_to_double_accuracy(system):
+    from covcontact.solvers.backends import SINGLE_REFINE_RTOL
+
+    A, b = system
+    double = make_solver("pardiso")
+    single = make_solver("pardiso", precision="single")
+    x2 = double.solve(A, b)
+    x1 = single.solve(A, b)
+    assert single.single and single.iparm[27] == 1 and not double.single and double.iparm[27] == 0
+    assert single._a.dtype == np.float32
+    raw = single.precondition(b)  # the plain substitution: float32 rounding shows in its residual
+    assert 1e-10 < _relres(A, raw, b) < 1e-4
+    assert _relres(A, x1, b) <= SINGLE_REFINE_RTOL
+    np.testing.assert_allclose(x1, x2, rtol=0, atol=1e-8 * np.abs(x2).max())
+    assert single.refine_iterations >= 1
+    report = single.precision_report()
+    assert report == {"precision": "single", "single_factorizations": 1, "refinement_gmres_iterations":
+                      single.refine_iterations}
+    # several right-hand sides
+    B = np.column_stack([b, 2.0 * b + 1.0])
+    X = single.solve_factorized(B)
+    assert max(_relres(A, X[:, j], B[:, j]) for j in range(2)) <= SINGLE_REFINE_RTOL
+
+
+def test_flexible_gmres_needs_no_linear_preconditioner(system):
+    """A single-precision substitution is not linear to double precision: GMRES that applies it once more to
+    the combined basis misses 1e-12 by the float32 rounding; flexible GMRES reaches it."""
+    A, b = system
+    s = make_solver("pardiso", precision="single")
+    s.factorize(A)
+    x, _ = gmres_right(A, b, s.precondition, 1e-12, 10)
+    xf, its = gmres_right(A, b, s.precondition, 1e-12, 10, flexible=True)
+    assert x is None or _relres(A, x, b) > 1e-10
+    assert xf is not None and _relres(A, xf, b) <= 1.01e-12 and its <= 5
+
+
+def test_auto_rule(system, monkeypatch):
+    """auto: double precision below PARDISO_SINGLE_FROM unknowns; above it single precision where the
+    analysis finds a factorisation of at least SINGLE_MIN_FLOP_RATIO substitutions, else analysed again in
+    double precision."""
+    from covcontact.solvers import backends
+
+    A, b = system
+    s = make_solver("pardiso", precision="auto")
+    s.factorize(A)
+    assert A.shape[0] < backends.PARDISO_SINGLE_FROM and not s.single and s.n_single == 0
+    monkeypatch.setattr(backends, "PARDISO_SINGLE_FROM", 1000)
+    for min_ratio, single in ((0.0, True), (1e9, False)):
+        monkeypatch.setattr(backends, "SINGLE_MIN_FLOP_RATIO", min_ratio)
+        s = make_solver("pardiso", precision="auto")
+        x = s.solve(A, b)
+        assert s.single == single and s.n_single == int(single) and s.iparm[27] == int(single)
+        assert _relres(A, x, b) <= 1e-10
+    assert make_solver("pardiso", symmetric=False, precision="single").precision_report() is None
+
+
+def test_falls_back_to_double_when_refinement_fails(system, monkeypatch):
+    from covcontact.solvers import backends
+
+    A, b = system
+    monkeypatch.setattr(backends, "SINGLE_REFINE_RTOL", 0.0)  # a tolerance refinement cannot meet
+    monkeypatch.setattr(backends, "SINGLE_REFINE_BACKWARD", 0.0)
+    s = make_solver("pardiso", precision="single")
+    x = s.solve(A, b)
+    assert s.single_given_up.startswith("refinement of a single-precision solve stopped")
+    assert not s.single and s.iparm[27] == 0 and s._a.dtype == np.float64
+    assert _relres(A, x, b) < 1e-12
+    s.factorize(2.0 * A)  # the rest of the solver's life in double precision
+    assert not s.single and s.n_single == 1
+    assert s.precision_report()["single_given_up"] == s.single_given_up
+
+
+def _block_run(precision: str, tmp: Path):
+    """A 16^3 hex8 block (14,739 unknowns) pressed on a rigid plane, PARDISO, one load step."""
+    from covcontact.materials import SaintVenantKirchhoff
+    from covcontact.mesh.generators import block
+    from covcontact.problem import Body, ContactPair, Dirichlet, OutputOptions, Problem, RigidBody, SolverOptions, Steps
+
+    mesh = block(1.0, 1.0, 1.0, 16, 16, 16, cell="hex8")
+    problem = Problem(
+        name="block", bodies=[Body("b", mesh, SaintVenantKirchhoff(E=1000.0, nu=0.3))],
+        rigid=[RigidBody("floor", shape="plane", params={"point": (0, 0, 0), "normal": (0, 0, 1)})],
+        contacts=[ContactPair("c", ("b", "zmin"), ("floor", ""), penalty=1e7, weighting="area")],
+        dirichlet=[Dirichlet("b", "zmax", (0, 1, 2), (0.0, 0.0, -0.01))],
+        steps=Steps.equal(2), output=OutputOptions(vtu=False),
+        solver=SolverOptions(linear="pardiso", factorization_precision=precision, reuse_factorization=False))
+    res = problem.run(out=tmp / precision, quiet=True)
+    assert res.exit_code == 0
+    return res
+
+
+def test_newton_same_iterations_and_results(tmp_path):
+    runs = {p: _block_run(p, tmp_path) for p in ("double", "single")}
+    d, s = runs["double"].summary, runs["single"].summary
+    assert [st["iterations"] for st in s["steps"]] == [st["iterations"] for st in d["steps"]]
+    for a, b in zip(d["steps"], s["steps"], strict=True):
+        np.testing.assert_allclose(b["residual_norms"][:-1], a["residual_norms"][:-1], rtol=1e-6)
+        assert b["residual_norms"][-1] < 1e-8 * b["residual_norms"][0]
+        np.testing.assert_allclose(b["contact_force"], a["contact_force"], rtol=1e-9,
+                                   atol=1e-9 * np.linalg.norm(a["contact_force"]))
+    u_d, u_s = runs["double"].u, runs["single"].u
+    assert np.abs(u_s - u_d).max() <= 1e-9 * np.abs(u_d).max()
+    assert "factorization_precision" not in d
+    rep = s["factorization_precision"]
+    assert rep["precision"] == "single" and rep["single_factorizations"] == sum(st["iterations"] for st in s["steps"])
+
+
+def test_precision_in_the_input(tmp_path):
+    text = (ROOT / "examples" / "contact" / "two_blocks.toml").read_text()
+    path = tmp_path / "p.toml"
+    for value in ("auto", "double", "single"):
+        path.write_text(text + f'\n[solver]\nfactorization_precision = "{value}"\n')
+        assert load_problem(path).solver.factorization_precision == value
+    path.write_text(text + '\n[solver]\nfactorization_precision = "half"\n')
+    with pytest.raises(InputError, match=r"solver\.factorization_precision"):
+        load_problem(path)
+    path.write_text(text + '\n[solver]\nlinear = "superlu"\nfactorization_precision = "single"\n')
+    with pytest.raises(InputError, match=r'factorization_precision: "single" is PARDISO\'s; linear = \'superlu\''):
+        load_problem(path)
+
+
+def test_run_default_is_auto(tmp_path):
+    """The default: "auto"; a small problem stays in double precision and its summary says nothing of it."""
+    problem = load_problem(ROOT / "examples" / "contact" / "two_blocks.toml")
+    assert problem.solver.factorization_precision == "auto"
+    problem.solver = dataclasses.replace(problem.solver, linear="pardiso")
+    problem.output.vtu = False
+    res = problem.run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0 and "factorization_precision" not in res.summary
