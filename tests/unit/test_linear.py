@@ -319,3 +319,30 @@ def test_pardiso_spd_option_falls_back_on_indefinite(problem, indefinite):
     assert s.mtype == 2
     x = s.solve(indefinite, b)
     assert s.mtype == -2 and rel_residual(indefinite, x, b) < RTOL
+
+
+def test_pardiso_upper_structure():
+    """The upper triangle handed to PARDISO: scipy's triu with every missing diagonal entry added as a
+    structural zero (position nnz), indices sorted, values found through the positions."""
+    from covcontact.solvers.backends import _upper_structure
+
+    rng = np.random.default_rng(5)
+    n = 300
+    A = sp.random(n, n, density=0.03, random_state=rng, format="csr")
+    A = (A + A.T).tocsr()
+    A.setdiag(np.where(rng.random(n) < 0.2, 0.0, 1.0 + rng.random(n)))
+    A.eliminate_zeros()  # about a fifth of the diagonal absent from the pattern
+    A.sort_indices()
+    missing = np.flatnonzero(A.diagonal() == 0.0)
+    assert missing.size > 20
+    ia, ja, pos = _upper_structure(A)
+    U = sp.triu(A + sp.csr_matrix((np.full(missing.size, 7.0), (missing, missing)), shape=A.shape)).tocsr()
+    U.sort_indices()
+    assert ia.dtype == ja.dtype == np.int32
+    np.testing.assert_array_equal(ia, U.indptr)
+    np.testing.assert_array_equal(ja, U.indices)
+    values = np.append(A.data, 0.0)[pos]
+    expected = U.data.copy()
+    expected[np.isin(np.arange(U.nnz), [U.indptr[i] for i in missing])] = 0.0  # the structural zeros
+    np.testing.assert_array_equal(values, expected)
+    assert (pos == A.nnz).sum() == missing.size

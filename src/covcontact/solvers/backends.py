@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
+from numba import njit
 
 from .linear import (
     LinearSolver,
@@ -141,24 +142,40 @@ SINGLE_REFINE_MAX = 20
 
 
 def _upper_structure(K: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """CSR structure (ia, ja int32) of the upper triangle of K with every diagonal entry present,
-    and for each entry its position in K.data (K.nnz for a structural zero on the diagonal)."""
-    n = K.shape[0]
-    rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(K.indptr))
-    keep = np.flatnonzero(K.indices >= rows)
-    r, c, pos = rows[keep], K.indices[keep].astype(np.int64), keep
-    has_diag = np.zeros(n, dtype=bool)
-    has_diag[r[c == r]] = True
-    missing = np.flatnonzero(~has_diag)
-    if missing.size:  # PARDISO needs the diagonal in the structure of symmetric matrices
-        r = np.concatenate([r, missing])
-        c = np.concatenate([c, missing])
-        pos = np.concatenate([pos, np.full(missing.size, K.nnz)])
-        order = np.lexsort((c, r))
-        r, c, pos = r[order], c[order], pos[order]
+    """CSR structure (ia, ja int32) of the upper triangle of K (sorted indices, as ``_as_csr`` leaves them)
+    with every diagonal entry present, and for each entry its position in K.data (K.nnz for a structural
+    zero on the diagonal)."""
+    return _upper_kernel(K.indptr.astype(np.int64), K.indices.astype(np.int32), K.shape[0])
+
+
+@njit(cache=True)
+def _upper_kernel(indptr, indices, n):  # pragma: no cover - compiled
+    nnz = indptr[n]
     ia = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(np.bincount(r, minlength=n), out=ia[1:])
-    return ia, c.astype(np.int32), pos
+    for i in range(n):  # count the upper entries, a missing diagonal included
+        c = 0
+        diag = False
+        for p in range(indptr[i], indptr[i + 1]):
+            if indices[p] >= i:
+                c += 1
+                diag = diag or indices[p] == i
+        ia[i + 1] = ia[i] + c + (0 if diag else 1)
+    ja = np.empty(ia[n], dtype=np.int32)
+    pos = np.empty(ia[n], dtype=np.int64)
+    for i in range(n):
+        q = ia[i]
+        first = indptr[i]
+        while first < indptr[i + 1] and indices[first] < i:
+            first += 1
+        if first == indptr[i + 1] or indices[first] != i:  # a structural zero first: the others lie right of i
+            ja[q] = i
+            pos[q] = nnz
+            q += 1
+        for p in range(first, indptr[i + 1]):
+            ja[q] = indices[p]
+            pos[q] = p
+            q += 1
+    return ia, ja, pos
 
 
 class PardisoSolver(LinearSolver):
