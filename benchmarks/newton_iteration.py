@@ -11,6 +11,8 @@ iterations. Writes JSON.
                                                                        # two Newton iterations timed
     python benchmarks/newton_iteration.py --blocks --plates 408 --reuse          # the whole step, reusing
                                                                        # factorisations (inexact Newton)
+    python benchmarks/newton_iteration.py --blocks 16 --plates 80 --reuse auto --precision double  # against
+                                                                       # --precision single: PARDISO in float32
 """
 
 from __future__ import annotations
@@ -68,11 +70,13 @@ def two_blocks_problem(n: int) -> Problem:
         steps=Steps.equal(1), output=OutputOptions(vtu=False), solver=SolverOptions())
 
 
-def measure(prob: Problem, iterations: int | None = None, reuse: bool | str = False, solver: str = "auto") -> dict:
+def measure(prob: Problem, iterations: int | None = None, reuse: bool | str = False, solver: str = "auto",
+            precision: str = "auto") -> dict:
     if iterations:  # time a fixed number of iterations of the first step (no cutback)
         prob.solver = SolverOptions(max_iterations=iterations, max_cutbacks=0)
     prob.solver.reuse_factorization = reuse
     prob.solver.linear = solver
+    prob.solver.factorization_precision = precision
     t0 = time.perf_counter()
     model = Model(prob)
     newton = Newton(model, prob.solver)
@@ -88,7 +92,8 @@ def measure(prob: Problem, iterations: int | None = None, reuse: bool | str = Fa
             "factorizations": newton.stats["factorizations"], "krylov_iterations": newton.stats["krylov_iterations"],
             "residual_norms": [r for o in outcomes for r in o.residual_norms],
             "per_iteration_s": per_it, "iteration_total_s": wall / its,
-            "solver": newton.linear.name,
+            "solver": newton.linear.name, "factorization_precision": newton.linear.precision_report(),
+            "flop_ratio": getattr(newton.linear, "flop_ratio", None),
             "peak_rss_gib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20}
 
 
@@ -102,9 +107,11 @@ def main() -> None:
                     help="two-block sizes n (mesh-facet contact between deformable bodies)")
     ap.add_argument("--iterations", type=int, default=None,
                     help="time only this many Newton iterations of the step (for the largest sizes)")
-    ap.add_argument("--reuse", action="store_true",
-                    help="[solver] reuse_factorization = true: GMRES preconditioned by the last factorisation (with "
-                         "an AMG solver: CG to Newton's forcing term on a kept hierarchy)")
+    ap.add_argument("--reuse", nargs="?", const="true", default="false", choices=("true", "false", "auto"),
+                    help="[solver] reuse_factorization (--reuse alone: true): GMRES preconditioned by the last "
+                         "factorisation (with an AMG solver: CG to Newton's forcing term on a kept hierarchy)")
+    ap.add_argument("--precision", default="auto", choices=("auto", "double", "single"),
+                    help="[solver] factorization_precision (PARDISO)")
     ap.add_argument("--solver", default="auto",
                     help="the linear solver (default auto: the direct one here, as the serial model is used)")
     args = ap.parse_args()
@@ -114,16 +121,17 @@ def main() -> None:
         blocks = args.blocks
     if args.plates is not None:
         plates = args.plates
+    reuse = {"true": True, "false": False}.get(args.reuse, args.reuse)
     measure(block_problem(4))  # compile
     rows = []
     for n in blocks:
-        rows.append(measure(block_problem(n), args.iterations, args.reuse, args.solver))
+        rows.append(measure(block_problem(n), args.iterations, reuse, args.solver, args.precision))
         print(json.dumps(rows[-1]))
     for n in plates:
-        rows.append(measure(plate_problem(n), args.iterations, args.reuse, args.solver))
+        rows.append(measure(plate_problem(n), args.iterations, reuse, args.solver, args.precision))
         print(json.dumps(rows[-1]))
     for n in args.two_blocks:
-        rows.append(measure(two_blocks_problem(n), args.iterations, args.reuse, args.solver))
+        rows.append(measure(two_blocks_problem(n), args.iterations, reuse, args.solver, args.precision))
         print(json.dumps(rows[-1]))
     result = {"benchmark": "newton_iteration", "machine": platform.machine(), "threads": numba.get_num_threads(),
               "date": time.strftime("%Y-%m-%d"), "rows": rows}
