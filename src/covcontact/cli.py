@@ -107,14 +107,18 @@ def cmd_run(args) -> int:
 
 def _run_ranks(args, problem) -> int:
     """``covcontact run --ranks N``: the same command under ``mpiexec -n N`` with a distributed solver; returns its
-    exit code. SIGINT and SIGTERM are passed on to mpiexec."""
+    exit code. SIGINT and SIGTERM are passed on to mpiexec: with Open MPI the first as SIGUSR2 and SIGUSR1, which
+    it relays to the ranks without killing them, so that they stop together at their next Newton iteration and
+    keep their converged steps, as a serial run does (solvers/signals.py); a second signal is passed on as it is
+    and stops them at once."""
     import shutil
     import signal
     import subprocess
 
-    from .parallel.launcher import cores_here, environment_for_mpiexec, ranks_from_env
+    from .parallel.launcher import cores_here, environment_for_mpiexec, is_open_mpi, ranks_from_env
     from .solvers.linear import available
     from .solvers.run import auto_line, check_distributable, requested_linear, resolve_linear
+    from .solvers.signals import StopSignals
 
     n = args.ranks
     if n < 1:
@@ -136,11 +140,11 @@ def _run_ranks(args, problem) -> int:
     if solver != requested and not args.quiet:
         print(auto_line(solver, n), file=sys.stderr, flush=True)
     cmd = [mpiexec, "-n", str(n)]
+    open_mpi = is_open_mpi(mpiexec)
     if n > cores:  # legal, but the ranks take turns on the cores
         print(f"covcontact: warning: --ranks {n} on {cores} cores: the ranks will share cores, which is slower than "
               f"--ranks {cores}", file=sys.stderr, flush=True)
-        version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True, check=False).stdout
-        if "Open MPI" in version or "OpenRTE" in version:  # Open MPI refuses more ranks than cores unless told
+        if open_mpi:  # Open MPI refuses more ranks than cores unless told
             cmd.append("--oversubscribe")
     cmd += [sys.executable, "-m", "covcontact.cli", "run", str(args.problem), "--solver", solver]
     cmd += ["--out", args.out] if args.out else []
@@ -150,9 +154,11 @@ def _run_ranks(args, problem) -> int:
     proc = subprocess.Popen(cmd, env=env)
     received: list[int] = []
 
+    relay = {v: k for k, v in StopSignals.RELAYED.items()} if open_mpi else {}
+
     def forward(sig, _frame):
         received.append(sig)
-        proc.send_signal(sig)
+        proc.send_signal(relay.get(sig, sig) if len(received) == 1 else sig)
 
     previous = {sig: signal.signal(sig, forward) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:

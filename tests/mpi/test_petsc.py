@@ -162,10 +162,12 @@ def _processes_with(text: str) -> list[str]:
 
 
 def test_ranks_stopped_by_sigterm(tmp_path):
-    """SIGTERM to ``covcontact run --ranks 2`` reaches the ranks through mpiexec: exit code 143, no process left."""
+    """SIGTERM to ``covcontact run --ranks 2``: the ranks stop together at their next Newton iteration, as a serial
+    run does: exit code 143, summary "interrupted" with the converged steps, no process left; ``--resume`` then
+    ends as the uninterrupted run (the same iterations, the displacements to the last bit of the checkpoint)."""
+    path = ROOT / "benchmarks" / "problems" / "two_blocks_30k.toml"
     out = tmp_path / "stopped"
-    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(ROOT / "benchmarks" / "problems" / "two_blocks_30k.toml"),
-           "--ranks", "2", "--out", str(out)]
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(path), "--ranks", "2", "--out", str(out)]
     proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
     watchdog = threading.Timer(300, proc.kill)  # a hung run fails the test instead of hanging it
     watchdog.start()
@@ -173,6 +175,7 @@ def test_ranks_stopped_by_sigterm(tmp_path):
         if line.startswith("step    1/"):
             break
     proc.send_signal(signal.SIGTERM)
+    rest = proc.stderr.read()
     assert proc.wait(timeout=60) == 143
     watchdog.cancel()
     proc.stderr.close()
@@ -180,6 +183,19 @@ def test_ranks_stopped_by_sigterm(tmp_path):
     while _processes_with(str(out)) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert _processes_with(str(out)) == []
+    assert "stopped by SIGTERM: the step in flight is dropped; resume with --resume" in rest
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted" and 1 <= len(summary["steps"]) < 10
+    assert all(s["converged"] for s in summary["steps"])
+    resumed = _ranks(path, out, "--resume", "--quiet")
+    assert resumed.returncode == 0, resumed.stderr[-3000:]
+    ref = _ranks(path, tmp_path / "ref", "--quiet")
+    assert ref.returncode == 0, ref.stderr[-3000:]
+    a, b = (json.loads((d / "summary.json").read_text()) for d in (out, tmp_path / "ref"))
+    assert a["status"] == b["status"] == "completed" and _iterations(a) == _iterations(b)
+    for rank in (0, 1):
+        ua, ub = (np.load(d / f"checkpoint.rank{rank}-of-2.npz")["u"] for d in (out, tmp_path / "ref"))
+        assert np.abs(ua - ub).max() <= 1e-12 * np.abs(ub).max()
 
 
 def test_serial_solver_refused_under_ranks(tmp_path):

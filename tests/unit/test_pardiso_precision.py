@@ -116,7 +116,16 @@ def _block_run(precision: str, tmp: Path):
     """A 16^3 hex8 block (14,739 unknowns) pressed on a rigid plane, PARDISO, one load step."""
     from covcontact.materials import SaintVenantKirchhoff
     from covcontact.mesh.generators import block
-    from covcontact.problem import Body, ContactPair, Dirichlet, OutputOptions, Problem, RigidBody, SolverOptions, Steps
+    from covcontact.problem import (
+        Body,
+        ContactPair,
+        Dirichlet,
+        OutputOptions,
+        Problem,
+        RigidBody,
+        SolverOptions,
+        Steps,
+    )
 
     mesh = block(1.0, 1.0, 1.0, 16, 16, 16, cell="hex8")
     problem = Problem(

@@ -52,3 +52,12 @@ def environment_for_mpiexec() -> dict[str, str]:
         env.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
         env.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     return env
+
+
+def is_open_mpi(mpiexec: str) -> bool:
+    """Whether ``mpiexec`` is Open MPI's (it asks for --oversubscribe to run more ranks than cores, and kills its
+    ranks right after passing SIGTERM or SIGINT on, but passes SIGUSR1 and SIGUSR2 on alone)."""
+    import subprocess
+
+    version = subprocess.run([mpiexec, "--version"], capture_output=True, text=True, check=False).stdout
+    return "Open MPI" in version or "OpenRTE" in version

@@ -96,6 +96,7 @@ class Newton:
         self._stalled = False  # the last inexact correction did not reduce the residual enough
         self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
+        self.poll = None  # called before every iteration (a distributed run's stop signals: StopSignals.poll)
 
     # ------------------------------------------------------------------------------------------
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
@@ -237,6 +238,8 @@ class Newton:
         r_ref = r0  # max(||R_0||, ||R_1||) once the first correction is made
         inexact = False
         for it in range(1, opt.max_iterations + 1):
+            if self.poll is not None:
+                self.poll()
             eta = loose = None  # the first correction of a step: a new factorisation (see _solve)
             if it > 1:  # GMRES tolerance relative to ||rhs||: quadratic forcing, and 1 % of the convergence
                 # threshold, so that the iterate is that of exact Newton to well within the test

@@ -305,7 +305,8 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
     status = "completed"
     code = 0
     work_before = model.plastic_work(state)  # plastic work of the committed state (collective)
-    with StopSignals(enabled=size == 1) as stops:
+    with StopSignals(comm=model.comm if size > 1 else None) as stops:
+        newton.poll = stops.poll  # distributed: every rank stops at the same Newton iteration
         try:
             for si in range(state.stage, len(plan)):
                 spec = plan[si]
@@ -393,6 +394,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                                              "pvd": writer.pvd_entries, "wall_time_s": summary["wall_time_s"],
                                              "force_scale": newton.scale_seen, "last_step_lams": lams},
                                             rank, size)
+                    stops.poll()
                 if status == "failed":
                     break
         except (Interrupted, SystemError) as exc:
