@@ -93,7 +93,23 @@ def test_auto_rule(system, monkeypatch):
         x = s.solve(A, b)
         assert s.single == single and s.n_single == int(single) and s.iparm[27] == int(single)
         assert _relres(A, x, b) <= 1e-10
-    assert make_solver("pardiso", symmetric=False, precision="single").precision_report() is None
+    assert make_solver("pardiso", matching=True, precision="single").precision_report() is None
+
+
+def test_single_lu_for_nonsymmetric_matrices(system):
+    """Friction makes the tangent non-symmetric: LU (mtype 11) in single precision, refined alike."""
+    A, _ = system
+    U = sp.triu(A, 1)
+    N = (A + 0.3 * (U - U.T)).tocsr()
+    N.sort_indices()
+    b = N @ np.random.default_rng(1).standard_normal(N.shape[0])
+    single = make_solver("pardiso", symmetric=False, precision="single")
+    x = single.solve(N, b)
+    assert single.mtype == 11 and single.single and single.iparm[27] == 1
+    assert 1e-10 < _relres(N, single.precondition(b), b) < 1e-4
+    assert _relres(N, x, b) <= 1e-10
+    np.testing.assert_allclose(x, make_solver("pardiso", symmetric=False).solve(N, b), rtol=0,
+                               atol=1e-8 * np.abs(x).max())
 
 
 def test_falls_back_to_double_when_refinement_fails(system, monkeypatch):

@@ -185,7 +185,7 @@ class PardisoSolver(LinearSolver):
     definite); ``matching=True`` adds weighted matching and scaling to LDL^T (saddle-point
     matrices with zero diagonal blocks).
 
-    ``precision``: ``"double"``; ``"single"``, a symmetric matrix factorised in single precision (PARDISO's
+    ``precision``: ``"double"``; ``"single"``, the matrix factorised in single precision (PARDISO's
     iparm[27]: about half the time and half the memory of the factor) and each solve refined in double
     precision by GMRES preconditioned with that factor, to a relative residual of ``SINGLE_REFINE_RTOL`` (or
     the backward error of a double-precision solve); or ``"auto"``, single precision from
@@ -193,7 +193,8 @@ class PardisoSolver(LinearSolver):
     ``SINGLE_MIN_FLOP_RATIO`` substitutions dear (else it is analysed again in double precision). If the
     refinement misses its tolerance in
     ``SINGLE_REFINE_MAX`` iterations the solver factorises in double precision from then on
-    (``single_given_up`` says why). Non-symmetric matrices and ``matching`` always use double precision.
+    (``single_given_up`` says why). Symmetric (LDL^T) and non-symmetric (LU, friction) matrices alike;
+    ``matching`` (saddle points) always uses double precision.
     """
 
     name = "pardiso"
@@ -292,7 +293,7 @@ class PardisoSolver(LinearSolver):
         self.precision = precision
 
     def precision_report(self) -> dict | None:
-        if self.mtype == 11 or self.matching:
+        if self.matching:
             return None
         report = {"precision": self.precision, "single_factorizations": self.n_single,
                   "refinement_gmres_iterations": self.refine_iterations}
@@ -301,7 +302,7 @@ class PardisoSolver(LinearSolver):
         return report
 
     def _wants_single(self, n: int) -> bool:
-        if self.mtype == 11 or self.matching or self.single_given_up:
+        if self.matching or self.single_given_up:
             return False
         return self.precision == "single" or (self.precision == "auto" and n >= PARDISO_SINGLE_FROM)
 
