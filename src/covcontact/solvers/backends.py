@@ -243,6 +243,10 @@ class PardisoSolver(LinearSolver):
         ip[1] = 2  # METIS nested dissection
         ip[7] = 0  # iterative refinement: automatic (2 steps after perturbed pivots)
         ip[34] = 1  # zero-based indexing
+        # conditional numerical reproducibility: the threads fixed, so that the threaded factorisation adds in a
+        # fixed order (without it, LU on two threads differed by 1e-15 between runs, enough to change a
+        # frictional run's iterations; the same time, docs/performance.md)
+        ip[33] = 1 if self._n < PARDISO_SERIAL_BELOW else max(_mkl_max_threads(), 1)
         ip[17] = ip[18] = -1  # report the factors' non-zeros and the factorisation's Mflop (phase 11)
         ip[27] = 1 if self.single else 0  # single precision: the values and right-hand sides as float32
         if self.mtype == 11:
