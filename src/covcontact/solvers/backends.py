@@ -215,12 +215,10 @@ class PardisoSolver(LinearSolver):
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, spd: bool = False,
                  matching: bool = False, precision: str = "double"):
         super().__init__(symmetric, check_tol)
-        if precision not in ("double", "single", "auto"):
-            raise ValueError(f'precision must be "double", "single" or "auto", got {precision!r}')
+        self.set_precision(precision)
         self._fn = _pardiso_function()
         self.mtype = (2 if spd else -2) if symmetric else 11
         self.matching = matching
-        self.precision = precision
         self.single = False  # the current analysis and factorisation are in single precision
         self.single_given_up = ""  # why single precision was given up for the rest of this solver's life
         self.refine_iterations = 0  # GMRES iterations of the refinements since the solver was made
@@ -316,11 +314,9 @@ class PardisoSolver(LinearSolver):
         self._release()
         self._n = K.shape[0]
         self.single = self._wants_single(self._n) if single is None else single
-        if same_pattern:
-            pass
-        elif self.mtype == 11:
+        if not same_pattern and self.mtype == 11:
             self._ia, self._ja, self._pos = K.indptr.astype(np.int32), K.indices.astype(np.int32), None
-        else:
+        elif not same_pattern:
             self._ia, self._ja, self._pos = _upper_structure(K)
             self._pad = bool((self._pos == K.nnz).any())
         self._set_iparm()
@@ -393,6 +389,7 @@ class PardisoSolver(LinearSolver):
         self.single = False
         self._analyze(K, same_pattern=True)
         self._factor(K)
+        self.n_factorizations += 1
         return self._substitute(b)
 
     def _diagnosis(self) -> str:
