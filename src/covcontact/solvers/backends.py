@@ -210,7 +210,7 @@ class PardisoSolver(LinearSolver):
         except PackageNotFoundError as exc:  # MKL alone is not enough: pypardiso is the declared route to it
             raise ImportError("pypardiso is not installed") from exc
         _pardiso_function()
-        return True, ver, "MKL PARDISO: LDL^T (mtype -2) / LU (11)"
+        return True, ver, "MKL PARDISO: LDL^T (mtype -2) / LU (11), in double or single precision"
 
     def __init__(self, symmetric: bool = True, check_tol: float = 1e-6, spd: bool = False,
                  matching: bool = False, precision: str = "double"):
