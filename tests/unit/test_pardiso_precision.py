@@ -130,27 +130,18 @@ def test_falls_back_to_double_when_refinement_fails(system, monkeypatch):
 
 def _block_run(precision: str, tmp: Path):
     """A 16^3 hex8 block (14,739 unknowns) pressed on a rigid plane, PARDISO, one load step."""
+    from covcontact import problem as pb
     from covcontact.materials import SaintVenantKirchhoff
     from covcontact.mesh.generators import block
-    from covcontact.problem import (
-        Body,
-        ContactPair,
-        Dirichlet,
-        OutputOptions,
-        Problem,
-        RigidBody,
-        SolverOptions,
-        Steps,
-    )
 
     mesh = block(1.0, 1.0, 1.0, 16, 16, 16, cell="hex8")
-    problem = Problem(
-        name="block", bodies=[Body("b", mesh, SaintVenantKirchhoff(E=1000.0, nu=0.3))],
-        rigid=[RigidBody("floor", shape="plane", params={"point": (0, 0, 0), "normal": (0, 0, 1)})],
-        contacts=[ContactPair("c", ("b", "zmin"), ("floor", ""), penalty=1e7, weighting="area")],
-        dirichlet=[Dirichlet("b", "zmax", (0, 1, 2), (0.0, 0.0, -0.01))],
-        steps=Steps.equal(2), output=OutputOptions(vtu=False),
-        solver=SolverOptions(linear="pardiso", factorization_precision=precision, reuse_factorization=False))
+    problem = pb.Problem(
+        name="block", bodies=[pb.Body("b", mesh, SaintVenantKirchhoff(E=1000.0, nu=0.3))],
+        rigid=[pb.RigidBody("floor", shape="plane", params={"point": (0, 0, 0), "normal": (0, 0, 1)})],
+        contacts=[pb.ContactPair("c", ("b", "zmin"), ("floor", ""), penalty=1e7, weighting="area")],
+        dirichlet=[pb.Dirichlet("b", "zmax", (0, 1, 2), (0.0, 0.0, -0.01))],
+        steps=pb.Steps.equal(2), output=pb.OutputOptions(vtu=False),
+        solver=pb.SolverOptions(linear="pardiso", factorization_precision=precision, reuse_factorization=False))
     res = problem.run(out=tmp / precision, quiet=True)
     assert res.exit_code == 0
     return res
