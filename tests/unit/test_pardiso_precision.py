@@ -83,9 +83,10 @@ def test_auto_rule(system, monkeypatch):
     from covcontact.solvers import backends
 
     A, b = system
+    small = elastic_like(10)  # 3,000 unknowns
     s = make_solver("pardiso", precision="auto")
-    s.factorize(A)
-    assert A.shape[0] < backends.PARDISO_SINGLE_FROM and not s.single and s.n_single == 0
+    s.factorize(small)
+    assert small.shape[0] < backends.PARDISO_SINGLE_FROM and not s.single and s.n_single == 0
     monkeypatch.setattr(backends, "PARDISO_SINGLE_FROM", 1000)
     for min_ratio, single in ((0.0, True), (1e9, False)):
         monkeypatch.setattr(backends, "SINGLE_MIN_FLOP_RATIO", min_ratio)

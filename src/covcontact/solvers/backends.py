@@ -126,11 +126,12 @@ PARDISO_SERIAL_BELOW = 12_000
 REUSE_MIN_FLOP_RATIO = 50.0
 
 #: ``precision = "auto"`` factorises in single precision from this many unknowns on (see PardisoSolver) ...
-PARDISO_SINGLE_FROM = 12_000
+PARDISO_SINGLE_FROM = 4_000
 #: ... where the factorisation needs at least this many times the flops of a substitution (``flop_ratio``).
 #: Measured whole runs (benchmarks/newton_iteration.py problems, 2 cores; docs/performance.md): single
 #: precision took 7 % longer on a plate of ratio 83 (39,366 unknowns; each refinement needs 1-2 GMRES
-#: iterations there) and 6-25 % less time on plates of ratio 107 and 155 and blocks of 127 to 328.
+#: iterations there) and 6-25 % less time on plates of ratio 107 and 155 and blocks of 127 to 328; on one
+#: thread 14-20 % less on the Hertz ball of 5,085 unknowns (ratio 112) and blocks of 6,591 and 10,125 (105, 135).
 SINGLE_MIN_FLOP_RATIO = 100.0
 #: a single-precision factorisation's solve is refined by GMRES in double precision to this relative residual
 SINGLE_REFINE_RTOL = 1e-10
