@@ -204,3 +204,14 @@ def test_threaded_lu_is_reproducible():
         assert s.iparm[33] >= 1
         s.close()
     assert all(np.array_equal(x, xs[0]) for x in xs[1:])
+
+
+def test_single_with_another_solver_is_a_warning(tmp_path):
+    """linear = "auto" may resolve to a solver without single precision: the run says so and goes on."""
+    problem = load_problem(ROOT / "examples" / "contact" / "two_blocks.toml")
+    problem.solver = dataclasses.replace(problem.solver, factorization_precision="single")
+    problem.output.vtu = False
+    res = problem.run(out=tmp_path / "o", quiet=True, solver="superlu")
+    assert res.exit_code == 0
+    said = 'factorization_precision = "single" is for PARDISO; the linear solver superlu factorises in double precision'
+    assert res.summary["warnings"] == [said]

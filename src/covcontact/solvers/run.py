@@ -289,6 +289,9 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         say(f"resuming {problem.name} after step {state.step} (load factor {state.lam:.4g})")
     else:
         warnings = model.start_warnings(u, state)
+        if problem.solver.factorization_precision == "single" and newton.linear.precision_report() is None:
+            warnings.append(f'factorization_precision = "single" is for PARDISO; the linear solver '
+                            f'{newton.linear.name} factorises in double precision')
         if warnings:
             summary["warnings"] = warnings
             for w in warnings:
