@@ -1,8 +1,9 @@
 """Checkpoints, --resume and signals, through the command line in subprocesses.
 
 A run stopped by SIGTERM half-way and resumed must give what a run that was never stopped gives: the same
-Newton iterations in every step and the same final displacements (1e-10 relative); with friction and a
-rigid path (ironing), the augmented Lagrangian and solid-shells. Checkpoints of another or a changed
+Newton iterations in every step and the same final displacements (1e-10 relative; bit for bit for the
+augmented Lagrangian, solid-shells and two deformable blocks); with friction and a rigid path (ironing), the
+augmented Lagrangian, solid-shells, petsc-gamg and two deformable blocks. Checkpoints of another or a changed
 problem, damaged or missing ones are refused with exit code 2 and one line.
 """
 
@@ -78,6 +79,14 @@ def gamg(tmp: Path) -> Path:
     return path
 
 
+def two_blocks(tmp: Path) -> Path:
+    """Two deformable blocks (mesh-facet master), the serial direct solver: the contact couplings met so far
+    are part of the checkpoint, so the resumed run's matrices have the uninterrupted run's structure."""
+    path = tmp / "two_blocks.toml"
+    path.write_text((EXAMPLES / "contact" / "two_blocks.toml").read_text())
+    return path
+
+
 def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
@@ -117,8 +126,9 @@ def _has_gamg() -> bool:
     return "petsc-gamg" in available()
 
 
-@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg],
-                         ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg"])
+@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, two_blocks],
+                         ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
+                              "two-blocks"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")
@@ -144,6 +154,8 @@ def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
         assert [s["uzawa_iterations"] for s in b["steps"]] == [s["uzawa_iterations"] for s in a["steps"]]
     ua, ub = _final_u(tmp_path / "ref"), _final_u(out)
     assert np.linalg.norm(ub - ua) <= 1e-10 * np.linalg.norm(ua)
+    if make in (augmented, shells, two_blocks):
+        np.testing.assert_array_equal(ub, ua)  # bit for bit
     rows = (out / "convergence.csv").read_text().splitlines()
     ref_rows = (tmp_path / "ref" / "convergence.csv").read_text().splitlines()
     assert [r.split(",")[:2] for r in rows] == [r.split(",")[:2] for r in ref_rows]

@@ -108,6 +108,19 @@ class CouplingPattern:
             ranks = [self.pattern.ranks(conn) for conn, _ in local]
         return self.pattern, [(conn, rk, K) for (conn, K), rk in zip(local, ranks)]
 
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The contact couplings met so far, for a checkpoint: a resumed run rebuilds the same pattern, so its
+        matrices have the structure (structural zeros included) and its factorisations the ordering of the
+        uninterrupted run's, and its results are those bit for bit."""
+        return {f"coupling.{i}": block for i, block in enumerate(self.contact_blocks)}
+
+    def restore(self, arrays: dict[str, np.ndarray]) -> None:
+        """The couplings of :meth:`arrays` (a checkpoint's); the pattern rebuilt with them."""
+        blocks = [np.asarray(arrays[f"coupling.{i}"], dtype=np.int64) for i in range(len(arrays))]
+        if blocks:
+            self.contact_blocks = blocks
+            self.pattern = Pattern(self.n_nodes, self.body_blocks + self.contact_blocks)
+
     @staticmethod
     def scatter(data: np.ndarray, pattern: Pattern, triples: list) -> None:
         for conn, ranks, K in triples:

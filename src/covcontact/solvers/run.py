@@ -267,6 +267,9 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
     if resume:
         u, arrays, meta = checkpoint.load(out, problem_hash, rank, size)
         last_increment = arrays.pop("newton.last_increment", None)
+        couplings = {k: arrays.pop(k) for k in [k for k in arrays if k.startswith("coupling.")]}
+        if getattr(model, "coupling", None) is not None:  # the serial model's contact couplings met so far
+            model.coupling.restore(couplings)
         if last_increment is not None and meta.get("last_step_lams"):
             newton._last = (*(float(v) for v in meta["last_step_lams"]), np.array(last_increment))
         try:
@@ -391,6 +394,9 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                             if newton._last is not None and problem.solver.predictor == "extrapolate":
                                 extra["newton.last_increment"] = newton._last[2]
                                 lams = [newton._last[0], newton._last[1]]
+                            coupling = getattr(model, "coupling", None)
+                            if coupling is not None:
+                                extra.update(coupling.arrays())
                             checkpoint.save(out, u, {**state.arrays(), **extra},
                                             {"problem_hash": problem_hash, "summary": json.loads(
                                                 json.dumps(summary, default=_jsonable)),
