@@ -183,7 +183,7 @@ class PardisoSolver(LinearSolver):
     """MKL PARDISO with the analysis (phase 11) redone only when the pattern changes.
 
     Options: ``spd=True`` uses Cholesky (mtype 2; falls back to -2 if the matrix is not positive
-    definite); ``matching=True`` adds weighted matching and scaling to LDL^T (saddle-point
+    definite); ``matching=True`` adds weighted matching and scaling to LDL^T and LU (saddle-point
     matrices with zero diagonal blocks).
 
     ``precision``: ``"double"``; ``"single"``, the matrix factorised in single precision (PARDISO's
@@ -249,7 +249,12 @@ class PardisoSolver(LinearSolver):
         ip[17] = ip[18] = -1  # report the factors' non-zeros and the factorisation's Mflop (phase 11)
         ip[27] = 1 if self.single else 0  # single precision: the values and right-hand sides as float32
         if self.mtype == 11:
-            ip[9], ip[10], ip[12] = 13, 1, 1  # pivot perturbation 1e-13, scaling, matching
+            # pivot perturbation 1e-13; scaling and weighted matching only when asked for (saddle points): they
+            # make the analysis depend on the values of the matrix analysed, so that a later step's LU would
+            # depend on the step at which the pattern was analysed (a resumed run differed by 1e-14); on
+            # friction tangents they changed neither the time nor the residual (docs/performance.md)
+            ip[9] = 13
+            ip[10] = ip[12] = 1 if self.matching else 0
         else:
             ip[9] = 8  # pivot perturbation 1e-8
             ip[20] = 1  # Bunch-Kaufman 1x1 and 2x2 pivots
@@ -289,6 +294,10 @@ class PardisoSolver(LinearSolver):
         else:
             a = K.data[self._pos]
         return a.astype(np.float32) if self.single else a
+
+    def new_step(self) -> None:
+        if self.matching:  # weighted matching and scaling: the analysis reads the values
+            self._indptr = self._indices = None
 
     def set_precision(self, precision: str) -> None:
         if precision not in ("double", "single", "auto"):

@@ -351,6 +351,11 @@ class LinearSolver:
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name} symmetric={self.symmetric}>"
 
+    def new_step(self) -> None:
+        """A load step (or its retry after a cutback) begins. A backend whose analysis depends on the matrix
+        values, not only on its pattern, analyses again at the step's first factorisation, so that a step's
+        results do not depend on the steps before it (a resumed run repeats the uninterrupted one)."""
+
     def reuse_pays(self) -> bool:
         """Whether the factorisation of the last analysed pattern costs enough forward and backward
         substitutions to be worth reusing as a preconditioner (``reuse_factorization = "auto"``). A backend

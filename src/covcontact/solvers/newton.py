@@ -207,6 +207,7 @@ class Newton:
         out = StepOutcome(converged=False)
         free = m.free
         self._failed = False
+        self.linear.new_step()
         if trial is None:
             trial = m.start_step(committed)
         else:
