@@ -199,7 +199,7 @@ class SolverOptions:
     #: or "extrapolate" (the previous step's increment scaled to this one, then Newton)
     predictor: str = "tangent"
     #: precision of PARDISO's factorisations: "double", "single" (refined to double-precision accuracy by GMRES),
-    #: or "auto" (single from 20,000 unknowns on); the other solvers factorise in double precision
+    #: or "auto" (single where it pays: PardisoSolver's rule); the other solvers factorise in double precision
     factorization_precision: str = "auto"
 
 

@@ -388,10 +388,8 @@ class PardisoSolver(LinearSolver):
         if d is not None and np.isfinite(d).all():
             x = x + d
             nr = float(np.linalg.norm(b - K @ x))
-            if self._K_norm is None:
-                self._K_norm = float(np.linalg.norm(K.data))
             if nr <= SINGLE_REFINE_RTOL * nb or nr <= SINGLE_REFINE_BACKWARD * (
-                    self._K_norm * float(np.linalg.norm(x)) + nb):
+                    self._frobenius() * float(np.linalg.norm(x)) + nb):
                 return x
         # the single-precision factor is too poor for this matrix: double precision from now on
         self.single_given_up = (f"refinement of a single-precision solve stopped at a relative residual "

@@ -461,14 +461,19 @@ class LinearSolver:
         nb = np.linalg.norm(b, axis=0)
         r = np.linalg.norm(self._K @ x - b, axis=0)
         self.residual = float(np.max(np.where(nb > 0, r / np.where(nb > 0, nb, 1.0), r)))
-        if self._K_norm is None:
-            self._K_norm = float(np.linalg.norm(self._K.data))
         nx = np.linalg.norm(x, axis=0)
-        denom = self._K_norm * nx + nb
+        denom = self._frobenius() * nx + nb
         self.backward_error = float(np.max(np.where(denom > 0, r / np.where(denom > 0, denom, 1.0), r)))
         if self.residual > self.check_tol and self.residual <= 1e-2 and self.backward_error <= 1e-11:
             return self.backward_error
         return self.residual
+
+    def _frobenius(self) -> float:
+        """||K||_F of the factorised matrix (cached until the next factorisation), for backward errors."""
+        if self._K_norm is None:
+            assert self._K is not None
+            self._K_norm = float(np.linalg.norm(self._K.data))
+        return self._K_norm
 
     def _diagnosis(self) -> str:
         return ""

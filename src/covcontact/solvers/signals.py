@@ -7,7 +7,7 @@ anywhere else the handler raises :class:`Interrupted` at once, which drops the s
 A distributed run (several MPI ranks) cannot stop one rank at once: the others would wait for it in their
 next collective operation. There the handler only records the signal, and :meth:`StopSignals.poll`, called
 by every rank at the same points of the computation (each Newton iteration, each step's end), agrees on it
-with one reduction and raises :class:`Interrupted` on every rank together. Open MPI's mpiexec kills its ranks
+with one allgather and raises :class:`Interrupted` on every rank together. Open MPI's mpiexec kills its ranks
 moments after passing SIGTERM or SIGINT on, but passes SIGUSR1 and SIGUSR2 on and lets them run: a distributed
 run takes SIGUSR1 as SIGTERM and SIGUSR2 as SIGINT (``covcontact run --ranks`` sends those to mpiexec).
 """
