@@ -324,7 +324,7 @@ def test_pardiso_spd_option_falls_back_on_indefinite(problem, indefinite):
 def test_pardiso_upper_structure():
     """The upper triangle handed to PARDISO: scipy's triu with every missing diagonal entry added as a
     structural zero (position nnz), indices sorted, values found through the positions."""
-    from covcontact.solvers.backends import _upper_structure
+    from covcontact.solvers.pardiso_backend import _upper_structure
 
     rng = np.random.default_rng(5)
     n = 300

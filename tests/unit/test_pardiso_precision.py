@@ -41,7 +41,7 @@ def system():
 
 
 def test_single_factor_refined_to_double_accuracy(system):
-    from covcontact.solvers.backends import SINGLE_REFINE_RTOL
+    from covcontact.solvers.pardiso_backend import SINGLE_REFINE_RTOL
 
     A, b = system
     double = make_solver("pardiso")
@@ -80,16 +80,16 @@ def test_auto_rule(system, monkeypatch):
     """auto: double precision below PARDISO_SINGLE_FROM unknowns; above it single precision where the
     analysis finds a factorisation of at least SINGLE_MIN_FLOP_RATIO substitutions, else analysed again in
     double precision."""
-    from covcontact.solvers import backends
+    from covcontact.solvers import pardiso_backend
 
     A, b = system
     small = elastic_like(10)  # 3,000 unknowns
     s = make_solver("pardiso", precision="auto")
     s.factorize(small)
-    assert small.shape[0] < backends.PARDISO_SINGLE_FROM and not s.single and s.n_single == 0
-    monkeypatch.setattr(backends, "PARDISO_SINGLE_FROM", 1000)
+    assert small.shape[0] < pardiso_backend.PARDISO_SINGLE_FROM and not s.single and s.n_single == 0
+    monkeypatch.setattr(pardiso_backend, "PARDISO_SINGLE_FROM", 1000)
     for min_ratio, single in ((0.0, True), (1e9, False)):
-        monkeypatch.setattr(backends, "SINGLE_MIN_FLOP_RATIO", min_ratio)
+        monkeypatch.setattr(pardiso_backend, "SINGLE_MIN_FLOP_RATIO", min_ratio)
         s = make_solver("pardiso", precision="auto")
         x = s.solve(A, b)
         assert s.single == single and s.n_single == int(single) and s.iparm[27] == int(single)
@@ -114,11 +114,11 @@ def test_single_lu_for_nonsymmetric_matrices(system):
 
 
 def test_falls_back_to_double_when_refinement_fails(system, monkeypatch):
-    from covcontact.solvers import backends
+    from covcontact.solvers import pardiso_backend
 
     A, b = system
-    monkeypatch.setattr(backends, "SINGLE_REFINE_RTOL", 0.0)  # a tolerance refinement cannot meet
-    monkeypatch.setattr(backends, "SINGLE_REFINE_BACKWARD", 0.0)
+    monkeypatch.setattr(pardiso_backend, "SINGLE_REFINE_RTOL", 0.0)  # a tolerance refinement cannot meet
+    monkeypatch.setattr(pardiso_backend, "SINGLE_REFINE_BACKWARD", 0.0)
     s = make_solver("pardiso", precision="single")
     x = s.solve(A, b)
     assert s.single_given_up.startswith("refinement of a single-precision solve stopped")

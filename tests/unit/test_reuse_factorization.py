@@ -71,8 +71,8 @@ def test_auto_reuses_only_expensive_pardiso_factorisations():
     small bulky tangent (3 dofs per node, 8^3 nodes) is not worth reusing, a larger one (14^3) is."""
     import scipy.sparse as sp
 
-    from covcontact.solvers.backends import REUSE_MIN_FLOP_RATIO
     from covcontact.solvers.linear import make_solver
+    from covcontact.solvers.pardiso_backend import REUSE_MIN_FLOP_RATIO
 
     def elastic_like(m):
         T = sp.diags([-np.ones(m - 1), 2 * np.ones(m), -np.ones(m - 1)], [-1, 0, 1])

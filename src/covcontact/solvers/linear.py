@@ -19,8 +19,9 @@ Every solver keeps its symbolic analysis while the sparsity pattern (indptr, ind
 records the time of its last analysis, factorisation and solve, checks the residual of each solve
 and raises ``SingularMatrixError`` for a singular matrix or a non-finite solution.
 
-The backend classes live in :mod:`covcontact.solvers.backends` (imported on first use, and re-exported
-here: ``from covcontact.solvers.linear import PardisoSolver`` works). A new backend is a
+The backend classes live in :mod:`covcontact.solvers.backends` and, for PARDISO and PETSc, in
+:mod:`covcontact.solvers.pardiso_backend` and :mod:`covcontact.solvers.petsc_backend` (imported on first use,
+and re-exported here: ``from covcontact.solvers.linear import PardisoSolver`` works). A new backend is a
 :class:`LinearSolver` subclass with a static ``probe()`` in its own module of this package, registered by
 one :data:`REGISTRY` entry, e.g. ``"petsc": Backend("petsc_backend", "PetscSolver", auto=False)``.
 """
@@ -36,8 +37,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import scipy.sparse as sp
 
-if TYPE_CHECKING:  # re-exported lazily by __getattr__ (backends imports this module)
-    from .backends import AMGSolver, CholmodSolver, MumpsSolver, PardisoSolver, SuperLUSolver  # noqa: F401
+if TYPE_CHECKING:  # re-exported lazily by __getattr__ (the backend modules import this module)
+    from .backends import AMGSolver, CholmodSolver, MumpsSolver, SuperLUSolver  # noqa: F401
+    from .pardiso_backend import PardisoSolver  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,7 @@ class Backend:
 
 #: all backends, in order of preference; a new backend is one more entry
 REGISTRY: dict[str, Backend] = {
-    "pardiso": Backend("backends", "PardisoSolver"),
+    "pardiso": Backend("pardiso_backend", "PardisoSolver"),
     "cholmod": Backend("backends", "CholmodSolver", symmetric_only=True),
     "mumps": Backend("backends", "MumpsSolver"),
     "superlu": Backend("backends", "SuperLUSolver"),
@@ -70,16 +72,15 @@ REGISTRY: dict[str, Backend] = {
 }
 BACKENDS = tuple(REGISTRY)
 _DIRECT = tuple(name for name, b in REGISTRY.items() if b.auto)
-#: names re-exported from the backend module
-_REEXPORT = ("AMGSolver", "CholmodSolver", "MumpsSolver", "PardisoSolver", "SuperLUSolver", "_PARDISO_ERRORS",
-             "_pardiso_function", "_upper_structure")
+#: names re-exported from the backend modules, and their module
+_REEXPORT = {**dict.fromkeys(("AMGSolver", "CholmodSolver", "MumpsSolver", "SuperLUSolver"), "backends"),
+             **dict.fromkeys(("PardisoSolver", "_PARDISO_ERRORS", "_pardiso_function", "_upper_structure"),
+                             "pardiso_backend")}
 
 
 def __getattr__(name: str) -> Any:
     if name in _REEXPORT:
-        from . import backends
-
-        return getattr(backends, name)
+        return getattr(importlib.import_module(f".{_REEXPORT[name]}", __package__), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
