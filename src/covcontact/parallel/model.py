@@ -90,9 +90,15 @@ class DistMatrix:
         self.eliminated = True
         return self
 
-    def body_values(self) -> np.ndarray:
-        """Values of the entries of ``structure.rows/cols``."""
-        return self.body.data[self.structure.keep]
+    def body_values(self, out: np.ndarray | None = None) -> np.ndarray:
+        """Values of the entries of ``structure.rows/cols`` (into ``out`` if given)."""
+        data, keep = self.body.data, self.structure.keep
+        out = np.empty(keep.size) if out is None else out
+        if keep.size == data.size:  # every entry (one rank): keep is 0, 1, ...
+            np.copyto(out, data)
+        else:
+            np.take(data, keep, out=out)
+        return out
 
     def contact_triplets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """PETSc rows, columns and values of the contact share (may repeat entries)."""

@@ -185,8 +185,10 @@ def _make_model(problem, tangent: str | None, linear: str) -> Model:
     """The serial Model, or the distributed one for a backend that distributes (``petsc*``)."""
     check_distributable(problem, linear, ranks_from_env())
     if _distributes(linear):
+        from ..allocator import keep_freed_memory
         from ..parallel.model import DistributedModel
 
+        keep_freed_memory()  # PETSc's matrices and hierarchies of each iteration reuse memory (allocator.py)
         return DistributedModel(problem, tangent=tangent)
     return Model(problem, tangent=tangent)
 
