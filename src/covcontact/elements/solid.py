@@ -19,7 +19,7 @@ from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
 from ..materials.update import material_update
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
-from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, f_times_d, gather, inverse3
+from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather, inverse3
 
 __all__ = ["BLOCKS_PER_THREAD", "SOLID_CELLS", "SolidBody", "SolidStress", "solid_chunk", "solid_gauss_fields"]
 
@@ -54,10 +54,64 @@ def _kinematics(dNg, Ji, ue, G, F):
             F[i, j] = s
 
 
+@njit(cache=True, inline="always")
+def _gradients_t(dNg, Ji, ue, Gt, F):
+    """Gt = (dN/dX)^T (3, nen), node index last (the tangent loops run over nodes in SIMD lanes), and
+    F = I + sum_a u_a (x) G_a."""
+    nen = ue.shape[0]
+    for j in range(3):
+        j0 = Ji[0, j]
+        j1 = Ji[1, j]
+        j2 = Ji[2, j]
+        for a in range(nen):
+            Gt[j, a] = dNg[a, 0] * j0 + dNg[a, 1] * j1 + dNg[a, 2] * j2
+    for i in range(3):
+        for j in range(3):
+            s = 1.0 if i == j else 0.0
+            for a in range(nen):
+                s += ue[a, i] * Gt[j, a]
+            F[i, j] = s
+
+
+@njit(cache=True, inline="always")
+def _first_elasticity(F, S, D, wd, T, A):
+    """The first elasticity tensor times the weight, A[l, k, 3 j + n] = wd A_kjln (A_kjln = sum_im F_ki C_ijmn
+    F_lm + delta_kl S_jn) from the material's S and D (Voigt). Scratch T (3, 3, 9): first C[m, i, 3 j + n] =
+    C_ijmn, then T[m, k, 3 j + n] = sum_i F_ki C_ijmn; the 9-long last axes are contiguous (SIMD lanes)."""
+    C = A  # A's storage holds C until T is formed
+    for m in range(3):
+        for i in range(3):
+            for j in range(3):
+                for n in range(3):
+                    C[m, i, 3 * j + n] = D[VOIGT[i, j], VOIGT[m, n]]
+    for m in range(3):
+        for k in range(3):
+            f0 = F[k, 0]
+            f1 = F[k, 1]
+            f2 = F[k, 2]
+            for jn in range(9):
+                T[m, k, jn] = f0 * C[m, 0, jn] + f1 * C[m, 1, jn] + f2 * C[m, 2, jn]
+    for l in range(3):
+        f0 = F[l, 0]
+        f1 = F[l, 1]
+        f2 = F[l, 2]
+        for k in range(3):
+            for jn in range(9):
+                A[l, k, jn] = wd * (f0 * T[0, k, jn] + f1 * T[1, k, jn] + f2 * T[2, k, jn])
+        for j in range(3):
+            for n in range(3):
+                A[l, l, 3 * j + n] += wd * S[VOIGT[j, n]]
+
+
 @njit(cache=True)
-def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D, P, T, A, Q, hist_n, hist):
+def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, Gt, F, S, D, P, T, A, Q, Kt, hist_n, hist):
     """Internal force fe (3 nen,) and tangent Ke (3 nen, 3 nen) of one element (overwritten); the material
     history of its Gauss points: hist_n (ngp, nh) committed (read), hist (ngp, nh) trial (written).
+
+    The tangent is summed over the Gauss points as Kt[a, k, l, b] with the node b last, so that the
+    innermost loops (over the nodes a of Q, over b of Kt) are contiguous and run in SIMD lanes; Ke gets
+    Kt's blocks b >= a and their mirror images (exactly symmetric).
+    Scratch: Gt (3, nen), Q (3, 3, 3, nen), Kt (nen, 3, 3, nen).
 
     Returns 0, 1 if det F <= 0 at a Gauss point, 2 if det J0 <= 0 (that point is skipped).
     """
@@ -66,9 +120,11 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D,
     for r in range(nd):
         fe[r] = 0.0
     if want_K:
-        for r in range(nd):
-            for s in range(nd):
-                Ke[r, s] = 0.0
+        for a in range(nen):
+            for k in range(3):
+                for l in range(3):
+                    for b in range(nen):
+                        Kt[a, k, l, b] = 0.0
     flag = 0
     for g in range(w.size):
         dNg = dNdxi[g]
@@ -76,7 +132,7 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D,
         if det <= 0.0:
             flag = 2
             continue
-        _kinematics(dNg, Ji, ue, G, F)
+        _gradients_t(dNg, Ji, ue, Gt, F)
         if material_update(kind, params, F, hist_n[g], hist[g], S, D) != 0 and flag == 0:
             flag = 1
         wd = w[g] * det
@@ -86,38 +142,36 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, G, F, S, D,
                 P[k, j] = wd * (F[k, 0] * S[VOIGT[0, j]] + F[k, 1] * S[VOIGT[1, j]] + F[k, 2] * S[VOIGT[2, j]])
         for a in range(nen):
             for k in range(3):
-                fe[3 * a + k] += P[k, 0] * G[a, 0] + P[k, 1] * G[a, 1] + P[k, 2] * G[a, 2]
+                fe[3 * a + k] += P[k, 0] * Gt[0, a] + P[k, 1] * Gt[1, a] + P[k, 2] * Gt[2, a]
         if not want_K:
             continue
-        f_times_d(F, D, T)  # T[k, j, m, n] = sum_i F_ki C_ijmn
-        # A[k, j, l, n] = wd (sum_m T_kjmn F_lm + delta_kl S_jn)
+        _first_elasticity(F, S, D, wd, T, A)
+        # Q[k, l, n, a] = sum_j G_aj A_kjln
         for k in range(3):
-            for j in range(3):
-                for l in range(3):
-                    for n in range(3):
-                        v = T[k, j, 0, n] * F[l, 0] + T[k, j, 1, n] * F[l, 1] + T[k, j, 2, n] * F[l, 2]
-                        if k == l:
-                            v += S[VOIGT[j, n]]
-                        A[k, j, l, n] = wd * v
+            for l in range(3):
+                for n in range(3):
+                    a0 = A[l, k, n]
+                    a1 = A[l, k, 3 + n]
+                    a2 = A[l, k, 6 + n]
+                    for a in range(nen):
+                        Q[k, l, n, a] = a0 * Gt[0, a] + a1 * Gt[1, a] + a2 * Gt[2, a]
+        # Kt[a, k, l, b] += sum_n Q[k, l, n, a] G_bn
         for a in range(nen):
-            # Q[k, l, n] = sum_j G_aj A_kjln
             for k in range(3):
                 for l in range(3):
-                    for n in range(3):
-                        Q[k, l, n] = G[a, 0] * A[k, 0, l, n] + G[a, 1] * A[k, 1, l, n] + G[a, 2] * A[k, 2, l, n]
-            for b in range(a, nen):
-                g0 = G[b, 0]
-                g1 = G[b, 1]
-                g2 = G[b, 2]
-                for k in range(3):
-                    for l in range(3):
-                        Ke[3 * a + k, 3 * b + l] += Q[k, l, 0] * g0 + Q[k, l, 1] * g1 + Q[k, l, 2] * g2
+                    q0 = Q[k, l, 0, a]
+                    q1 = Q[k, l, 1, a]
+                    q2 = Q[k, l, 2, a]
+                    for b in range(nen):
+                        Kt[a, k, l, b] += q0 * Gt[0, b] + q1 * Gt[1, b] + q2 * Gt[2, b]
     if want_K:
         for a in range(nen):
-            for b in range(a + 1, nen):
+            for b in range(a, nen):
                 for k in range(3):
                     for l in range(3):
-                        Ke[3 * b + l, 3 * a + k] = Ke[3 * a + k, 3 * b + l]
+                        v = Kt[a, k, l, b]
+                        Ke[3 * a + k, 3 * b + l] = v
+                        Ke[3 * b + l, 3 * a + k] = v
     return flag
 
 
@@ -140,17 +194,19 @@ def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, n
     nblk = max(1, min(nblocks, nc))
     for t in prange(nblk):
         lo, hi = block_range(t, nc, nblk)
-        Xe, ue, G, J0, Ji, F, S, D = _work(nen)
+        Xe, ue, _, J0, Ji, F, S, D = _work(nen)
+        Gt = np.empty((3, nen))
         P = np.empty((3, 3))
-        T = np.empty((3, 3, 3, 3))
-        A = np.empty((3, 3, 3, 3))
-        Q = np.empty((3, 3, 3))
+        T = np.empty((3, 3, 9))
+        A = np.empty((3, 3, 9))
+        Q = np.empty((3, 3, 3, nen))
+        Kt = np.empty((nen, 3, 3, nen))
         Kdummy = np.empty((0, 0))
         for c in range(lo, hi):
             gather(X, u, conn, e0 + c, Xe, ue)
             Kc = Ke[c] if want_K else Kdummy
-            flags[c] = _element(kind, params, Xe, ue, dNdxi, w, want_K, Kc, fe[c], J0, Ji, G, F, S, D, P,
-                                T, A, Q, hist_n[e0 + c], hist[e0 + c])
+            flags[c] = _element(kind, params, Xe, ue, dNdxi, w, want_K, Kc, fe[c], J0, Ji, Gt, F, S, D, P,
+                                T, A, Q, Kt, hist_n[e0 + c], hist[e0 + c])
 
 
 @njit(parallel=True, cache=True)
