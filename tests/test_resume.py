@@ -1,9 +1,10 @@
 """Checkpoints, --resume and signals, through the command line in subprocesses.
 
 A run stopped by SIGTERM half-way and resumed must give what a run that was never stopped gives: the same
-Newton iterations in every step and the same final displacements (bit for bit; 1e-10 relative with petsc-gamg);
-with friction and a rigid path (ironing), the augmented Lagrangian, solid-shells, petsc-gamg and two deformable
-blocks. Checkpoints of another or a changed
+Newton iterations in every step and the same final displacements (bit for bit; 1e-10 relative with petsc-gamg,
+whose set-up is not reproducible to the last bit from one run to the next);
+with friction and a rigid path (ironing), the augmented Lagrangian, solid-shells, petsc-gamg, PETSc's MUMPS (the
+distributed model on one process) and two deformable blocks. Checkpoints of another or a changed
 problem, damaged or missing ones are refused with exit code 2 and one line.
 """
 
@@ -79,6 +80,14 @@ def gamg(tmp: Path) -> Path:
     return path
 
 
+def mumps(tmp: Path) -> Path:
+    """Two deformable blocks with PETSc's MUMPS: the distributed model on one process, whose matrix keeps the
+    contact entries met so far; the checkpoint keeps them, so the resumed run factorises the same structure."""
+    path = tmp / "mumps.toml"
+    path.write_text((EXAMPLES / "contact" / "two_blocks.toml").read_text() + '\n[solver]\nlinear = "petsc"\n')
+    return path
+
+
 def two_blocks(tmp: Path) -> Path:
     """Two deformable blocks (mesh-facet master), the serial direct solver: the contact couplings met so far
     are part of the checkpoint, so the resumed run's matrices have the uninterrupted run's structure."""
@@ -126,11 +135,11 @@ def _has_gamg() -> bool:
     return "petsc-gamg" in available()
 
 
-@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, two_blocks],
+@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "two-blocks"])
+                              "petsc-mumps", "two-blocks"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
-    if make is gamg and not _has_gamg():
+    if make in (gamg, mumps) and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")
     problem = make(tmp_path)
     ref = _run(problem, tmp_path / "ref")
@@ -153,8 +162,9 @@ def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if "uzawa_iterations" in a["steps"][0]:
         assert [s["uzawa_iterations"] for s in b["steps"]] == [s["uzawa_iterations"] for s in a["steps"]]
     ua, ub = _final_u(tmp_path / "ref"), _final_u(out)
-    assert np.linalg.norm(ub - ua) <= 1e-10 * np.linalg.norm(ua)
-    if make is not gamg:
+    if make is gamg:  # GAMG's set-up itself differs from run to run in the last bits (docs/theory.md section 10)
+        assert np.linalg.norm(ub - ua) <= 1e-10 * np.linalg.norm(ua)
+    else:
         np.testing.assert_array_equal(ub, ua)  # bit for bit
     rows = (out / "convergence.csv").read_text().splitlines()
     ref_rows = (tmp_path / "ref" / "convergence.csv").read_text().splitlines()

@@ -164,7 +164,7 @@ def _processes_with(text: str) -> list[str]:
 def test_ranks_stopped_by_sigterm(tmp_path):
     """SIGTERM to ``covcontact run --ranks 2``: the ranks stop together at their next Newton iteration, as a serial
     run does: exit code 143, summary "interrupted" with the converged steps, no process left; ``--resume`` then
-    ends as the uninterrupted run (the same iterations, the displacements to the last bit of the checkpoint)."""
+    ends as the uninterrupted run (the same iterations, the displacements to 1e-12)."""
     path = ROOT / "benchmarks" / "problems" / "two_blocks_30k.toml"
     out = tmp_path / "stopped"
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(path), "--ranks", "2", "--out", str(out)]
@@ -195,6 +195,7 @@ def test_ranks_stopped_by_sigterm(tmp_path):
     assert a["status"] == b["status"] == "completed" and _iterations(a) == _iterations(b)
     for rank in (0, 1):
         ua, ub = (np.load(d / f"checkpoint.rank{rank}-of-2.npz")["u"] for d in (out, tmp_path / "ref"))
+        # not bit for bit: MUMPS on two ranks differs from run to run by about 3e-17 (uninterrupted runs too)
         assert np.abs(ua - ub).max() <= 1e-12 * np.abs(ub).max()
 
 

@@ -357,6 +357,15 @@ class LinearSolver:
         values, not only on its pattern, analyses again at the step's first factorisation, so that a step's
         results do not depend on the steps before it (a resumed run repeats the uninterrupted one)."""
 
+    def history(self) -> dict[str, np.ndarray]:
+        """What a checkpoint keeps of this solver (keys ``linear.*``): the part of the sparsity pattern that
+        depends on the steps before, so that a resumed run analyses the uninterrupted run's pattern. None
+        for the serial backends (the serial model keeps its contact couplings itself)."""
+        return {}
+
+    def restore_history(self, arrays: dict[str, np.ndarray]) -> None:
+        """The ``history`` of a checkpoint, for the factorisations to come."""
+
     def reuse_pays(self) -> bool:
         """Whether the factorisation of the last analysed pattern costs enough forward and backward
         substitutions to be worth reusing as a preconditioner (``reuse_factorization = "auto"``). A backend

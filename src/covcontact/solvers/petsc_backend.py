@@ -154,6 +154,7 @@ class PetscSolver(LinearSolver):
         self._structure = None
         self._ckey: np.ndarray | None = None
         self._values: np.ndarray | None = None  # the COO values of a distributed matrix (_dist_values)
+        self._restored: np.ndarray | None = None  # contact keys from a checkpoint, for the next factorize
         self.iterations = 0  # Krylov iterations of the last solve
         self.krylov_iterations = 0  # and of all solves
         self.ranks = 1
@@ -267,13 +268,15 @@ class PetscSolver(LinearSolver):
         self.t_analyze = 0.0
         st, lay = K.structure, K.layout
         n = lay.n_dofs
+        if self._restored is not None:  # a resumed run: the contact entries of the uninterrupted run's matrix
+            self._structure, self._ckey, self._restored = st, self._restored, None
         same, ukey, inv, cv = self._dist_pattern(K)
         comm = K.comm
         if not same:
             ckey = ukey
             if self._structure is st and self._ckey is not None:
                 union = np.union1d(self._ckey, ukey)
-                if union.size <= 2 * ukey.size + 1000:
+                if union.size <= 2 * ukey.size + 1000 or union.size == self._ckey.size:
                     ckey = union
             self._release()
             rows = np.concatenate([st.rows, st.diag, ckey // n])
@@ -290,6 +293,15 @@ class PetscSolver(LinearSolver):
         self._factor_op()
         self.n_factorizations += 1
         self.t_factor = time.perf_counter() - t0
+
+    def history(self) -> dict[str, np.ndarray]:
+        """The contact entries of the distributed matrix's structure (this rank's keys, row n + column): they
+        grow with the contacts met, entries of lost contacts staying as zeros."""
+        return {} if self._ckey is None or self._dist is None else {"linear.contact_keys": self._ckey.copy()}
+
+    def restore_history(self, arrays: dict[str, np.ndarray]) -> None:
+        keys = arrays.get("linear.contact_keys")
+        self._restored = None if keys is None else np.asarray(keys, dtype=np.int64)
 
     def _dist_pattern(self, K) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:
         """Whether the DistMatrix K fits the current matrix's structure (on every rank), and its unique

@@ -272,6 +272,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
         couplings = {k: arrays.pop(k) for k in [k for k in arrays if k.startswith("coupling.")]}
         if getattr(model, "coupling", None) is not None:  # the serial model's contact couplings met so far
             model.coupling.restore(couplings)
+        newton.linear.restore_history({k: arrays.pop(k) for k in [k for k in arrays if k.startswith("linear.")]})
         if last_increment is not None and meta.get("last_step_lams"):
             newton._last = (*(float(v) for v in meta["last_step_lams"]), np.array(last_increment))
         try:
@@ -399,6 +400,7 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                             coupling = getattr(model, "coupling", None)
                             if coupling is not None:
                                 extra.update(coupling.arrays())
+                            extra.update(newton.linear.history())  # the distributed matrix's contact entries
                             checkpoint.save(out, u, {**state.arrays(), **extra},
                                             {"problem_hash": problem_hash, "summary": json.loads(
                                                 json.dumps(summary, default=_jsonable)),
