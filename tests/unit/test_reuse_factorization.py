@@ -36,7 +36,9 @@ def test_same_iterations_and_results_with_fewer_factorizations(tmp_path, example
     n_reuse = sum(s["factorizations"] for s in reuse["steps"])
     assert n_reuse < n_plain and sum(s["krylov_iterations"] for s in reuse["steps"]) > 0
     for a, b in zip(plain["steps"], reuse["steps"], strict=True):
-        np.testing.assert_allclose(b["contact_force"], a["contact_force"], rtol=1e-6, atol=1e-9)
+        # components that vanish (sliding's lateral one) are zero to Newton's tolerance, relative to the force
+        np.testing.assert_allclose(b["contact_force"], a["contact_force"], rtol=1e-6,
+                                   atol=1e-9 * np.linalg.norm(a["contact_force"]))
         assert b["residual_norms"][-1] <= 1e-8 or b["residual_norms"][-1] <= 10 * a["residual_norms"][-1]
 
 
