@@ -40,37 +40,37 @@ def _jacobian(Xe, dNg, J0, Ji):
 
 
 @njit(cache=True, inline="always")
-def _kinematics(dNg, Ji, ue, G, F):
-    """G = dN/dX (nen, 3) and F = I + sum_a u_a (x) G_a."""
-    nen = ue.shape[0]
-    for a in range(nen):
-        for j in range(3):
-            G[a, j] = dNg[a, 0] * Ji[0, j] + dNg[a, 1] * Ji[1, j] + dNg[a, 2] * Ji[2, j]
+def _deformation_gradient(ue, G, F, node_last):
+    """F = I + sum_a u_a (x) G_a from G[a, j] = dN_a/dX_j, or from G[j, a] if node_last (a constant at each call
+    site: the branch folds away once inlined)."""
     for i in range(3):
         for j in range(3):
             s = 1.0 if i == j else 0.0
-            for a in range(nen):
-                s += ue[a, i] * G[a, j]
+            for a in range(ue.shape[0]):
+                s += ue[a, i] * (G[j, a] if node_last else G[a, j])
             F[i, j] = s
+
+
+@njit(cache=True, inline="always")
+def _kinematics(dNg, Ji, ue, G, F):
+    """G = dN/dX (nen, 3) and F = I + sum_a u_a (x) G_a."""
+    for a in range(ue.shape[0]):
+        for j in range(3):
+            G[a, j] = dNg[a, 0] * Ji[0, j] + dNg[a, 1] * Ji[1, j] + dNg[a, 2] * Ji[2, j]
+    _deformation_gradient(ue, G, F, False)
 
 
 @njit(cache=True, inline="always")
 def _gradients_t(dNg, Ji, ue, Gt, F):
     """Gt = (dN/dX)^T (3, nen), node index last (the tangent loops run over nodes in SIMD lanes), and
     F = I + sum_a u_a (x) G_a."""
-    nen = ue.shape[0]
     for j in range(3):
         j0 = Ji[0, j]
         j1 = Ji[1, j]
         j2 = Ji[2, j]
-        for a in range(nen):
+        for a in range(ue.shape[0]):
             Gt[j, a] = dNg[a, 0] * j0 + dNg[a, 1] * j1 + dNg[a, 2] * j2
-    for i in range(3):
-        for j in range(3):
-            s = 1.0 if i == j else 0.0
-            for a in range(nen):
-                s += ue[a, i] * Gt[j, a]
-            F[i, j] = s
+    _deformation_gradient(ue, Gt, F, True)
 
 
 @njit(cache=True, inline="always")
