@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from ..assembly.pattern import Pattern
 from ..assembly.system import BodyBlock, InvertedElementError, System
@@ -37,17 +38,50 @@ class Structure:
     """
 
     def __init__(self, pattern: Pattern, touched: np.ndarray, constrained: np.ndarray, layout: DofLayout):
-        rows = np.repeat(np.arange(pattern.n_dofs), np.diff(pattern.indptr))
-        cols = pattern.indices.astype(np.int64)
-        self.keep = np.flatnonzero(touched[rows // 3])
-        r, c = rows[self.keep], cols[self.keep]
-        self.bc = constrained[r] | constrained[c]
-        self.bc_data = self.keep[self.bc]  # pattern data positions zeroed by the elimination
-        self.rows = layout.to_petsc[r]
-        self.cols = layout.to_petsc[c]
+        # one compiled pass (1.3 s of whole-array numpy at 2e5 dofs before)
+        self.keep, self.bc, self.bc_data, self.rows, self.cols = _structure_entries(
+            pattern.indptr, pattern.indices, touched, constrained, layout.to_petsc)
         owned = layout.owned
         self.diag = layout.to_petsc[owned[constrained[owned]]]
         self.layout = layout
+
+
+@njit(cache=True)
+def _structure_entries(indptr, indices, touched, constrained, to_petsc):
+    """The pattern's entries in rows of touched nodes: their data positions, whether they lie in a constrained
+    row or column, the positions of those, and their PETSc rows and columns (Structure's arrays)."""
+    n = indptr.size - 1
+    m = 0
+    for i in range(n):
+        if touched[i // 3]:
+            m += indptr[i + 1] - indptr[i]
+    keep = np.empty(m, np.int64)
+    bc = np.empty(m, np.bool_)
+    rows = np.empty(m, to_petsc.dtype)
+    cols = np.empty(m, to_petsc.dtype)
+    k = 0
+    nbc = 0
+    for i in range(n):
+        if not touched[i // 3]:
+            continue
+        ci = constrained[i]
+        pi = to_petsc[i]
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            keep[k] = p
+            rows[k] = pi
+            cols[k] = to_petsc[j]
+            b = ci or constrained[j]
+            bc[k] = b
+            nbc += b
+            k += 1
+    bc_data = np.empty(nbc, np.int64)  # pattern data positions zeroed by the elimination
+    q = 0
+    for k in range(m):
+        if bc[k]:
+            bc_data[q] = keep[k]
+            q += 1
+    return keep, bc, bc_data, rows, cols
 
 
 class DistMatrix:
