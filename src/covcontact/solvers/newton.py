@@ -222,7 +222,7 @@ class Newton:
             du_d = np.zeros_like(du_d)
         R, K, trial = self._evaluate(u, lam_b, committed, trial)
         t0 = time.perf_counter()
-        rhs = -R - K @ du_d
+        rhs = -R - K @ du_d if np.any(du_d) else -R  # (no product with a zero increment: 0.2 s at 1e6 dofs)
         rhs[~free] = 0.0
         K = m.eliminate(K)
         self.timing["bc"] += time.perf_counter() - t0
