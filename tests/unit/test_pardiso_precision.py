@@ -206,6 +206,34 @@ def test_threaded_lu_is_reproducible():
     assert all(np.array_equal(x, xs[0]) for x in xs[1:])
 
 
+def test_reproducible_mode_in_the_input_and_the_solver(tmp_path):
+    """[solver] reproducible (default true) reaches PARDISO through Newton: false leaves MKL's reproducible mode off
+    (iparm[33] = 0) on a threaded matrix, the default sets it; the solve is right either way; a non-boolean is an
+    input error naming the key."""
+    text = (ROOT / "examples" / "contact" / "two_blocks.toml").read_text()
+    path = tmp_path / "p.toml"
+    assert load_problem(ROOT / "examples" / "contact" / "two_blocks.toml").solver.reproducible is True
+    path.write_text(text + '\n[solver]\nreproducible = false\n')
+    problem = load_problem(path)
+    assert problem.solver.reproducible is False
+    path.write_text(text + '\n[solver]\nreproducible = "no"\n')
+    with pytest.raises(InputError, match=r"solver\.reproducible"):
+        load_problem(path)
+
+    from covcontact.solvers.model import Model
+    from covcontact.solvers.newton import Newton
+
+    A = elastic_like(16)  # 12,288 unknowns: threaded (PARDISO_SERIAL_BELOW)
+    b = A @ np.random.default_rng(3).standard_normal(A.shape[0])
+    for flag in (True, False):
+        options = dataclasses.replace(problem.solver, reproducible=flag, linear="pardiso")
+        s = Newton(Model(problem), options).linear
+        x = s.solve(A, b)
+        assert (s.iparm[33] >= 1) == flag
+        assert _relres(A, x, b) < 1e-10
+        s.close()
+
+
 def test_single_with_another_solver_is_a_warning(tmp_path):
     """linear = "auto" may resolve to a solver without single precision: the run says so and goes on."""
     problem = load_problem(ROOT / "examples" / "contact" / "two_blocks.toml")

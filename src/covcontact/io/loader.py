@@ -517,6 +517,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             predictor=s.get("predictor", "str", solver.predictor, choices=("tangent", "extrapolate")),
             factorization_precision=s.get("factorization_precision", "str", solver.factorization_precision,
                                           choices=("auto", "double", "single")),
+            reproducible=s.get("reproducible", "bool", solver.reproducible),
         )
         if solver.factorization_precision == "single" and solver.linear.lower().strip() not in ("auto", "pardiso"):
             s.fail(f'"single" is PARDISO\'s; linear = {solver.linear!r} factorises in double precision '

@@ -357,6 +357,10 @@ class LinearSolver:
         values, not only on its pattern, analyses again at the step's first factorisation, so that a step's
         results do not depend on the steps before it (a resumed run repeats the uninterrupted one)."""
 
+    #: whether threaded factorisations must give the same bits on every run (``[solver] reproducible``; only
+    #: PARDISO has a faster mode that does not)
+    reproducible = True
+
     def history(self) -> dict[str, np.ndarray]:
         """What a checkpoint keeps of this solver (keys ``linear.*``): the part of the sparsity pattern that
         depends on the steps before, so that a resumed run analyses the uninterrupted run's pattern. None

@@ -87,6 +87,7 @@ class Newton:
         self.opt = options
         self.linear = make_solver(linear or options.linear, symmetric=model.symmetric)
         self.linear.set_precision(options.factorization_precision)
+        self.linear.reproducible = options.reproducible
         self.linear.set_near_null_space(model.near_null_space())  # rigid-body modes (AMG only)
         self.scale_seen = 0.0  # the largest force scale of the converged steps so far
         self.timing = {"assembly": 0.0, "contact": 0.0, "bc": 0.0, "factor": 0.0, "solve": 0.0, "krylov": 0.0}

@@ -229,6 +229,8 @@ class PardisoSolver(LinearSolver):
         # fixed order (without it, LU on two threads differed by 1e-15 between runs, enough to change a
         # frictional run's iterations; the same time, docs/performance.md)
         ip[33] = 1 if self._n < PARDISO_SERIAL_BELOW else max(_mkl_max_threads(), 1)
+        if not self.reproducible:  # [solver] reproducible = false: the faster substitutions, bits may vary
+            ip[33] = 0
         ip[17] = ip[18] = -1  # report the factors' non-zeros and the factorisation's Mflop (phase 11)
         ip[27] = 1 if self.single else 0  # single precision: the values and right-hand sides as float32
         if self.mtype == 11:
