@@ -27,34 +27,34 @@ class InvertedElementError(RuntimeError):
         self.element = element
 
 
+@njit(cache=True, inline="always")
+def _constrained_pass(indptr, indices, constrained, zero, one):
+    """Count (zero and one empty) or list the entries of _constrained_entries; returns the two counts."""
+    fill = zero.size > 0
+    nz = 0
+    no = 0
+    for i in range(indptr.size - 1):
+        ci = constrained[i]
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if ci or constrained[j]:
+                if fill:
+                    zero[nz] = p
+                    if i == j:
+                        one[no] = p
+                nz += 1
+                no += i == j
+    return nz, no
+
+
 @njit(cache=True)
 def _constrained_entries(indptr, indices, constrained):
     """Data positions of the CSR entries in a constrained row or column, and of the diagonal ones among them
-    (one compiled pass: the whole-array version made 1e6-dof temporaries, about 1 s a pattern)."""
-    n = indptr.size - 1
-    nz = 0
-    no = 0
-    for i in range(n):
-        ci = constrained[i]
-        for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
-            if ci or constrained[j]:
-                nz += 1
-                no += i == j
+    (compiled, counted then listed: the whole-array version made 1e6-dof temporaries, about 1 s a pattern)."""
+    nz, no = _constrained_pass(indptr, indices, constrained, np.empty(0, np.int64), np.empty(0, np.int64))
     zero = np.empty(nz, np.int64)
     one = np.empty(no, np.int64)
-    a = 0
-    b = 0
-    for i in range(n):
-        ci = constrained[i]
-        for p in range(indptr[i], indptr[i + 1]):
-            j = indices[p]
-            if ci or constrained[j]:
-                zero[a] = p
-                a += 1
-                if i == j:
-                    one[b] = p
-                    b += 1
+    _constrained_pass(indptr, indices, constrained, zero, one)
     return zero, one
 
 
