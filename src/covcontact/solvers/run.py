@@ -193,6 +193,11 @@ def _make_model(problem, tangent: str | None, linear: str) -> Model:
     return Model(problem, tangent=tangent)
 
 
+def _pop_prefixed(arrays: dict[str, np.ndarray], prefix: str) -> dict[str, np.ndarray]:
+    """The checkpoint arrays whose keys start with ``prefix``, taken out of ``arrays``."""
+    return {k: arrays.pop(k) for k in [k for k in arrays if k.startswith(prefix)]}
+
+
 def _tangent_name(problem, tangent: str | None) -> str:
     """The tangent case of the run: the override, else the pairs' common case (or "per-pair")."""
     if tangent:
@@ -269,10 +274,10 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
     if resume:
         u, arrays, meta = checkpoint.load(out, problem_hash, rank, size)
         last_increment = arrays.pop("newton.last_increment", None)
-        couplings = {k: arrays.pop(k) for k in [k for k in arrays if k.startswith("coupling.")]}
+        couplings = _pop_prefixed(arrays, "coupling.")
         if getattr(model, "coupling", None) is not None:  # the serial model's contact couplings met so far
             model.coupling.restore(couplings)
-        newton.linear.restore_history({k: arrays.pop(k) for k in [k for k in arrays if k.startswith("linear.")]})
+        newton.linear.restore_history(_pop_prefixed(arrays, "linear."))
         if last_increment is not None and meta.get("last_step_lams"):
             newton._last = (*(float(v) for v in meta["last_step_lams"]), np.array(last_increment))
         try:
