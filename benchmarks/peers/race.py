@@ -20,14 +20,15 @@ mortar penalty condition (kratos_deck.nodal_penalties) and to CalculiX as the sl
 pressure-overclosure law. Default k: 2.5e5 for two_blocks (Kratos's active set does not settle with the problem
 file's 1e6; see peers/README.md), 1e4 for hertz.
 
-Each run is a whole process, start to exit (covcontact: ``python -m covcontact run FILE`` for two_blocks, a child
-process that builds the mesh and calls ``Problem.run`` for hertz, whose mesh has no TOML generator; Kratos:
+Each run is a whole process, start to exit (covcontact: ``python -m covcontact run FILE``; for hertz the file reads
+the graded ball from an Abaqus mesh file the race writes, as no TOML generator grades it; Kratos:
 kratos_run.py under Kratos's Python; CalculiX: ``ccx -i job``). The codes alternate, ``--repeats`` runs each,
 the median wall time is kept and the ratio peer / covcontact is formed from the medians of the same race. Every
 code gets ``--threads`` threads (OMP, MKL, NUMBA, OpenBLAS and CalculiX's variables, and Kratos's
 ``ParallelUtilities.SetNumThreads``). One untimed covcontact run first fills numba's on-disk cache.
-``--ours-ranks 2`` runs covcontact instead as two single-threaded MPI ranks with ``petsc-gamg`` (``mpiexec``; the
-distributed model of docs/performance.md, "Distributed runs"), its way of using two cores on one problem.
+covcontact decides itself how to use them (``--ranks auto``: one MPI rank per thread where its solver ``auto``
+picks ``petsc-gamg``, the 2e5 sizes, else one process of ``--threads`` threads); ``--ours-ranks 1`` keeps it
+to one process, ``--ours-ranks N`` runs N ranks with ``petsc-gamg`` (docs/performance.md, "Distributed runs").
 
 Accuracy: the total force per step of every code (covcontact: its contact force; Kratos and CalculiX: the
 reaction of the loaded face), each peer's relative difference to covcontact, and for hertz F / F_Hertz per step.
@@ -90,6 +91,61 @@ def thread_env(threads: int) -> dict:
     return env
 
 
+def hertz_toml(mesh, mesh_file: Path, size: str, penalty: float, rtol: float | None = None) -> str:
+    """The problem file of one hertz size, equal to tests/verification/hertz_setup.hertz_problem (SVK, 10 steps,
+    the flat face moved down by D_MAX, sliding, symmetry planes, no VTU); writes the graded quarter ball to
+    ``mesh_file`` (Abaqus, its node sets flat, curved, symx and symy), which the problem file reads."""
+    import meshio
+
+    sets = {k: np.asarray(mesh.node_sets[k]) for k in ("flat", "symx", "symy")}
+    faces = np.asarray(mesh.face_sets["curved"])  # the contact surface, an element set of quadrilaterals
+    curved = [np.zeros(0, dtype=np.int64), np.arange(faces.shape[0])]
+    meshio.Mesh(mesh.points, [("hexahedron", mesh.cells), ("quad", faces)], point_sets=sets,
+                cell_sets={"curved": curved}).write(mesh_file)
+    text = f"""# hertz race problem, size {size} (written by benchmarks/peers/race.py)
+[problem]
+name = "hertz-{size}"
+
+[[bodies]]
+name = "ball"
+element = "hex8"
+material = {{ model = "svk", E = {E!r}, nu = {NU!r} }}
+mesh = {{ file = "{mesh_file.name}" }}
+
+[[rigid]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+
+[[contact]]
+slave = "ball.curved"
+master = "floor"
+penalty = {penalty!r}
+weighting = "area"
+
+[[dirichlet]]
+set = "ball.flat"
+components = "z"
+value = {-D_MAX!r}
+
+[[dirichlet]]
+set = "ball.symx"
+components = "x"
+
+[[dirichlet]]
+set = "ball.symy"
+components = "y"
+
+[steps]
+count = {STEPS}
+
+[output]
+vtu = false
+"""
+    return text + (f"\n[solver]\nrtol = {rtol!r}\n" if rtol is not None else "")
+
+
 def two_blocks_toml(size: str, penalty: float, rtol: float | None = None) -> str:
     """The problem file of one two_blocks size: benchmarks/problems/two_blocks_5k.toml with other element counts
     and penalty (same material, supports, 10 steps, no VTU); ``rtol``: Newton's relative tolerance if not the
@@ -135,6 +191,8 @@ class Cell:
             self.penalty = args.hertz_penalty
             self.n = HERTZ[size]
             mesh = hertz_mesh(n=self.n, nr=self.n // 2)
+            self.toml = self.dir / "problem.toml"
+            self.toml.write_text(hertz_toml(mesh, self.dir / "ball.inp", size, self.penalty, args.ours_rtol))
             info = write_case(replace(hertz_case(mesh, E, NU, D_MAX, STEPS, self.penalty),
                                       linear_solver=args.kratos_solver), self.kdir)
             self.dofs, self.label = 3 * mesh.n_nodes, f"n={self.n}"
@@ -151,22 +209,16 @@ class Cell:
 
     # covcontact
     def ours_cmd(self) -> list[str]:
-        if self.problem == "two_blocks":
-            cmd = [sys.executable, "-m", "covcontact", "run", str(self.toml), "--out", str(self.ours_out), "--quiet"]
-        else:
-            cmd = [sys.executable, str(Path(__file__).resolve()), "--worker-hertz", str(self.n), str(self.penalty),
-                   str(self.ours_out), repr(self.args.ours_rtol)]
-        if self.args.ours_ranks > 1:  # MPI ranks on the same cores, each single-threaded, petsc-gamg
-            cmd = ["mpiexec", "-n", str(self.args.ours_ranks), "--bind-to", "none", *cmd]
-            cmd += ["--solver", "petsc-gamg"] if self.problem == "two_blocks" else ["petsc-gamg"]
+        cmd = [sys.executable, "-m", "covcontact", "run", str(self.toml), "--out", str(self.ours_out), "--quiet"]
+        if self.args.ours_ranks is not None:  # else covcontact's own choice (--ranks auto)
+            cmd += ["--ranks", str(self.args.ours_ranks)]
+            cmd += ["--solver", "petsc-gamg"] if self.args.ours_ranks > 1 else []
         return cmd
 
     def run_ours(self) -> float:
         shutil.rmtree(self.ours_out, ignore_errors=True)
-        env = thread_env(1 if self.args.ours_ranks > 1 else self.args.threads)
-        if hasattr(os, "geteuid") and os.geteuid() == 0:  # Open MPI refuses root without these
-            env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-        wall, _, proc = timed(self.ours_cmd(), env=env)
+        ranks = self.args.ours_ranks or 1  # explicit ranks: one thread each; auto shares the threads out itself
+        wall, _, proc = timed(self.ours_cmd(), env=thread_env(1 if ranks > 1 else self.args.threads))
         if proc.returncode not in (0, 1):
             raise RuntimeError(f"covcontact failed:\n{proc.stderr[-2000:]}")
         return wall
@@ -175,6 +227,7 @@ class Cell:
         s = json.loads((self.ours_out / "summary.json").read_text())
         scale = self.force_scale
         return {"converged": bool(s["converged"]), "dofs": s["dofs"], "linear_solver": s["linear_solver"],
+                "ranks": s.get("parallel", {}).get("ranks", 1),
                 "iterations": s["total_iterations"], "iterations_per_step": [st["iterations"] for st in s["steps"]],
                 "factorizations": sum(st.get("factorizations", 0) for st in s["steps"]),
                 "krylov_iterations": sum(st.get("krylov_iterations", 0) for st in s["steps"]),
@@ -280,17 +333,6 @@ def table(records: list[dict], threads: int) -> str:
     return "\n".join(rows)
 
 
-def worker_hertz(n: int, penalty: float, out: str, rtol: float | None, solver: str | None = None) -> int:
-    """Child process: the covcontact Hertz run (no VTU, as the peers write no field output here)."""
-    from hertz_setup import hertz_problem
-
-    mesh = hertz_mesh(n=n, nr=n // 2)
-    problem = hertz_problem(mesh, "svk", steps=STEPS, penalty=penalty, vtu=False)
-    if rtol is not None:
-        problem.solver.rtol = rtol
-    return problem.run(out=Path(out), quiet=True, solver=solver).exit_code
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--problems", default="two_blocks,hertz")
@@ -311,14 +353,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ours-rtol", type=float, default=None,
                     help="covcontact's Newton tolerance [solver] rtol (default: its own, 1e-8); e.g. 1e-5 races it at "
                          "the accuracy of CalculiX's default controls (peers/README.md)")
-    ap.add_argument("--ours-ranks", type=int, default=1,
-                    help="run covcontact as this many MPI ranks of one thread each with petsc-gamg (mpiexec; the `mpi` "
-                         "extra) instead of one process of --threads threads")
-    ap.add_argument("--worker-hertz", nargs="+", help=argparse.SUPPRESS)
+    ap.add_argument("--ours-ranks", type=int, default=None,
+                    help="covcontact's --ranks: 1 runs one process of --threads threads, N > 1 N MPI ranks (the "
+                         "--threads shared among them) with petsc-gamg (the `mpi` extra); default: covcontact's own "
+                         "choice (one rank per thread where its solver auto picks petsc-gamg, else one process)")
     args = ap.parse_args(argv)
-    if args.worker_hertz:
-        n, penalty, out, rtol, *solver = args.worker_hertz
-        return worker_hertz(int(n), float(penalty), out, None if rtol == "None" else float(rtol), *solver)
     if args.kratos and not args.kratos_python:
         print("give --kratos-python (or set KRATOS_PYTHON): the Python of an environment with Kratos", file=sys.stderr)
         return 2

@@ -43,9 +43,10 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     r.add_argument("--resume", action="store_true",
                    help="continue from the last checkpoint in the output folder (same problem, same ranks)")
-    r.add_argument("--ranks", type=int, default=1, metavar="N",
+    r.add_argument("--ranks", type=_ranks_arg, default="auto", metavar="N",
                    help="run as N MPI ranks of the distributed model (starts mpiexec itself; the `mpi` extra): "
-                        "petsc-gamg where auto picks it, else petsc (MUMPS), or the --solver given (default 1: "
+                        "petsc-gamg where auto picks it, else petsc (MUMPS), or the --solver given; 1: one "
+                        "process (default auto: one rank per core where the solver auto picks petsc-gamg, else "
                         "one process)")
     s = sub.add_parser("study", help="run a problem once per tangent case and tabulate the iterations",
                        description="Run a problem once per tangent case; writes table.md, table.csv "
@@ -80,6 +81,17 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _ranks_arg(text: str) -> int | str:
+    """``--ranks``: ``auto`` or a whole number (checked by the run: at least 1)."""
+    text = text.strip().lower()
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of ranks or auto, got {text!r}") from None
+
+
 def _check_solver(name: str | None) -> None:
     if name is None or name == "auto":
         return
@@ -96,8 +108,13 @@ def cmd_run(args) -> int:
 
     problem = load_problem(args.problem)
     _check_solver(args.solver or problem.solver.linear)
+    started = args.ranks == "auto"
+    if started:  # one rank per core where auto picks petsc-gamg (solvers/run.py auto_ranks), else this process
+        from .solvers.run import auto_ranks
+
+        args.ranks = auto_ranks(problem, args.solver, args.out, args.resume)
     if args.ranks != 1:
-        return _run_ranks(args, problem)
+        return _run_ranks(args, problem, started)
     result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver,
                          resume=args.resume)
     if not args.quiet and result.model.is_root:  # one line from a distributed run
@@ -105,7 +122,7 @@ def cmd_run(args) -> int:
     return result.exit_code
 
 
-def _run_ranks(args, problem) -> int:
+def _run_ranks(args, problem, started: bool = False) -> int:
     """``covcontact run --ranks N``: the same command under ``mpiexec -n N`` with a distributed solver; returns its
     exit code. SIGINT and SIGTERM are passed on to mpiexec: with Open MPI the first as SIGUSR2 and SIGUSR1, which
     it relays to the ranks without killing them, so that they stop together at their next Newton iteration and
@@ -115,7 +132,13 @@ def _run_ranks(args, problem) -> int:
     import signal
     import subprocess
 
-    from .parallel.launcher import cores_here, environment_for_mpiexec, is_open_mpi, ranks_from_env
+    from .parallel.launcher import (
+        cores_here,
+        environment_for_mpiexec,
+        is_open_mpi,
+        ranks_from_env,
+        threads_per_rank,
+    )
     from .solvers.linear import available
     from .solvers.run import auto_line, check_distributable, requested_linear, resolve_linear
     from .solvers.signals import StopSignals
@@ -138,7 +161,7 @@ def _run_ranks(args, problem) -> int:
     solver = resolve_linear(problem, args.solver, ranks=n)
     check_distributable(problem, solver, n)
     if solver != requested and not args.quiet:
-        print(auto_line(solver, n), file=sys.stderr, flush=True)
+        print(auto_line(solver, n, started=started), file=sys.stderr, flush=True)
     cmd = [mpiexec, "-n", str(n)]
     open_mpi = is_open_mpi(mpiexec)
     if n > cores:  # legal, but the ranks take turns on the cores
@@ -151,6 +174,8 @@ def _run_ranks(args, problem) -> int:
     cmd += ["--tangent", args.tangent] if args.tangent else []
     cmd += [flag for flag, on in (("--quiet", args.quiet), ("--resume", args.resume)) if on]
     env = environment_for_mpiexec()  # each rank takes its share of the cores (parallel.comm.share_cores)
+    if started:  # the run's thread budget is shared out: NUMBA_NUM_THREADS and the like become per rank
+        env.update(threads_per_rank(env, n))
     proc = subprocess.Popen(cmd, env=env)
     received: list[int] = []
 

@@ -199,6 +199,32 @@ def test_ranks_stopped_by_sigterm(tmp_path):
         assert np.abs(ua - ub).max() <= 1e-12 * np.abs(ub).max()
 
 
+def test_auto_starts_one_rank_per_core(tmp_path):
+    """Without ``--ranks`` a problem that ``auto`` hands to petsc-gamg (two blocks, 107,760 dofs) runs as one MPI
+    rank per core of its thread budget (NUMBA_NUM_THREADS = 2: two, each with one numba thread), and says so."""
+    from covcontact.parallel.launcher import cores_here
+
+    text = (ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml").read_text()
+    for old, new in (("nx = 10, ny = 10, nz = 5", "nx = 32, ny = 32, nz = 15"),
+                     ("nx = 11, ny = 11, nz = 5", "nx = 33, ny = 33, nz = 15"), ("count = 10", "count = 1"),
+                     ("value = [0.0, 0.0, -0.05]", "value = [0.0, 0.0, -0.01]")):
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / "big.toml"
+    path.write_text(text)
+    env = dict(os.environ, NUMBA_NUM_THREADS="2")
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(path), "--out", str(tmp_path / "o")]
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    ranks = min(2, cores_here())
+    assert summary["dofs"] == 107_760 and summary["linear_solver"] == "petsc-gamg"
+    assert summary.get("parallel", {}).get("ranks", 1) == ranks
+    if ranks == 2:
+        assert "linear solver: petsc-gamg (auto, 2 MPI ranks" in proc.stderr and "`--ranks 1`" in proc.stderr
+        assert summary["parallel"]["numba_threads"] == 1
+
+
 def test_serial_solver_refused_under_ranks(tmp_path):
     """A solver that runs in one process is refused with one line and exit 2, by ``--ranks`` before it starts
     mpiexec, and by the ranks themselves under ``mpiexec`` (instead of two serial runs writing one folder)."""

@@ -54,6 +54,16 @@ def environment_for_mpiexec() -> dict[str, str]:
     return env
 
 
+#: the thread counts a run started with ``--ranks auto`` divides among its ranks
+THREAD_VARS = ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+
+
+def threads_per_rank(env: dict[str, str], ranks: int) -> dict[str, str]:
+    """The thread-count variables of ``env`` that are set, each divided among ``ranks`` ranks (at least 1 each),
+    so that ranks started on the cores of one run do not each take the whole run's threads."""
+    return {k: str(max(1, int(env[k]) // ranks)) for k in THREAD_VARS if env.get(k, "").strip().isdigit()}
+
+
 def is_open_mpi(mpiexec: str) -> bool:
     """Whether ``mpiexec`` is Open MPI's (it asks for --oversubscribe to run more ranks than cores, and kills its
     ranks right after passing SIGTERM or SIGINT on, but passes SIGUSR1 and SIGUSR2 on alone)."""

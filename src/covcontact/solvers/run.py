@@ -151,6 +151,54 @@ def resolve_linear(problem, linear: str | None, ranks: int | None = None) -> str
     return "petsc" if (ranks or ranks_from_env()) > 1 else name
 
 
+#: a run that ``auto`` hands to petsc-gamg on several cores is started as one MPI rank per core, with at least this
+#: many dofs per rank (GAMG's coarse levels and the ranks' shared interfaces cost more than they save below it)
+AUTO_DOFS_PER_RANK = 50_000
+
+
+def thread_budget() -> int:
+    """The cores a run may use: those this process may run on, at most ``NUMBA_NUM_THREADS`` where it is set."""
+    import os
+
+    from ..parallel.launcher import cores_here
+
+    budget = cores_here()
+    value = os.environ.get("NUMBA_NUM_THREADS", "").strip()
+    return max(1, min(budget, int(value))) if value.isdigit() else budget
+
+
+def checkpoint_ranks(out: Path) -> int | None:
+    """The number of ranks that wrote the checkpoint in ``out`` (None where there is none)."""
+    if (out / "checkpoint.npz").is_file():
+        return 1
+    for path in sorted(out.glob("checkpoint.rank0-of-*.npz")):
+        n = path.name[len("checkpoint.rank0-of-"):-len(".npz")]
+        if n.isdigit():
+            return int(n)
+    return None
+
+
+def auto_ranks(problem, linear: str | None, out: str | Path | None, resume: bool) -> int:
+    """How many MPI ranks ``covcontact run`` starts without ``--ranks``: one (this process) unless ``auto`` hands
+    the problem to ``petsc-gamg`` (:func:`auto_amg`), whose Krylov solves and GAMG run one thread per rank, and the
+    run may use several cores (:func:`thread_budget`) and ``mpiexec`` is on the PATH: then one rank per core, at
+    most one per ``AUTO_DOFS_PER_RANK`` dofs. ``--resume`` takes the number of ranks of the checkpoint it resumes.
+    A process that an MPI launcher started is a rank itself: one."""
+    import shutil
+
+    from ..parallel.launcher import under_launcher
+
+    if under_launcher() or requested_linear(problem, linear) != "auto":
+        return 1
+    folder = Path(out) if out is not None else Path("results") / problem.name
+    if resume and (n := checkpoint_ranks(folder)) is not None:
+        return n
+    if resolve_linear(problem, linear, ranks=1) != "petsc-gamg" or shutil.which("mpiexec") is None:
+        return 1
+    dofs = 3 * sum(b.mesh.points.shape[0] for b in problem.bodies)
+    return max(1, min(thread_budget(), dofs // AUTO_DOFS_PER_RANK))
+
+
 def _distributes(linear: str) -> bool:
     """Whether the linear solver ``linear`` runs the distributed model (``petsc*``)."""
     from .linear import REGISTRY, backend_class
@@ -158,13 +206,15 @@ def _distributes(linear: str) -> bool:
     return linear in REGISTRY and getattr(backend_class(linear), "distributed", False)
 
 
-def auto_line(linear: str, ranks: int, one_core_hint: bool = False) -> str:
-    """The line a run prints when ``auto`` picked ``linear`` (``petsc-gamg``, or ``petsc`` on several ranks)."""
+def auto_line(linear: str, ranks: int, one_core_hint: bool = False, started: bool = False) -> str:
+    """The line a run prints when ``auto`` picked ``linear`` (``petsc-gamg``, or ``petsc`` on several ranks);
+    ``started``: the ranks were started by :func:`auto_ranks`, not asked for."""
     if linear != "petsc-gamg":
         return f"linear solver: {linear} (auto, {ranks} MPI ranks: MUMPS, distributed)"
     why = "a large frictionless problem of bulky solid bodies"
     if ranks > 1:
-        return f"linear solver: {linear} (auto, {ranks} MPI ranks: {why})"
+        how = "; one per core, `--ranks 1` keeps one process" if started else ""
+        return f"linear solver: {linear} (auto, {ranks} MPI ranks: {why}{how})"
     hint = "; its solves run on one core, `--ranks 2` runs two MPI ranks" if one_core_hint else ""
     return (f"linear solver: {linear} (auto: {why}; --solver with a direct one, `covcontact info` lists them, to "
             f"factorise instead{hint})")
