@@ -225,6 +225,18 @@ def test_auto_starts_one_rank_per_core(tmp_path):
         assert summary["parallel"]["numba_threads"] == 1
 
 
+def test_launcher_of_another_mpi_refused(tmp_path):
+    """A process that a launcher says is one of two ranks, but whose MPI sees one rank (an mpiexec of another MPI
+    than mpi4py's, whose processes would each run the whole problem into one folder): one line, exit 2."""
+    env = dict(os.environ, MPI_LOCALNRANKS="2")  # what MPICH's launcher sets; this process's MPI is a singleton
+    cmd = [sys.executable, "-m", "covcontact.cli", "run", str(TWO_BLOCKS), "--solver", "petsc", "--quiet",
+           "--out", str(tmp_path / "o")]
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True, timeout=120, env=env)
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert proc.stderr.count("\n") == 1 and "another MPI than mpi4py's" in proc.stderr
+    assert not (tmp_path / "o" / "summary.json").exists()
+
+
 def test_serial_solver_refused_under_ranks(tmp_path):
     """A solver that runs in one process is refused with one line and exit 2, by ``--ranks`` before it starts
     mpiexec, and by the ranks themselves under ``mpiexec`` (instead of two serial runs writing one folder)."""

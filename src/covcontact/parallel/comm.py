@@ -14,10 +14,21 @@ import numpy as np
 
 
 def world() -> Any:
-    """mpi4py's COMM_WORLD (initialises MPI; a plain ``python`` run is one rank)."""
+    """mpi4py's COMM_WORLD (initialises MPI; a plain ``python`` run is one rank). InputError where the launcher
+    started several processes but MPI sees one rank in each: an ``mpiexec`` of another MPI than the one mpi4py
+    was built on, whose processes would each run the whole problem into the same output folder."""
     from mpi4py import MPI
 
-    return MPI.COMM_WORLD
+    from ..io.validate import InputError
+    from .launcher import ranks_from_env
+
+    comm = MPI.COMM_WORLD
+    started = ranks_from_env()
+    if started > 1 and comm.size == 1:
+        raise InputError(f"mpiexec started {started} processes, but MPI sees one rank in each: that "
+                         f"mpiexec belongs to another MPI than mpi4py's (mpi4py.get_config() names it); put that "
+                         f"MPI's mpiexec first on the PATH, or run one process (--ranks 1)")
+    return comm
 
 
 def sum_all(comm, a: np.ndarray) -> np.ndarray:
