@@ -276,10 +276,22 @@ def test_output_files_have_the_users_permissions(tmp_path, capsys):
 
 
 def test_compile_command(capsys):
-    """`covcontact compile` runs its warm-up problems (here one of them) and says what it did."""
+    """`covcontact compile` runs its warm-up problems (here one of them) and says what it did, and leaves the
+    bytecode of every covcontact module written (as a pip installation has it), even where Python itself writes
+    none (PYTHONDONTWRITEBYTECODE)."""
+    import importlib.util
+
+    import covcontact
+
+    package = Path(covcontact.__file__).parent
+    sources = sorted(package.rglob("*.py"))
+    probe = Path(importlib.util.cache_from_source(str(package / "warmup.py")))
+    probe.unlink(missing_ok=True)
     code, _, err = run_cli(["compile", "--only", "plane with friction"], capsys)
     assert code == 0, err
     assert "compiled hex8 on a plane with friction" in err and "1 warm-up problems" in err
+    missing = [str(p) for p in sources if not Path(importlib.util.cache_from_source(str(p))).is_file()]
+    assert probe.is_file() and missing == []
     code, _, err = run_cli(["compile", "--only", "no such label"], capsys)
     assert code == 2 and "--only" in err and len(err.strip().splitlines()) == 1
 

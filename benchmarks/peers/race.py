@@ -25,7 +25,9 @@ the graded ball from an Abaqus mesh file the race writes, as no TOML generator g
 kratos_run.py under Kratos's Python; CalculiX: ``ccx -i job``). The codes alternate, ``--repeats`` runs each,
 the median wall time is kept and the ratio peer / covcontact is formed from the medians of the same race. Every
 code gets ``--threads`` threads (OMP, MKL, NUMBA, OpenBLAS and CalculiX's variables, and Kratos's
-``ParallelUtilities.SetNumThreads``). One untimed covcontact run first fills numba's on-disk cache.
+``ParallelUtilities.SetNumThreads``). One untimed covcontact run first fills numba's on-disk cache, and
+covcontact's modules are compiled to bytecode first, as an installed package has them (an editable installation
+run with PYTHONDONTWRITEBYTECODE would compile them again in every timed run, about 0.1 s).
 covcontact decides itself how to use them (``--ranks auto``: one MPI rank per thread where its solver ``auto``
 picks ``petsc-gamg``, the 2e5 sizes, else one process of ``--threads`` threads); ``--ours-ranks 1`` keeps it
 to one process, ``--ours-ranks N`` runs N ranks with ``petsc-gamg`` (docs/performance.md, "Distributed runs").
@@ -71,6 +73,7 @@ from kratos_deck import hertz_case, two_blocks_case, write_case
 from kratos_results import read_results
 
 from covcontact.problem import SolverOptions
+from covcontact.warmup import byte_compile
 
 THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                "CCX_NPROC_EQUATION_SOLVER", "CCX_NPROC_STIFFNESS", "CCX_NPROC_RESULTS", "NUMBER_OF_CPUS")
@@ -369,6 +372,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         work = args.keep or Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
+        byte_compile()  # covcontact's modules as an installed package has them (PYTHONDONTWRITEBYTECODE)
         warm = Cell("two_blocks", "5k", work / "warmup", args)  # fills numba's cache (not timed)
         warm.run_ours()
         for size in sizes:

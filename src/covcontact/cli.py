@@ -72,8 +72,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="largest relative error (Frobenius norm) that passes (default 1e-6)")
     w = sub.add_parser("compile", help="compile every numerical kernel into numba's cache (once, after installing)",
                        description="Run tiny problems that call every compiled kernel, so that numba's cache "
-                       "holds them all and the first real run starts at once. Run it once after installing "
-                       "covcontact or upgrading numba.")
+                       "holds them all and the first real run starts at once (and compiles covcontact's modules to "
+                       "bytecode where the installation has none). Run it once after installing covcontact or "
+                       "upgrading numba.")
     w.add_argument("--only", default=None, metavar="TEXT",
                    help="only the warm-up problems whose label contains TEXT (default: all)")
     sub.add_parser("info", help="version, linear solvers, threads",
@@ -233,12 +234,13 @@ def cmd_check_tangent(args) -> int:
 def cmd_compile(args) -> int:
     import time
 
-    from .warmup import PROBLEMS, warm
+    from .warmup import PROBLEMS, byte_compile, warm
 
     if args.only is not None and not any(args.only in label for label, _ in PROBLEMS):
         raise InputError(f"--only: no warm-up problem matches {args.only!r} (labels: "
                          f"{'; '.join(label for label, _ in PROBLEMS)})")
     t0 = time.perf_counter()
+    byte_compile()  # the modules' bytecode too, where the installation lacks it (PYTHONDONTWRITEBYTECODE)
     done = warm(only=args.only)
     print(f"covcontact: {len(done)} warm-up problems in {time.perf_counter() - t0:.1f} s; the kernels are in "
           f"numba's cache", file=sys.stderr)
