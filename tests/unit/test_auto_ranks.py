@@ -99,3 +99,21 @@ def test_ranks_option(tmp_path, capsys):
     # auto on a small problem: this process, as before
     assert main(["run", str(path), "--ranks", "auto", "--quiet", "--out", str(tmp_path / "o")]) == 0
     assert (tmp_path / "o" / "summary.json").is_file()
+
+
+def test_cgroup_quota(tmp_path):
+    """A container's CPU quota bounds the cores (cgroup v2 cpu.max, v1 cfs quota / period; none: no bound)."""
+    from covcontact.parallel.launcher import cgroup_cpus
+
+    assert cgroup_cpus(str(tmp_path)) is None
+    (tmp_path / "cpu.max").write_text("max 100000\n")
+    assert cgroup_cpus(str(tmp_path)) is None
+    (tmp_path / "cpu.max").write_text("150000 100000\n")
+    assert cgroup_cpus(str(tmp_path)) == 2
+    v1 = tmp_path / "v1"
+    (v1 / "cpu").mkdir(parents=True)
+    (v1 / "cpu" / "cpu.cfs_quota_us").write_text("-1\n")
+    (v1 / "cpu" / "cpu.cfs_period_us").write_text("100000\n")
+    assert cgroup_cpus(str(v1)) is None
+    (v1 / "cpu" / "cpu.cfs_quota_us").write_text("400000\n")
+    assert cgroup_cpus(str(v1)) == 4

@@ -33,8 +33,35 @@ def rank_from_env() -> int:
 
 
 def cores_here() -> int:
-    """The cores this process may run on (its affinity mask where the system has one)."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    """The cores this process may run on: its affinity mask where the system has one, at most the CPU quota of
+    its control group (a container limited to 2 CPUs on a 64-core host sees 64 cores in its mask)."""
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    quota = cgroup_cpus()
+    return max(1, min(cores, quota)) if quota is not None else cores
+
+
+def cgroup_cpus(root: str = "/sys/fs/cgroup") -> int | None:
+    """The CPU quota of this process's control group rounded up to whole CPUs (cgroup v2 ``cpu.max``, v1
+    ``cpu.cfs_quota_us`` / ``cpu.cfs_period_us``); None where there is none or it cannot be read."""
+    import math
+
+    def read(name: str) -> str:
+        try:
+            with open(os.path.join(root, name)) as fh:
+                return fh.read().strip()
+        except OSError:
+            return ""
+
+    v2 = read("cpu.max").split()
+    if len(v2) == 2 and v2[0] != "max":
+        quota, period = v2
+    else:
+        quota, period = read("cpu/cpu.cfs_quota_us"), read("cpu/cpu.cfs_period_us")
+    try:
+        q, p = int(quota), int(period)
+    except ValueError:
+        return None
+    return max(1, math.ceil(q / p)) if q > 0 and p > 0 else None
 
 
 #: the variables by which a process started in an MPI job (an MPI singleton too, as a Python that loaded PETSc)
