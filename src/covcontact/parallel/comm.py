@@ -74,7 +74,8 @@ def share_cores(comm) -> int:
     """Give each rank its share of the cores for the numba element loops; returns the thread count.
 
     Left alone when ``NUMBA_NUM_THREADS`` is set. A rank bound to some cores (Open MPI binds to one core
-    per rank by default) uses those; an unbound rank shares the node's cores with the ranks on its node.
+    per rank by default) uses those; an unbound rank shares the node's cores with the ranks on its node; the
+    ranks of a node share its control group's CPU quota where it has one.
     """
     import numba
 
@@ -82,14 +83,17 @@ def share_cores(comm) -> int:
         return numba.get_num_threads()
     from mpi4py import MPI
 
-    from .launcher import cores_here
+    from .launcher import cgroup_cpus
 
     local = comm.Split_type(MPI.COMM_TYPE_SHARED)
     n_local = local.size
     local.Free()
-    mine = cores_here()
+    mine = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     total = os.cpu_count() or mine
     threads = mine if mine < total else max(1, total // n_local)
+    quota = cgroup_cpus()  # a container's CPUs, shared by the ranks on its node
+    if quota is not None:
+        threads = min(threads, max(1, quota // n_local))
     threads = max(1, min(threads, numba.config.NUMBA_NUM_THREADS))
     numba.set_num_threads(threads)
     return threads
