@@ -192,6 +192,7 @@ def test_nonconverging_step_exit_1(tmp_path, capsys):
 def test_info(capsys):
     code, out, _ = run_cli(["info"], capsys)
     assert code == 0 and "covcontact" in out and "superlu" in out and "threads" in out
+    assert "MPI ranks: " in out  # what --ranks auto may start here
 
 
 def test_console_script_runs(tmp_path):

@@ -247,6 +247,24 @@ def cmd_compile(args) -> int:
     return 0
 
 
+def _ranks_info() -> str:
+    """What ``--ranks auto`` may start here: its thread budget, whether mpiexec and the PETSc solvers are there."""
+    import shutil
+
+    from .solvers.linear import available
+    from .solvers.run import AUTO_DOFS_PER_RANK, thread_budget
+
+    budget = thread_budget()
+    missing = [what for what, ok in (("mpiexec on the PATH", shutil.which("mpiexec") is not None),
+                                     ("the PETSc solvers (the `mpi` extra)", "petsc-gamg" in available())) if not ok]
+    if missing:
+        return f"one process (no {' and no '.join(missing)}); `--ranks auto` needs them"
+    if budget < 2:
+        return "one process (one core for this run: its affinity, CPU quota or NUMBA_NUM_THREADS)"
+    return (f"`--ranks auto` starts up to {budget} (one per core, at most one per {AUTO_DOFS_PER_RANK:,} dofs) "
+            f"where auto picks petsc-gamg")
+
+
 def cmd_info(args) -> int:
     import numba
 
@@ -254,6 +272,7 @@ def cmd_info(args) -> int:
 
     print(f"covcontact {__version__}")
     print(f"numba {numba.__version__}, threads {numba.get_num_threads()}")
+    print(f"MPI ranks: {_ranks_info()}")
     print("linear solvers:")
     for d in describe():
         mark = "yes" if d.get("available") else "no "
