@@ -1,10 +1,10 @@
-"""The near-null space handed to PETSc's GAMG (solvers/petsc_backend.py rigid_body_basis): an orthonormal basis
+"""The near-null space handed to PETSc's GAMG (solvers/linear.py rigid_body_basis): an orthonormal basis
 of the six rigid-body modes whose bits do not depend on where the coordinates lie in memory (PETSc's own
 construction sums with BLAS, whose rounding does: its modes differed in the last bit from run to run)."""
 
 import numpy as np
 
-from covcontact.solvers.petsc_backend import rigid_body_basis
+from covcontact.solvers.linear import rigid_body_basis
 
 
 def _modes(X):

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 if TYPE_CHECKING:  # re-exported lazily by __getattr__ (the backend modules import this module)
     from .backends import AMGSolver, CholmodSolver, MumpsSolver, SuperLUSolver  # noqa: F401
@@ -262,6 +263,57 @@ def rigid_body_modes(X: np.ndarray, constrained: np.ndarray | None = None) -> np
     if mask is not None:
         B[mask] = 0.0
     return B
+
+
+@njit(cache=True)
+def _dots(Q, k, v):  # pragma: no cover - compiled
+    """Q[:, j] . v for j < k, each summed in index order (a fixed order: the same bits on every run)."""
+    out = np.zeros(k)
+    for j in range(k):
+        acc = 0.0
+        for i in range(v.size):
+            acc += Q[i, j] * v[i]
+        out[j] = acc
+    return out
+
+
+@njit(cache=True)
+def _column_sums(X):  # pragma: no cover - compiled
+    """The sums of X's columns, each in index order."""
+    out = np.zeros(X.shape[1])
+    for i in range(X.shape[0]):
+        for d in range(X.shape[1]):
+            out[d] += X[i, d]
+    return out
+
+
+def rigid_body_basis(coords: np.ndarray, comm=None) -> np.ndarray:
+    """An orthonormal basis (3 m, 6) of the :func:`rigid_body_modes` at ``coords`` (m, 3), on a distributed run
+    this rank's share of the nodes (``comm``: the ranks' mpi4py communicator), rows x, y, z interleaved, the
+    same bits on every run: the modes about the centroid of all ranks' nodes, orthonormalised by Gram-Schmidt
+    twice over with every sum taken in a fixed order, here and over the ranks through rank 0
+    (parallel.comm.sum_all). (PETSc's MatNullSpaceCreateRigidBody sums with BLAS, whose rounding depends on
+    where its vectors lie in memory: its modes, and with them GAMG's hierarchy, differed in the last bit
+    between runs of the same problem.)"""
+    from ..parallel.comm import sum_all
+
+    def total(a: np.ndarray) -> np.ndarray:
+        return sum_all(comm, a) if comm is not None else np.asarray(a, dtype=np.float64)
+
+    # one layout: numpy's reductions in rigid_body_modes add in an order that depends on it
+    X = np.ascontiguousarray(coords, dtype=np.float64)
+    n_all = total(np.array([float(X.shape[0])]))[0]
+    B = rigid_body_modes(X - total(_column_sums(X)) / max(n_all, 1.0))
+    Q = np.zeros_like(B)
+    for k in range(B.shape[1]):
+        v = B[:, k].copy()
+        for _ in range(2):
+            coef = total(_dots(Q, k, v))
+            for j in range(k):  # elementwise: no sum whose order could vary
+                v -= coef[j] * Q[:, j]
+        norm = float(np.sqrt(total(_dots(v[:, None], 1, v))[0]))
+        Q[:, k] = v / norm if norm > 0.0 else 0.0
+    return Q
 
 
 def near_null_candidates(B: np.ndarray | None, geometry: tuple | None, n: int) -> tuple[np.ndarray | None, bool]:

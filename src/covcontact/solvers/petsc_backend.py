@@ -25,68 +25,19 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 
-from .linear import LinearSolver, LinearSolverError, SingularMatrixError, _as_csr, near_null_candidates
+from .linear import (
+    LinearSolver,
+    LinearSolverError,
+    SingularMatrixError,
+    _as_csr,
+    near_null_candidates,
+    rigid_body_basis,
+)
 
 PREFIX = "covcontact_"
 
 
-@njit(cache=True)
-def _dots(Q, k, v):  # pragma: no cover - compiled
-    """Q[:, j] . v for j < k, each summed in index order (a fixed order: the same bits on every run)."""
-    out = np.zeros(k)
-    for j in range(k):
-        acc = 0.0
-        for i in range(v.size):
-            acc += Q[i, j] * v[i]
-        out[j] = acc
-    return out
-
-
-@njit(cache=True)
-def _column_sums(X):  # pragma: no cover - compiled
-    """The sums of X's columns, each in index order."""
-    out = np.zeros(X.shape[1])
-    for i in range(X.shape[0]):
-        for d in range(X.shape[1]):
-            out[d] += X[i, d]
-    return out
-
-
-def rigid_body_basis(coords: np.ndarray, comm=None) -> np.ndarray:
-    """An orthonormal basis (3 m, 6) of the rigid-body modes (translations, rotations about the centroid) at
-    ``coords`` (m, 3), this rank's share of the nodes in PETSc order, x, y, z interleaved: Gram-Schmidt twice
-    over, each dot product summed in a fixed order here and over the ranks through rank 0
-    (parallel.comm.sum_all), so that every run gets the same bits. (PETSc's MatNullSpaceCreateRigidBody sums
-    with BLAS, whose rounding depends on where its vectors lie in memory: its modes, and with them GAMG's
-    hierarchy, differed in the last bit between runs of the same problem.)"""
-    from ..parallel.comm import sum_all
-
-    def total(a: np.ndarray) -> np.ndarray:
-        return sum_all(comm, a) if comm is not None else np.asarray(a, dtype=np.float64)
-
-    X = np.asarray(coords, dtype=np.float64)
-    m = X.shape[0]
-    n_all = total(np.array([float(m)]))[0]
-    c = total(_column_sums(X)) / max(n_all, 1.0)
-    x, y, z = (X - c).T
-    B = np.zeros((3 * m, 6))
-    for d in range(3):
-        B[d::3, d] = 1.0
-    B[0::3, 3], B[1::3, 3] = -y, x
-    B[1::3, 4], B[2::3, 4] = -z, y
-    B[0::3, 5], B[2::3, 5] = z, -x
-    Q = np.zeros_like(B)
-    for k in range(6):
-        v = B[:, k].copy()
-        for _ in range(2):
-            coef = total(_dots(Q, k, v))
-            for j in range(k):  # elementwise: no sum whose order could vary
-                v -= coef[j] * Q[:, j]
-        norm = float(np.sqrt(total(_dots(v[:, None], 1, v))[0]))
-        Q[:, k] = v / norm if norm > 0.0 else 0.0
-    return Q
 #: the GAMG options each petsc-gamg solver sets from its parameters (threshold, smooths, level_pc)
 _GAMG_OPTIONS = ("pc_gamg_threshold", "pc_gamg_agg_nsmooths", "mg_levels_pc_type")
 _USER: set[str] | None = None
