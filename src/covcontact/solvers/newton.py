@@ -98,6 +98,10 @@ class Newton:
         self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
         self.poll = None  # called before every iteration (a distributed run's stop signals: StopSignals.poll)
+        #: called after every converged increment of :meth:`advance` (after its Uzawa updates) as
+        #: ``on_converged(u, lam_a, lam_b, committed, trial)``: the converged displacement, the increment's
+        #: load factors, the committed state it started from and its converged trial (check-tangent's probe)
+        self.on_converged = None
 
     # ------------------------------------------------------------------------------------------
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
@@ -336,6 +340,8 @@ class Newton:
                 res.augmentation = augment
                 outcomes.append(res)
             if res.converged:
+                if self.on_converged is not None:
+                    self.on_converged(u, lam, target, committed, trial)
                 committed = trial
                 lam = target
                 depth = max(depth - 1, 0)

@@ -256,20 +256,22 @@ def _tangent_name(problem, tangent: str | None) -> str:
     return cases.pop() if len(cases) == 1 else ("a" if not cases else "per-pair")
 
 
-def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resume=False) -> Result:
+def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resume=False, probe=None) -> Result:
     """Solve ``problem`` and write its results; see ``Problem.run``.
 
     With a distributing backend (``petsc``, ``petsc-gamg``) every MPI rank runs this function; only
-    rank 0 writes files and prints.
+    rank 0 writes files and prints. ``probe`` (``covcontact.tangent_check``): an object with ``step`` (the
+    step, counted over all stages, after which the run stops with status ``"stopped"``) and
+    ``increment(u, lam_a, lam_b, committed, trial)``, called for every converged increment of that step.
     """
     # numpy's and scipy's OpenBLAS on one thread for the run: no vector operation of a run gains from threads,
     # but a threaded call leaves OpenBLAS's workers spinning for a while afterwards, and they take the cores
     # from numba's element assembly and PARDISO (measured: assembly 1.5-2x slower on 2 cores); MKL untouched
     with ThreadpoolController().select(internal_api="openblas").limit(limits=1):
-        return _solve_problem(problem, out, tangent, quiet, linear, resume)
+        return _solve_problem(problem, out, tangent, quiet, linear, resume, probe)
 
 
-def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
+def _solve_problem(problem, out, tangent, quiet, linear, resume, probe=None) -> Result:
     t_start = time.perf_counter()
     out = Path(out) if out is not None else Path("results") / problem.name
     requested = requested_linear(problem, linear)
@@ -279,18 +281,18 @@ def _solve_problem(problem, out, tangent, quiet, linear, resume) -> Result:
         print(auto_line(linear, model.size, numba.get_num_threads() > 1), file=sys.stderr, flush=True)
     if model.size > 1:
         try:
-            return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
+            return _run(problem, model, out, tangent, quiet, linear, t_start, resume, probe)
         except InputError:  # a refused checkpoint: raised on every rank alike (exit 2)
             raise
         except Exception:  # noqa: BLE001  (maybe on one rank only: the others would wait forever)
             traceback.print_exc()
             sys.stderr.flush()
             model.comm.Abort(3)
-    return _run(problem, model, out, tangent, quiet, linear, t_start, resume)
+    return _run(problem, model, out, tangent, quiet, linear, t_start, resume, probe)
 
 
 def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_start: float,
-         resume: bool) -> Result:
+         resume: bool, probe=None) -> Result:
     newton = Newton(model, problem.solver, linear=linear)
     root = model.is_root
     rank, size = model.rank, model.size
@@ -387,6 +389,8 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                 for k in range(state.step + 1, before + len(spec.factors) + 1):
                     lam = spec.factors[k - before - 1]
                     stats0, time0 = dict(newton.stats), dict(newton.timing)
+                    if probe is not None and k == probe.step:
+                        newton.on_converged = probe.increment
                     success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
                     conv = [o for o in outcomes if o.converged]
                     iters = sum(o.iterations for o in outcomes)
@@ -463,7 +467,10 @@ def _run(problem, model, out: Path, tangent: str | None, quiet: bool, linear, t_
                                              "force_scale": newton.scale_seen, "last_step_lams": lams},
                                             rank, size)
                     stops.poll()
-                if status == "failed":
+                    if probe is not None and k == probe.step:
+                        status = "stopped"
+                        break
+                if status in ("failed", "stopped"):
                     break
         except (Interrupted, SystemError) as exc:
             stop = _interruption(exc)
