@@ -70,6 +70,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="count --step within this stage (the first stage's name is [problem] stage)")
     c.add_argument("--tangent", choices=TANGENT_CASES, default="exact",
                    help=cases + " (default: exact; cases a-d leave out parts of the exact Hessian by design)")
+    c.add_argument("--run-tangent", choices=TANGENT_CASES, default=None, metavar="CASE",
+                   help="the tangent case the run to the step solves with, as `covcontact run --tangent` (default: "
+                   "each pair's own case, as `covcontact run` without it)")
     c.add_argument("--columns", default="60", metavar="N|all",
                    help="tangent columns to difference: a share from the contact zone, one from the plastic "
                    "zone, the rest drawn at random (default 60); `all`: every free dof")
@@ -252,7 +255,7 @@ def cmd_check_tangent(args) -> int:
         raise InputError(f"--columns: a whole number > 0 or `all`, got {args.columns!r}")
     _check_solver(args.solver or problem.solver.linear)
     rep = check_tangent(problem, step=step, tangent=args.tangent, columns=None if cols == "all" else int(cols),
-                        h=args.h, solver=args.solver)
+                        h=args.h, solver=args.solver, run_tangent=args.run_tangent)
     for line in report_lines(rep, args.tol):
         print(line)
     if args.json:

@@ -9,8 +9,8 @@ Every chosen column c of the tangent is compared with differences of the residua
 step sizes h. A perturbation that changes a status of the state (a Gauss point yielding or unloading, a slave
 node opening or closing, stick/slip, a contact point moving onto another facet, an edge or a vertex) crosses
 a kink of R, where no difference quotient approximates the one-sided derivative the tangent is: such a
-column is judged at the largest step size at which neither side changes a status, and listed as a kink when
-there is none. The verdict is the relative error over the judged columns.
+column is judged only at step sizes at which neither side changes a status (at the one that agrees best:
+a wrong tangent disagrees at every step size), and listed as a kink when there is none. The verdict is the relative error over the judged columns.
 """
 
 from __future__ import annotations
@@ -76,9 +76,10 @@ def serial_solver(problem, solver: str | None) -> str | None:
     return "auto" if _distributes(name) else solver
 
 
-def reach(problem, step: int, tangent: str | None = "exact", solver: str | None = None) -> Reached:
+def reach(problem, step: int, tangent: str | None = None, solver: str | None = None) -> Reached:
     """Run ``problem`` as ``covcontact run`` does up to ``step`` (counted over all stages; 0: the undeformed
-    start) and return the state of its last converged increment."""
+    start) and return the state of its last converged increment. ``tangent``: the run's ``--tangent`` (None:
+    each pair's own case, as ``covcontact run`` without the option)."""
     names = [n for n, count in stage_steps(problem) for _ in range(count)]
     if step == 0:
         model = Model(problem, tangent=tangent)
@@ -254,8 +255,12 @@ class ColumnCheck:
     changes: list[str] = field(default_factory=list)
 
     def judged_at(self) -> int | None:
-        """The index of the largest step size at which neither side changes a status (None: none)."""
-        return next((i for i, (p, m) in enumerate(zip(self.plus_smooth, self.minus_smooth)) if p and m), None)
+        """The index of the step size at which the column is judged: among those at which neither side
+        changes a status, the one whose central difference agrees best with the tangent (a wrong tangent
+        disagrees at every step size; a right one agrees better until round-off takes over). None: there is
+        no such step size."""
+        smooth = [i for i, (p, m) in enumerate(zip(self.plus_smooth, self.minus_smooth)) if p and m]
+        return min(smooth, key=lambda i: self.central[i]) if smooth else None
 
 
 def difference_columns(model, u, lam, committed, guess, cols, hs, R0, K, ref) -> list[ColumnCheck]:
@@ -295,25 +300,29 @@ def _rel(err2: float, ref2: float) -> float:
 
 
 def check_tangent(problem, step: int = 1, tangent: str = "exact", columns: int | None = 60, seed: int = 0,
-                  h: float | None = None, solver: str | None = None) -> dict:
-    """Reach ``step`` as a run does (:func:`reach`) and compare the tangent with differences of the residual.
+                  h: float | None = None, solver: str | None = None, run_tangent: str | None = None) -> dict:
+    """Reach ``step`` as a run does (:func:`reach`, with the tangent case ``run_tangent``, default each
+    pair's own) and compare the tangent of case ``tangent`` with differences of the residual there.
 
     ``columns``: how many tangent columns to difference (None: every free dof), chosen by
     :func:`choose_columns`; ``h``: the first step size (default 1e-7 times the largest coordinate, at least
     1e-7), the others ``H_RATIOS`` of it. Returns a dict: ``relative_error`` (over the judged columns, each at
-    the largest step size at which neither side of it changes a status, Frobenius norm over the free rows),
+    :meth:`ColumnCheck.judged_at`, Frobenius norm over the free rows),
     ``converged`` (the run reached the step; else ``reason``), ``step``, ``stage``, ``load_factor``,
     ``columns``, ``judged``, ``kinks`` (one entry per column whose perturbation at the first step size
     changes a status: dof, label, what changed, the step size it was judged at or None), ``by_step_size``
     (relative errors of the central, forward and backward differences over the columns smooth at every step
     size), ``worst`` (the columns with the largest errors) and ``residual_norm`` of the checked state.
     """
-    reached = reach(problem, step, tangent, solver)
+    reached = reach(problem, step, run_tangent, solver)
     base = {"step": step, "stage": reached.stage, "load_factor": reached.lam, "converged": reached.converged}
     if not reached.converged:
         return {**base, "relative_error": float("nan"), "columns": 0, "reason": reached.reason,
                 "exit_code": reached.exit_code}
-    model, u, lam, committed, guess = reached.model, reached.u, reached.lam, reached.committed, reached.guess
+    u, lam, committed, guess = reached.u, reached.lam, reached.committed, reached.guess
+    # the state is checked with the tangent case asked for, whatever case the run solved with
+    model = Model(problem, tangent=tangent)
+    model.set_stage(committed)
     model.begin_step()
     R0, K, trial = model.evaluate(u, lam, committed, guess, want_K=True)
     ref = statuses(model, trial)
@@ -387,7 +396,7 @@ def report_lines(rep: dict, tol: float) -> list[str]:
     kinks = rep["kinks"]
     if kinks:
         lines.append(f"kinks: {len(kinks)} column(s) whose perturbation by h = {rep['h'][0]:.2e} changes a status "
-                     "(judged at the largest step size that changes none, else left out of the verdict):")
+                     "(judged at a step size that changes none, else left out of the verdict):")
         for k in kinks[:LISTED]:
             how = (f"judged at h = {k['judged_at']:.1e}: {k['error']:.2e}" if k["judged_at"] is not None else
                    "at the kink" + (f"; {k['one_sided']['side']} difference at h = {k['one_sided']['h']:.1e}: "
