@@ -48,6 +48,7 @@ class Reached:
     converged: bool = True
     reason: str = ""
     exit_code: int = 0
+    cutbacks: int = 0  # the cutbacks the run made up to and in the step
 
 
 class _Probe:
@@ -102,7 +103,8 @@ def reach(problem, step: int, tangent: str | None = None, solver: str | None = N
         return Reached(res.model, step, names[step - 1], float("nan"), converged=False, reason=why,
                        exit_code=res.exit_code or 1)
     u, lam, committed, trial = probe.last
-    return Reached(res.model, step, names[step - 1], lam, u, committed, trial)
+    return Reached(res.model, step, names[step - 1], lam, u, committed, trial,
+                   cutbacks=sum(int(e.get("cutbacks", 0)) for e in steps))
 
 
 # statuses ------------------------------------------------------------------------------------------------
@@ -315,7 +317,8 @@ def check_tangent(problem, step: int = 1, tangent: str = "exact", columns: int |
     size), ``worst`` (the columns with the largest errors) and ``residual_norm`` of the checked state.
     """
     reached = reach(problem, step, run_tangent, solver)
-    base = {"step": step, "stage": reached.stage, "load_factor": reached.lam, "converged": reached.converged}
+    base = {"step": step, "stage": reached.stage, "load_factor": reached.lam, "converged": reached.converged,
+            "cutbacks": reached.cutbacks}
     if not reached.converged:
         return {**base, "relative_error": float("nan"), "columns": 0, "reason": reached.reason,
                 "exit_code": reached.exit_code}
@@ -387,7 +390,8 @@ def report_lines(rep: dict, tol: float) -> list[str]:
                         f"--tangent exact)"))
     z = rep["zones"]
     lines.append("columns: " + ", ".join(f"{v} {k}" for k, v in z.items()) + f"; residual of the state "
-                 f"{rep['residual_norm']:.2e} (force scale {rep['force_scale']:.2e})")
+                 f"{rep['residual_norm']:.2e} (force scale {rep['force_scale']:.2e}); reached after "
+                 f"{rep['cutbacks']} cutback(s)")
     lines.append(f"differences over the {rep['smooth_columns']} columns that change no status at any step size "
                  "(relative error):")
     lines.append(f"  {'h':>10}  {'central':>10}  {'forward':>10}  {'backward':>10}")
