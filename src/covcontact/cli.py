@@ -125,7 +125,7 @@ def cmd_run(args) -> int:
     _check_solver(args.solver or problem.solver.linear)
     started = args.ranks == "auto"
     if started:  # one rank per core where auto picks petsc-gamg (solvers/run.py auto_ranks), else this process
-        from .solvers.run import auto_ranks
+        from .solvers.choice import auto_ranks
 
         args.ranks = auto_ranks(problem, args.solver, args.out, args.resume)
     if args.ranks != 1:
@@ -154,8 +154,8 @@ def _run_ranks(args, problem, started: bool = False) -> int:
         ranks_from_env,
         threads_per_rank,
     )
+    from .solvers.choice import auto_line, check_distributable, requested_linear, resolve_linear
     from .solvers.linear import available
-    from .solvers.run import auto_line, check_distributable, requested_linear, resolve_linear
     from .solvers.signals import StopSignals
 
     n = args.ranks
@@ -292,8 +292,8 @@ def _ranks_info() -> str:
     """What ``--ranks auto`` may start here: its thread budget, whether mpiexec and the PETSc solvers are there."""
     import shutil
 
+    from .solvers.choice import AUTO_DOFS_PER_RANK, thread_budget
     from .solvers.linear import available
-    from .solvers.run import AUTO_DOFS_PER_RANK, thread_budget
 
     budget = thread_budget()
     missing = [what for what, ok in (("mpiexec on the PATH", shutil.which("mpiexec") is not None),

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .observer import Observer
 from .solvers.model import Model
 from .solvers.state import State
 
@@ -51,15 +52,22 @@ class Reached:
     cutbacks: int = 0  # the cutbacks the run made up to and in the step
 
 
-class _Probe:
-    """Stops a run after ``step`` and keeps the last converged increment of that step."""
+class _Probe(Observer):
+    """An observer that stops a run after ``step`` and keeps the last converged increment of that step."""
 
     def __init__(self, step: int):
         self.step = step
         self.last = None
 
+    def increment_started(self, run, step: int, lam: float) -> None:
+        run.newton.on_converged = self.increment if step == self.step else None
+
     def increment(self, u, lam_a, lam_b, committed, trial) -> None:
         self.last = (u.copy(), lam_b, committed, trial)
+
+    def increment_converged(self, run, inc) -> None:
+        if inc.step == self.step:
+            run.request_stop("stopped")
 
 
 def stage_steps(problem) -> list[tuple[str, int]]:
@@ -71,10 +79,10 @@ def stage_steps(problem) -> list[tuple[str, int]]:
 def serial_solver(problem, solver: str | None) -> str | None:
     """The linear solver of the check's run: the run's own, unless it would distribute the model over MPI
     ranks (the check differences the serial model): then the first direct solver."""
-    from .solvers.run import _distributes, resolve_linear
+    from .solvers.choice import distributes, resolve_linear
 
     name = resolve_linear(problem, solver, ranks=1)
-    return "auto" if _distributes(name) else solver
+    return "auto" if distributes(name) else solver
 
 
 def reach(problem, step: int, tangent: str | None = None, solver: str | None = None) -> Reached:
@@ -94,7 +102,7 @@ def reach(problem, step: int, tangent: str | None = None, solver: str | None = N
     probe = _Probe(step)
     with tempfile.TemporaryDirectory() as tmp:
         res = solve_problem(prob, out=tmp, tangent=tangent, quiet=True, linear=serial_solver(problem, solver),
-                            probe=probe)
+                            observers=[probe])
     steps = res.summary["steps"]
     if probe.last is None or res.exit_code != 0 or not steps or steps[-1]["step"] != step:
         last = steps[-1] if steps else {}

@@ -51,7 +51,7 @@ def block_system(n: int = 10):
         dirichlet=[Dirichlet("cube", "xmin", (0, 1, 2), (0.0, 0.0, 0.0))],
         forces=[NodalForce("cube", "xmax", (0.0, 0.3, -1.0), "total")],
     )
-    system = System(problem)
+    system = System(problem.bodies, problem.rigid, problem.loads, problem.dirichlet)
     body = SolidBody("hex8", mesh.points, mesh.cells, material)
     P = Pattern(body.n_nodes, [mesh.cells])
     data = P.zeros()

@@ -12,8 +12,8 @@ import pytest
 from covcontact.cli import main
 from covcontact.parallel import launcher
 from covcontact.parallel.launcher import threads_per_rank
-from covcontact.solvers import run as run_mod
-from covcontact.solvers.run import AUTO_DOFS_PER_RANK, auto_ranks, checkpoint_ranks, thread_budget
+from covcontact.solvers import choice as run_mod
+from covcontact.solvers.choice import AUTO_DOFS_PER_RANK, auto_ranks, checkpoint_ranks, thread_budget
 
 
 def _problem(dofs: int, linear: str | None = None):

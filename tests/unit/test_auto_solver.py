@@ -10,8 +10,8 @@ import pytest
 from covcontact.materials import NeoHooke, SaintVenantKirchhoff
 from covcontact.mesh.generators import block, plate
 from covcontact.problem import Body, ContactPair, Problem, RigidBody, SolverOptions
+from covcontact.solvers.choice import AUTO_AMG_DOFS, auto_amg, resolve_linear
 from covcontact.solvers.linear import available
-from covcontact.solvers.run import AUTO_AMG_DOFS, auto_amg, resolve_linear
 
 
 def problem(n: int, **body) -> Problem:

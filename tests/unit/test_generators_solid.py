@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from covcontact.fem.quadrature import gauss_hex
-from covcontact.io.loader import _generators
+from covcontact.io.bodies_input import mesh_generators
 from covcontact.mesh import boundary_faces, check_orientation, face_normals, jacobian_determinants
 from covcontact.mesh.generators_solid import half_cylinder_solid
 
@@ -102,7 +102,7 @@ def test_grading_pulls_nodes_to_the_lowest_line():
 
 
 def test_loader_collects_the_generator():
-    gens = _generators()
+    gens = mesh_generators()
     assert gens["half_cylinder_solid"] is half_cylinder_solid and "block" in gens
 
 

@@ -15,6 +15,7 @@ from numba import njit
 from ..elements.solid import SolidBody
 from ..fem.quadrature import default_rule
 from ..fem.shapes import shape_functions
+from ..loads import NodalForce, Pressure
 from .pattern import Pattern
 
 
@@ -91,13 +92,16 @@ def face_load_vector(X: np.ndarray, faces: np.ndarray, area_only: bool = False) 
 
 
 class System:
-    """Global arrays of a problem's deformable bodies, their loads and Dirichlet conditions."""
+    """Global arrays of deformable bodies, their loads and Dirichlet conditions, and the reference nodes of
+    the rigid bodies with free components: ``System(bodies, rigid, loads, dirichlet)`` (``covcontact.problem``
+    Body and RigidBody, ``covcontact.loads`` NodalForce / Pressure / Traction and Dirichlet)."""
 
-    def __init__(self, problem):
-        self.problem = problem
+    def __init__(self, bodies, rigid=(), loads=(), dirichlet=()):
+        self.bodies = {b.name: b for b in bodies}
+        self.loads, self.dirichlet = list(loads), list(dirichlet)
         self.blocks: list[BodyBlock] = []
         offset = 0
-        for body in problem.bodies:
+        for body in bodies:
             if body.formulation == "solid-shell":
                 from ..elements.solidshell import SolidShellBody
 
@@ -113,28 +117,28 @@ class System:
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
             offset += body.mesh.n_nodes
         self.n_deformable = offset
-        self.reference = self._reference_nodes(problem, offset)
+        self.reference = self._reference_nodes(rigid, offset)
         self.n_nodes = offset + 2 * len(self.reference)
         self.n_dofs = 3 * self.n_nodes
         self.X = np.zeros((self.n_nodes, 3))
-        for blk, body in zip(self.blocks, problem.bodies):
+        for blk, body in zip(self.blocks, bodies):
             self.X[blk.offset: blk.offset + blk.n_nodes] = body.mesh.points
         for ref in self.reference:
             self.X[ref.A] = ref.origin
         pairs = [np.array([[ref.A, ref.B] for ref in self.reference], dtype=np.int64)] if self.reference else []
         self.pattern = Pattern(self.n_nodes, [body.mesh.cells + blk.offset
-                                              for blk, body in zip(self.blocks, problem.bodies)] + pairs)
+                                              for blk, body in zip(self.blocks, bodies)] + pairs)
         self._build_loads()
         self._build_dirichlet()
 
     @staticmethod
-    def _reference_nodes(problem, offset: int) -> list:
+    def _reference_nodes(rigid, offset: int) -> list:
         """The reference-node pairs (A: translation, B: rotation vector) of rigid bodies with free components,
         numbered after the deformable nodes."""
         from ..contact.reference import ReferenceBody
 
         out = []
-        for rb in problem.rigid:
+        for rb in rigid:
             if rb.free:
                 A = offset + 2 * len(out)
                 out.append(ReferenceBody(rb.name, A, A + 1, rb.reference_point(), tuple(rb.free),
@@ -149,15 +153,13 @@ class System:
         raise KeyError(body)
 
     def global_nodes(self, body: str, set_name: str) -> np.ndarray:
-        mesh = self.problem.body(body).mesh
+        mesh = self.bodies[body].mesh
         return mesh.node_sets[set_name] + self.offset(body)
 
     # -- loads ----------------------------------------------------------------------------------
     def load_vector(self, load, value=None) -> np.ndarray:
         """External force vector (n_dofs,) of one load (NodalForce, Pressure or Traction) with its value
         replaced by ``value`` (default: its own)."""
-        from ..problem import NodalForce, Pressure
-
         value = np.asarray(load.value if value is None else value, dtype=float)
         f = np.zeros((self.n_nodes, 3))
         if isinstance(load, NodalForce):
@@ -166,7 +168,7 @@ class System:
                 value = value / len(nodes)
             np.add.at(f, nodes, value[None, :])
             return f.ravel()
-        mesh = self.problem.body(load.body).mesh
+        mesh = self.bodies[load.body].mesh
         faces = mesh.face_sets[load.set]
         off = self.offset(load.body)
         if isinstance(load, Pressure):
@@ -177,7 +179,7 @@ class System:
 
     def _build_loads(self) -> None:
         f = np.zeros(self.n_dofs)
-        for load in [*self.problem.forces, *self.problem.pressures, *self.problem.tractions]:
+        for load in self.loads:
             f += self.load_vector(load)
         self.f_ext = f
 
@@ -185,7 +187,7 @@ class System:
     def _build_dirichlet(self) -> None:
         """The dofs of the first stage's Dirichlet conditions (their values: ``covcontact.solvers.stages``)."""
         constrained = np.zeros(self.n_dofs, dtype=bool)
-        for bc in self.problem.dirichlet:
+        for bc in self.dirichlet:
             nodes = self.global_nodes(bc.body, bc.set)
             constrained[(3 * nodes[:, None] + np.asarray(bc.components)[None, :]).ravel()] = True
         self.set_constraints(constrained)

@@ -393,8 +393,10 @@ class ContactManager:
     def point_data(self, n_nodes: int, state: ContactState) -> dict:
         return report.point_data(self, n_nodes, state)
 
-    def visual(self, lam: float, state: ContactState):
-        return report.visual(self, lam, state)
+    def node_fields(self, state: ContactState):
+        """(gap, pressure, status) over the extended node numbering (deformable nodes, then the nodes of rigid
+        meshes), for the result files."""
+        return report.node_fields(self, self.num.n_ext, state)
 
 
 __all__ = ["CASE_A", "ContactEvaluation", "ContactManager"]

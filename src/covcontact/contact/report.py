@@ -92,13 +92,6 @@ def point_data(manager, n_nodes: int, state: ContactState) -> dict:
     return {"gap": gap[:n_nodes], "contact_pressure": pressure[:n_nodes], "contact_status": status[:n_nodes]}
 
 
-def visual(manager, lam: float, state: ContactState):
-    """Rigid bodies for the VTU files: points, cell blocks and point data of the appended points."""
-    from ..io.rigid_visual import rigid_visual
-
-    return rigid_visual(manager, lam, node_fields(manager, manager.num.n_ext, state))
-
-
 def start_warnings(manager, x: np.ndarray, state: ContactState, names: dict[str, str]) -> list[str]:
     """Warnings about a set-up that is legal but almost certainly wrong: most slave nodes of a pass start
     inside the master (deeper than 1 % of their typical spacing: touching is fine), as an analytic surface

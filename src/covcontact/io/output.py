@@ -70,15 +70,18 @@ class ResultWriter:
         self.pvd_entries.append((time_value, name))
         self._write_pvd()
 
-    def restore(self, pvd_entries: list, step: int) -> None:
-        """Continue the files of an earlier run at the end of ``step`` (resume from a checkpoint): the
-        VTU series ``pvd_entries`` of the checkpoint, the iterations of steps up to ``step``."""
+    def restore_series(self, pvd_entries: list) -> None:
+        """Continue the VTU series of an earlier run (resume from a checkpoint): the checkpoint's
+        ``pvd_entries``; VTU files written after it are removed."""
         self.pvd_entries = [(float(t), str(f)) for t, f in pvd_entries]
         kept = {f for _, f in self.pvd_entries}
         for path in self.out.glob("step_*.vtu"):
             if path.name not in kept:
                 path.unlink()
         self._write_pvd()
+
+    def restore_iterations(self, step: int) -> None:
+        """Continue convergence.csv of an earlier run at the end of ``step``: the iterations of steps up to it."""
         csv = self.out / "convergence.csv"
         if csv.is_file():
             rows = csv.read_text().splitlines()[1:]

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .loader import _COMPONENT_NAMES, _dirichlet_values, _motion, _steps, _strs
+from .fields import COMPONENT_NAMES, dirichlet_values, names, read_motion, read_steps
 from .validate import Section, suggest
 
 
@@ -26,12 +26,12 @@ def named_conditions(top: Section, dirichlet, forces, pressures, tractions) -> d
 
 def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, first: str):
     """One ``[[stages]]`` entry, checked against the conditions, loads, bodies and pairs it names."""
-    from ..problem import Stage
+    from ..description import Stage
 
     name = st.get("name", "str")
     if name == first or any(x.name == name for x in earlier):
         st.fail(f"duplicate stage name {name!r}", "name")
-    steps = _steps(st.get("steps", "table", None))
+    steps = read_steps(st.get("steps", "table", None))
     released_before = {n: x.name for x in earlier for n in x.release}
 
     def check_name(sec: Section, key: str, value: str, kinds: tuple[str, ...], what: str) -> tuple[str, object]:
@@ -43,7 +43,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                      f"stays free", key)
         return named[value]
 
-    release = _strs(st, "release")
+    release = names(st, "release")
     pair_names = {c.name for c in contacts}
     pair_on = {c.name: bool(c.enabled) for c in contacts}  # as the stages before leave the pairs
     for x in earlier:
@@ -69,7 +69,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
         check_name(st, "release", n, ("dirichlet",), "Dirichlet condition")
     if len(set(release)) != len(release):
         st.fail("names a condition twice", "release")
-    remove = _strs(st, "remove")
+    remove = names(st, "remove")
     for n in remove:
         check_name(st, "remove", n, ("force", "pressure", "traction", "rigid"), "load")
     targets = {}
@@ -84,7 +84,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
             if kind == "dirichlet":
                 if obj.motion is not None:
                     tsec.fail(f"{n!r} prescribes a motion; give it a new one in 'motions'", n)
-                targets[n] = _dirichlet_values(tsec, n, len(obj.components))
+                targets[n] = dirichlet_values(tsec, n, len(obj.components))
             elif kind == "pressure":
                 targets[n] = tsec.get(n, "float")
             elif kind == "rigid":  # the force (a vector) or {force, moment} of a rigid body with free components
@@ -101,7 +101,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                     bad = [i for i in range(3) if vec[i] != 0.0 and base + i not in obj.free]
                     if bad:
                         tsec.fail(f"{key} {'xyz'[bad[0]]} component given, but rigid body {n!r} is moved in "
-                                  f"{_COMPONENT_NAMES[base + bad[0]]!r}", n)
+                                  f"{COMPONENT_NAMES[base + bad[0]]!r}", n)
             else:
                 targets[n] = tsec.get(n, "vector")
         tsec.done()
@@ -121,7 +121,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
             if n in released_before:
                 msec.fail(f"{n!r} was released in stage {released_before[n]!r}; a released condition stays "
                           f"free", n)
-            motions[n] = _motion(msec.get(n, "table"))
+            motions[n] = read_motion(msec.get(n, "table"))
             body = next((r for r in rigid if r.name == n), None)
             if body is not None and body.free and (np.any(motions[n].rotation != 0.0)
                                                    or n in targets):

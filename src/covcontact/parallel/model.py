@@ -209,12 +209,14 @@ class DistributedSystem(System):
     only the nodes of local elements.
     """
 
-    def __init__(self, problem, comm):
-        self.problem = problem
+    def __init__(self, bodies, loads, dirichlet, comm):
+        bodies = list(bodies)
+        self.bodies = {b.name: b for b in bodies}
+        self.loads, self.dirichlet = list(loads), list(dirichlet)
         self.comm = comm
         rank, size = comm.rank, comm.size
         offsets, offset = [], 0
-        for body in problem.bodies:
+        for body in bodies:
             offsets.append(offset)
             offset += body.mesh.n_nodes
         self.n_nodes = offset
@@ -222,16 +224,16 @@ class DistributedSystem(System):
         self.reference = []  # rigid bodies with reference nodes are refused in distributed runs
         self.n_dofs = 3 * offset
         self.X = np.zeros((self.n_nodes, 3))
-        for off, body in zip(offsets, problem.bodies):
+        for off, body in zip(offsets, bodies):
             self.X[off: off + body.mesh.n_nodes] = body.mesh.points
-        cells = [body.mesh.cells + off for off, body in zip(offsets, problem.bodies)]
+        cells = [body.mesh.cells + off for off, body in zip(offsets, bodies)]
         centroids = np.vstack([self.X[c].mean(axis=1) for c in cells])
         weights = np.concatenate([np.full(len(c), float(c.shape[1]) ** 2) for c in cells])
         part = rcb(centroids, weights, size)
         parts = np.split(part, np.cumsum([len(c) for c in cells])[:-1])
         self.blocks: list[BodyBlock] = []
         local_cells = []
-        for off, body, p in zip(offsets, problem.bodies, parts):
+        for off, body, p in zip(offsets, bodies, parts):
             elements = np.flatnonzero(p == rank)
             local = _make_body(body, body.mesh.cells[elements])
             self.blocks.append(BodyBlock(body.name, off, body.mesh.n_nodes,
@@ -312,7 +314,7 @@ class DistributedModel(Model):
         self.rank, self.size = comm.rank, comm.size
         self.threads = share_cores(comm)
         self.problem = problem
-        self.system = DistributedSystem(problem, comm)
+        self.system = DistributedSystem(problem.bodies, problem.loads, problem.dirichlet, comm)
         self.tangent = tangent
         from .contact import DistributedContact
 

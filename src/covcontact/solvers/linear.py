@@ -20,10 +20,11 @@ records the time of its last analysis, factorisation and solve, checks the resid
 and raises ``SingularMatrixError`` for a singular matrix or a non-finite solution.
 
 The backend classes live in :mod:`covcontact.solvers.backends` and, for PARDISO and PETSc, in
-:mod:`covcontact.solvers.pardiso_backend` and :mod:`covcontact.solvers.petsc_backend` (imported on first use,
-and re-exported here: ``from covcontact.solvers.linear import PardisoSolver`` works). A new backend is a
-:class:`LinearSolver` subclass with a static ``probe()`` in its own module of this package, registered by
-one :data:`REGISTRY` entry, e.g. ``"petsc": Backend("petsc_backend", "PetscSolver", auto=False)``.
+:mod:`covcontact.solvers.pardiso_backend` and :mod:`covcontact.solvers.petsc_backend`. They import this module
+(the base class); this module knows them by name only and imports the one asked for on first use, so there
+is no import cycle. A new backend is a :class:`LinearSolver` subclass with a static ``probe()`` in its own
+module of this package, registered by one :data:`REGISTRY` entry, e.g. ``"petsc": Backend("petsc_backend",
+"PetscSolver", auto=False)``.
 """
 
 from __future__ import annotations
@@ -32,15 +33,10 @@ import importlib
 import time
 from dataclasses import dataclass
 from functools import cache
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
-
-if TYPE_CHECKING:  # re-exported lazily by __getattr__ (the backend modules import this module)
-    from .backends import AMGSolver, CholmodSolver, MumpsSolver, SuperLUSolver  # noqa: F401
-    from .pardiso_backend import PardisoSolver  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -73,18 +69,6 @@ REGISTRY: dict[str, Backend] = {
 }
 BACKENDS = tuple(REGISTRY)
 _DIRECT = tuple(name for name, b in REGISTRY.items() if b.auto)
-#: names re-exported from the backend modules, and their module
-_REEXPORT = {**dict.fromkeys(("AMGSolver", "CholmodSolver", "MumpsSolver", "SuperLUSolver"), "backends"),
-             **dict.fromkeys(("PardisoSolver", "_PARDISO_ERRORS", "_pardiso_function", "_upper_structure"),
-                             "pardiso_backend")}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _REEXPORT:
-        return getattr(importlib.import_module(f".{_REEXPORT[name]}", __package__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 class LinearSolverError(RuntimeError):
     """A linear solve failed (bad input, backend error, or no convergence)."""
 
@@ -287,18 +271,17 @@ def _column_sums(X):  # pragma: no cover - compiled
     return out
 
 
-def rigid_body_basis(coords: np.ndarray, comm=None) -> np.ndarray:
+def rigid_body_basis(coords: np.ndarray, sum_ranks=None) -> np.ndarray:
     """An orthonormal basis (3 m, 6) of the :func:`rigid_body_modes` at ``coords`` (m, 3), on a distributed run
-    this rank's share of the nodes (``comm``: the ranks' mpi4py communicator), rows x, y, z interleaved, the
-    same bits on every run: the modes about the centroid of all ranks' nodes, orthonormalised by Gram-Schmidt
-    twice over with every sum taken in a fixed order, here and over the ranks through rank 0
-    (parallel.comm.sum_all). (PETSc's MatNullSpaceCreateRigidBody sums with BLAS, whose rounding depends on
-    where its vectors lie in memory: its modes, and with them GAMG's hierarchy, differed in the last bit
-    between runs of the same problem.)"""
-    from ..parallel.comm import sum_all
+    this rank's share of the nodes (``sum_ranks``: the sum of an array over the ranks, in a fixed order, e.g.
+    parallel.comm.sum_all), rows x, y, z interleaved, the same bits on every run: the modes about the centroid
+    of all ranks' nodes, orthonormalised by Gram-Schmidt twice over with every sum taken in a fixed order.
+    (PETSc's MatNullSpaceCreateRigidBody sums with BLAS, whose rounding depends on where its vectors lie in
+    memory: its modes, and with them GAMG's hierarchy, differed in the last bit between runs of the same
+    problem.)"""
 
     def total(a: np.ndarray) -> np.ndarray:
-        return sum_all(comm, a) if comm is not None else np.asarray(a, dtype=np.float64)
+        return sum_ranks(a) if sum_ranks is not None else np.asarray(a, dtype=np.float64)
 
     # one layout: numpy's reductions in rigid_body_modes add in an order that depends on it
     X = np.ascontiguousarray(coords, dtype=np.float64)
@@ -421,6 +404,13 @@ class LinearSolver:
 
     def restore_history(self, arrays: dict[str, np.ndarray]) -> None:
         """The ``history`` of a checkpoint, for the factorisations to come."""
+
+    def checkpoint(self) -> tuple[dict, dict]:
+        """This solver's part of a checkpoint (``covcontact.observer.Checkpointed``): its history."""
+        return self.history(), {}
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        self.restore_history({k: v for k, v in arrays.items() if k.startswith("linear.")})
 
     def reuse_pays(self) -> bool:
         """Whether the factorisation of the last analysed pattern costs enough forward and backward

@@ -30,7 +30,7 @@ class Model:
 
     def __init__(self, problem, tangent: str | None = None):
         self.problem = problem
-        self.system = System(problem)
+        self.system = System(problem.bodies, problem.rigid, problem.loads, problem.dirichlet)
         self.tangent = tangent
         self.contact = ContactManager(problem, self.system, tangent)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
@@ -111,6 +111,18 @@ class Model:
         from .linear import rigid_body_modes
 
         return rigid_body_modes(self.system.X, self.system.constrained)
+
+    # checkpoints ------------------------------------------------------------------------------
+    def checkpoint(self) -> tuple[dict, dict]:
+        """The model's part of a checkpoint: the contact couplings met so far (the tangent's sparsity pattern,
+        which a resumed run rebuilds alike)."""
+        coupling = getattr(self, "coupling", None)
+        return (coupling.arrays() if coupling is not None else {}), {}
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        coupling = getattr(self, "coupling", None)
+        if coupling is not None:
+            coupling.restore({k: v for k, v in arrays.items() if k.startswith("coupling.")})
 
     # state ------------------------------------------------------------------------------------
     def initial_state(self) -> State:

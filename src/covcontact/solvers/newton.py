@@ -103,6 +103,22 @@ class Newton:
         #: load factors, the committed state it started from and its converged trial (check-tangent's probe)
         self.on_converged = None
 
+    # checkpoints -------------------------------------------------------------------------------
+    def checkpoint(self) -> tuple[dict, dict]:
+        """Newton's part of a checkpoint: the largest force scale met, and the last step's increment where the
+        extrapolating predictor continues from it."""
+        arrays, meta = {}, {"force_scale": self.scale_seen, "last_step_lams": None}
+        if self._last is not None and self.opt.predictor == "extrapolate":
+            arrays["newton.last_increment"] = self._last[2]
+            meta["last_step_lams"] = [self._last[0], self._last[1]]
+        return arrays, meta
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        self.scale_seen = float(meta.get("force_scale", 0.0))
+        last = arrays.get("newton.last_increment")
+        if last is not None and meta.get("last_step_lams"):
+            self._last = (*(float(v) for v in meta["last_step_lams"]), np.array(last))
+
     # ------------------------------------------------------------------------------------------
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
         return self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=self.timing)

@@ -148,6 +148,13 @@ class PetscSolver(LinearSolver):
     distributed = True
 
     @staticmethod
+    def run_strategy():
+        """The strategy of a run on this solver: the distributed model, one share per MPI rank."""
+        from ..parallel.run import DistributedRun
+
+        return DistributedRun()
+
+    @staticmethod
     def probe() -> tuple[bool, str, str]:
         P = petsc()
         if not P.Sys.hasExternalPackage("mumps"):
@@ -472,7 +479,9 @@ class PetscGAMGSolver(PetscSolver):
             return
         # the rigid-body modes, orthonormalised the same way on every run (rigid_body_basis); PETSc's own
         # MatNullSpaceCreateRigidBody gave modes that differed in the last bit from run to run
-        basis = rigid_body_basis(coords, K.comm)
+        from ..parallel.comm import sum_all
+
+        basis = rigid_body_basis(coords, lambda a: sum_all(K.comm, a))
         self._near_columns = [np.ascontiguousarray(basis[:, k]) for k in range(basis.shape[1])]
         vecs = [P.Vec().createWithArray(col, size=(col.size, P.DECIDE), bsize=3, comm=self._op.comm)
                 for col in self._near_columns]

@@ -1,0 +1,202 @@
+"""The ``[[bodies]]`` section: deformable bodies, their meshes (generated or read), node sets given in the
+input and materials (docs/input.md)."""
+
+from __future__ import annotations
+
+import inspect
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..description import Body
+from .validate import _REQUIRED, InputError, Section, suggest
+
+CELLS = ("hex8", "hex18", "hex27")
+
+
+def mesh_generators() -> dict:
+    """The mesh generators a ``mesh = { generator = NAME }`` may name: name -> function."""
+    from ..mesh import generators, generators_solid
+
+    return {name: fn for mod in (generators, generators_solid) for name, fn in vars(mod).items()
+            if inspect.isfunction(fn) and not name.startswith("_") and fn.__module__ == mod.__name__
+            and "cell" in inspect.signature(fn).parameters}
+
+
+def build_mesh(sec: Section, base: Path, element: str | None):
+    """Mesh from ``generator = ...`` plus its arguments, or ``file = ...`` (read through meshio)."""
+    from ..mesh.io import MeshError, read_mesh
+
+    if sec.has("file") == sec.has("generator"):
+        sec.fail("give exactly one of 'file' or 'generator'")
+    if sec.has("file"):
+        fname = sec.get("file", "str")
+        sec.done()
+        path = (base / fname) if not Path(fname).is_absolute() else Path(fname)
+        if not path.exists():
+            sec.fail(f"mesh file {fname!r} does not exist (looked for {path}; a relative path is taken from the "
+                     f"problem file's folder)", "file")
+        try:
+            mesh = read_mesh(path)
+        except (MeshError, ValueError, KeyError, OSError) as exc:
+            sec.fail(f"cannot read mesh file {path}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}",
+                     "file")
+        if element is not None and mesh.cell_type != element:
+            sec.fail(f"element {element!r} does not match the mesh file's cells ({mesh.cell_type})", "file")
+        return mesh
+    gens = mesh_generators()
+    name = sec.get("generator", "str", choices=tuple(sorted(gens)))
+    fn = gens[name]
+    params = inspect.signature(fn).parameters
+    kwargs = {}
+    for key, value in sec.rest().items():
+        if key not in params or key == "cell":
+            allowed = ", ".join(k for k in params if k != "cell")
+            sec.fail(f"unknown key for generator {name!r}{suggest(key, [k for k in params if k != 'cell'])} "
+                     f"(allowed: {allowed})", key)
+        if isinstance(value, bool) or not isinstance(value, (int, float, str, list)):
+            sec.fail("must be a number, string or array", key)
+        if isinstance(value, list):
+            value = tuple(value)
+        kwargs[key] = value
+    missing = [k for k, p in params.items() if p.default is inspect.Parameter.empty and k not in kwargs
+               and k != "cell"]
+    if missing:
+        sec.fail(f"generator {name!r} needs {', '.join(missing)}")
+    try:
+        return fn(cell=element or "hex8", **kwargs)
+    except (ValueError, TypeError) as exc:
+        sec.fail(f"generator {name!r}: {exc}")
+
+
+HARDENING = {"linear": ("modulus",), "swift": ("K", "eps0", "n"), "voce": ("sigma_inf", "delta", "modulus")}
+
+
+def _hardening(sec: Section) -> dict:
+    law = sec.get("law", "str", choices=tuple(HARDENING))
+    out: dict = {"law": law}
+    for key in HARDENING[law]:
+        optional = law == "voce" and key == "modulus"
+        value = sec.get(key, "float", 0.0 if optional else _REQUIRED)
+        out[key] = value
+    sec.done()
+    return out
+
+
+def read_material(sec: Section):
+    from ..materials import material_from_name
+
+    model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke", "j2"))
+    E = sec.get("E", "float", positive=True)
+    nu = sec.get("nu", "float")
+    if not -1.0 < nu < 0.5:
+        sec.fail(f"must lie in (-1, 0.5), got {nu}", "nu")
+    if model == "j2":
+        from ..materials.plasticity import J2Plasticity
+
+        yield_stress = sec.get("yield_stress", "float", None)
+        hardening = _hardening(sec.get("hardening", "table"))
+        kinematic = sec.get("kinematic_modulus", "float", 0.0, nonnegative=True)
+        hill = None
+        if sec.has("hill48"):
+            h = sec.get("hill48", "table")
+            hill = {k: h.get(k, "float") for k in ("r0", "r45", "r90")}
+            h.done()
+        sec.done()
+        try:
+            return J2Plasticity(E=E, nu=nu, yield_stress=yield_stress, hardening=hardening,
+                                kinematic_modulus=kinematic, hill48=hill)
+        except ValueError as exc:
+            sec.fail(str(exc))
+    sec.done()
+    try:
+        return material_from_name(model, E=E, nu=nu)
+    except ValueError as exc:
+        sec.fail(str(exc))
+
+
+def user_sets(sec: Section | None, mesh) -> None:
+    """Node sets defined in the input: ``sets = { NAME = { box = [[x0, y0, z0], [x1, y1, z1]] } }`` (the nodes
+    inside an axis-aligned box, bounds included), ``{ closest = [x, y, z] }`` or ``{ closest = [[...], ...] }``
+    (the node nearest to each point) or ``{ nodes = [i, j, ...] }`` (node numbers of the mesh, from 0)."""
+    if sec is None:
+        return
+    X = mesh.points
+    for name in list(sec.data):
+        if name in mesh.node_sets:
+            sec.fail(f"a node set {name!r} exists already (from the mesh)", name)
+        d = sec.get(name, "table")
+        given = [k for k in ("box", "closest", "nodes") if d.has(k)]
+        if len(given) != 1:
+            d.fail("give exactly one of 'box', 'closest' or 'nodes'")
+        kind = given[0]
+        raw = d.get(kind, "any")
+        d.done()
+        key = d.key_path(kind)
+        where = f"{d.file}: {key}"
+        if kind == "nodes":
+            if not isinstance(raw, list) or not raw or not all(isinstance(v, int) and not isinstance(v, bool)
+                                                               for v in raw):
+                raise InputError(f"{where}: must be a non-empty array of node numbers")
+            ids = np.asarray(raw, dtype=np.int64)
+            if ids.min() < 0 or ids.max() >= len(X):
+                raise InputError(f"{where}: node numbers must lie in [0, {len(X) - 1}]")
+        else:
+            pts = raw if isinstance(raw, list) and raw and isinstance(raw[0], list) else [raw]
+            ok = all(isinstance(q, list) and len(q) == 3 and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in q)
+                for q in pts)
+            if not ok or (kind == "box" and len(pts) != 2):
+                shape = "two points [[x0, y0, z0], [x1, y1, z1]]" if kind == "box" else \
+                    "a point [x, y, z] or an array of points"
+                raise InputError(f"{where}: must be {shape}")
+            P = np.asarray(pts, dtype=float)
+            if kind == "box":
+                lo, hi = P.min(axis=0), P.max(axis=0)
+                ids = np.flatnonzero(np.all((X >= lo) & (X <= hi), axis=1))
+                if ids.size == 0:
+                    raise InputError(f"{where}: no node lies in the box")
+            else:
+                ids = np.unique(np.argmin(((X[None, :, :] - P[:, None, :]) ** 2).sum(axis=2), axis=1))
+        mesh.node_sets[name] = np.unique(ids).astype(np.int64)
+
+
+def read_bodies(top: Section, base: Path) -> list[Body]:
+    """Every ``[[bodies]]`` entry (at least one); ``base``: the folder mesh files are relative to."""
+    bodies: list[Body] = []
+    for b in top.get("bodies", "array", []):
+        bname = b.get("name", "str")
+        if any(x.name == bname for x in bodies):
+            b.fail(f"duplicate body name {bname!r}", "name")
+        element = b.get("element", "str", None, choices=CELLS)
+        formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell", "fbar"))
+        options = b.get("options", "table", None)
+        options = options.rest() if options is not None else {}
+        material = read_material(b.get("material", "table"))
+        mesh = build_mesh(b.get("mesh", "table"), base, element)
+        user_sets(b.get("sets", "table", None), mesh)
+        b.done()
+        if formulation == "solid-shell":
+            from ..elements.solidshell import check_options
+
+            try:
+                options = check_options(mesh, options)
+            except ValueError as exc:
+                b.fail(str(exc), "options")
+        elif formulation == "fbar":
+            if mesh.cell_type not in ("hex8", "hex27"):
+                b.fail(f"formulation = \"fbar\" needs hex8 or hex27 elements, got {mesh.cell_type}", "formulation")
+            unknown = sorted(set(options) - {"form"})
+            if unknown:
+                b.fail(f"unknown option {unknown[0]!r} for formulation = \"fbar\" (known: form)", "options")
+            if options.get("form", "spatial") not in ("spatial", "variational"):
+                b.fail(f"form must be \"spatial\" or \"variational\", got {options['form']!r}", "options")
+            if mesh.cell_type == "hex27" and options.get("form", "spatial") != "spatial":
+                b.fail("F-bar hex27 has the spatial form only; leave out 'form'", "options")
+        elif options:
+            b.fail("options are only known for formulation = \"solid-shell\" and \"fbar\"", "options")
+        bodies.append(Body(bname, mesh, material, formulation, options))
+    if not bodies:
+        top.fail("at least one [[bodies]] entry is needed")
+    return bodies

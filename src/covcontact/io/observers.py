@@ -1,0 +1,262 @@
+"""The observers that record a run (docs/architecture.md): summary.json, convergence.csv, the VTU series,
+checkpoints, pictures and the progress lines on stderr. Each listens to the run's events
+(``covcontact.observer.Observer``) and keeps its own part of a checkpoint.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+import numpy as np
+
+from ..observer import Observer
+from . import checkpoint
+from .output import ResultWriter, _jsonable
+from .rigid_visual import rigid_visual
+
+
+class Summary(Observer):
+    """summary.json: the run's header, a record per step (the procedure's report), per-stage totals, and at
+    the end the status and the time split. ``writer`` None: kept (a checkpoint holds it) but not written
+    (the ranks other than the first of a distributed run)."""
+
+    def __init__(self, writer: ResultWriter | None):
+        self.writer = writer
+        self.data: dict = {}
+        self.t_before = 0.0  # wall time of the runs before a resume
+
+    def header(self, run) -> None:
+        newton, model, problem = run.newton, run.model, run.problem
+        self.data = {"problem": problem.name, "status": "running", "converged": False, "tangent": run.case,
+                     "dofs": model.n_dofs, "free_dofs": int(model.free.sum()), "linear_solver": newton.linear.name,
+                     **({"units": problem.units} if problem.units else {}),
+                     "total_iterations": 0, "wall_time_s": 0.0, "steps": []}
+        if run.partition is not None:
+            self.data["parallel"] = run.partition
+
+    def started(self, run) -> None:
+        if run.warnings:
+            self.data["warnings"] = list(run.warnings)
+
+    def stage_entered(self, run, procedure, entering: bool) -> None:
+        if not procedure.staged:
+            return
+        spec = procedure.spec
+        stages = self.data.setdefault("stages", [])
+        if not any(st["name"] == spec.name for st in stages):
+            stages.append({"name": spec.name, "index": spec.index, "steps": 0, "iterations": 0, "cutbacks": 0,
+                           "converged": False, "released": list(spec.release_names)})
+
+    def _add(self, inc) -> None:
+        entry = inc.entry
+        self.data["steps"].append(entry)
+        self.data["total_iterations"] += inc.iterations
+        if "stage" in entry:
+            st = next(s for s in self.data["stages"] if s["name"] == entry["stage"])
+            st["steps"] += 1 if entry["converged"] else 0
+            st["iterations"] += entry["iterations"]
+            st["cutbacks"] += entry["cutbacks"]
+            st["converged"] = entry["converged"]
+            if "plastic_dissipation" in entry:
+                st["plastic_dissipation"] = st.get("plastic_dissipation", 0.0) + entry["plastic_dissipation"]
+
+    def increment_converged(self, run, inc) -> None:
+        self._add(inc)
+        self.data["wall_time_s"] = self.t_before + time.perf_counter() - run.t_start
+        self._write()
+
+    def increment_failed(self, run, inc) -> None:
+        self._add(inc)
+
+    def ended(self, run, status: str) -> None:
+        s = self.data
+        s["status"] = status
+        s["converged"] = status == "completed"
+        lin = run.newton.linear
+        if "parallel" in s:
+            s["parallel"]["linear"] = {"analyses": lin.n_analyses, "factorizations": lin.n_factorizations,
+                                       "krylov_iterations": getattr(lin, "krylov_iterations", 0)}
+        precision = lin.precision_report()
+        if precision is not None and precision["single_factorizations"]:
+            s["factorization_precision"] = precision
+        s["timing"] = dict(run.summary_timing)
+        s["wall_time_s"] = self.t_before + run.total_time
+        self._write()
+
+    def _write(self) -> None:
+        if self.writer is not None:
+            self.writer.write_summary(self.data)
+
+    def checkpoint(self) -> tuple[dict, dict]:
+        return {}, {"summary": json.loads(json.dumps(self.data, default=_jsonable)),
+                    "wall_time_s": self.data["wall_time_s"]}
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        self.data = meta["summary"]
+        self.t_before = float(meta.get("wall_time_s", 0.0))
+
+
+class Convergence(Observer):
+    """convergence.csv: every Newton iteration of every step (the failed attempts before cutbacks too)."""
+
+    def __init__(self, writer: ResultWriter):
+        self.writer = writer
+
+    def increment_converged(self, run, inc) -> None:
+        self.writer.add_iterations(inc.step, inc.records)
+
+    increment_failed = increment_converged
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        self.writer.restore_iterations(int(arrays["step.step"]))
+
+
+class Results(Observer):
+    """The VTU series and result.pvd: the start (step 0) and every ``every``-th converged step, the last step
+    of each stage and of the run always. ``writer`` None (the ranks other than the first of a distributed run):
+    the fields are computed (their gathering is collective) but not written."""
+
+    def __init__(self, writer: ResultWriter | None, every: int):
+        self.writer = writer
+        self.every = every
+        self.seconds = 0.0  # time spent writing
+
+    def started(self, run) -> None:
+        self._write(run, 0.0, 0, 0.0)
+
+    def increment_converged(self, run, inc) -> None:
+        k, proc = inc.step, run.procedure
+        if k % self.every == 0 or k == run.n_steps or k == proc.last_step:
+            self._write(run, inc.lam, k, proc.t_stage + inc.lam)
+
+    def _write(self, run, lam: float, step: int, time_value: float) -> None:
+        t0 = time.perf_counter()
+        points, blocks, pdata = result_fields(run.model, run.u, lam, run.state)
+        if self.writer is not None:
+            self.writer.write_vtu(step, time_value, points, blocks, pdata)
+        self.seconds += time.perf_counter() - t0
+
+    def checkpoint(self) -> tuple[dict, dict]:
+        return {}, {"pvd": self.writer.pvd_entries if self.writer is not None else []}
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        if self.writer is not None:
+            self.writer.restore_series(meta["pvd"])
+
+
+def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
+    """(points, cell blocks, point data) of the VTU file of ``state``: the deformable bodies (displacement,
+    Cauchy stress, cell fields, contact gap/pressure/status on slave nodes), then the rigid bodies."""
+    sysm = model.system
+    n = getattr(sysm, "n_deformable", sysm.n_nodes)  # not the reference nodes of rigid bodies
+    U = u.reshape(-1, 3)[:n]
+    cauchy = np.zeros((n, 6))
+    blocks = []
+    for blk, body, est in zip(sysm.blocks, model.problem.bodies, state.elements):
+        sl = slice(blk.offset, blk.offset + blk.n_nodes)
+        st = blk.solid.stress(U[sl], est)
+        cauchy[sl] = st.cauchy_nodal
+        cd = st.cell_data()
+        cd.update(blk.solid.plastic_fields(est))
+        cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
+        blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
+    points = sysm.X[:n].copy()
+    pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
+    extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, model.contact.node_fields(state.contact))
+    pdata.update(model.contact.point_data(n, state.contact) if model.contact.passes else {})
+    if extra_pts is not None and len(extra_pts):
+        m = len(extra_pts)
+        points = np.vstack([points, extra_pts])
+        for key, arr in list(pdata.items()):
+            pad_shape = (m,) + arr.shape[1:]
+            pad = extra_pdata.get(key, np.zeros(pad_shape) if key == "displacement" else np.full(pad_shape, np.nan))
+            pdata[key] = np.concatenate([arr, pad])
+        for ctype, conn, cd in extra_blocks:
+            blocks.append((ctype, conn + n, cd))
+    return points, blocks, pdata
+
+
+class Checkpoints(Observer):
+    """checkpoint.npz after every ``every``-th converged step (the last step of each stage and of the run
+    always): the displacement, the committed state and what every part of the run keeps (``parts``: objects
+    with ``checkpoint()``), per rank of a distributed run."""
+
+    def __init__(self, out, every: int, problem_hash: str, parts: list, rank: int = 0, size: int = 1):
+        self.out, self.every, self.problem_hash = out, every, problem_hash
+        self.parts, self.rank, self.size = parts, rank, size
+
+    def increment_converged(self, run, inc) -> None:
+        k = inc.step
+        if not (k % self.every == 0 or k == run.n_steps or k == run.procedure.last_step):
+            return
+        arrays, meta = {}, {"problem_hash": self.problem_hash}
+        for part in self.parts:
+            a, m = part.checkpoint()
+            arrays.update(a)
+            meta.update(m)
+        checkpoint.save(self.out, run.u, {**run.state.arrays(), **arrays}, meta, self.rank, self.size)
+
+
+class Pictures(Observer):
+    """initial.png / final.png (and the stages' pictures) of a completed run, where the problem asks for them."""
+
+    def __init__(self, out, say):
+        self.out, self.say = out, say
+
+    def ended(self, run, status: str) -> None:
+        if status != "completed":
+            return
+        from .pictures import render_pictures
+
+        for path in render_pictures(self.out):
+            self.say(f"picture {path}")
+
+
+class Progress(Observer):
+    """The lines on stderr: a line per step, the stages, and at the end the time split. Warnings, the
+    resume and an interruption are said even with ``quiet``."""
+
+    def __init__(self, quiet: bool, enabled: bool = True):
+        self.quiet = quiet
+        self.enabled = enabled
+
+    def say(self, msg: str, always: bool = False) -> None:
+        if self.enabled and (always or not self.quiet):
+            print(msg, file=sys.stderr, flush=True)
+
+    def started(self, run) -> None:
+        for w in run.warnings:
+            self.say(f"warning: {w}", always=True)
+
+    def resumed(self, run) -> None:
+        self.say(f"resuming {run.problem.name} after step {run.state.step} (load factor {run.state.lam:.4g})",
+                 always=True)
+
+    def stage_entered(self, run, procedure, entering: bool) -> None:
+        if entering:
+            spec = procedure.spec
+            self.say(f"stage {spec.index + 1}/{run.n_stages} {spec.name!r}"
+                     + (f": releasing {', '.join(spec.release_names)}" if spec.release_names else ""))
+
+    def increment_converged(self, run, inc) -> None:
+        if self.quiet:
+            return
+        # computed on every rank of a distributed run alike (the count is collective), printed by the first
+        active = run.model.active_count(run.state)
+        self.say(("" if not run.procedure.staged else f"stage {run.procedure.spec.name}  ")
+                 + f"step {inc.step:4d}/{run.n_steps}  lambda {inc.lam:.4g}  iterations {inc.iterations:3d}  "
+                 f"residual {inc.residual:.2e}  active {active:5d}"
+                 + (f"  cutbacks {inc.cutbacks}" if inc.cutbacks else "")
+                 + (f"  FAILED: {inc.why}" if not inc.success else ""))
+
+    increment_failed = increment_converged
+
+    def ended(self, run, status: str) -> None:
+        if run.interruption is not None:
+            self.say(f"{run.interruption}: the step in flight is dropped; resume with --resume", always=True)
+        precision = run.newton.linear.precision_report()
+        if precision is not None and precision["single_factorizations"] and "single_given_up" in precision:
+            self.say(f"note: factorising in double precision after a {precision['single_given_up']}")
+        self.say("time: " + "  ".join(f"{k} {v:.2f}s" for k, v in run.summary_timing.items()))

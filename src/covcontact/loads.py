@@ -1,0 +1,55 @@
+"""Boundary conditions and loads on the node and face sets of deformable bodies: the types the problem
+description (``covcontact.problem``) holds and the assembly (``covcontact.assembly``) turns into vectors."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .motion import RigidMotion
+
+
+@dataclass
+class Dirichlet:
+    """Prescribed displacement u_i = lam * value_i on the nodes of ``body``'s node set ``set``.
+
+    With ``motion`` the node set moves rigidly instead, u = motion(X, lam) - X on the given components
+    (``values`` unused). ``name`` lets later stages give new targets or release the condition.
+    """
+
+    body: str
+    set: str
+    components: tuple[int, ...]
+    values: tuple[float, ...]
+    name: str = ""
+    motion: RigidMotion | None = None
+
+
+@dataclass
+class NodalForce:
+    """Force ``lam * value`` on every node of a node set (``per_node``) or spread evenly (``total``)."""
+
+    body: str
+    set: str
+    value: tuple[float, float, float]
+    distribution: str = "per_node"
+    name: str = ""
+
+
+@dataclass
+class Pressure:
+    """Dead pressure ``lam * value`` on a face set (positive pushes against the outward normal)."""
+
+    body: str
+    set: str
+    value: float
+    name: str = ""
+
+
+@dataclass
+class Traction:
+    """Dead traction ``lam * value`` (force per reference area) on a face set."""
+
+    body: str
+    set: str
+    value: tuple[float, float, float]
+    name: str = ""

@@ -1,0 +1,164 @@
+"""Procedures: how a stage is stepped. A run drives one procedure per stage; a procedure advances the run one
+increment at a time and reports each increment (docs/architecture.md).
+
+``QuasiStatic`` is the load stepping of every stage today: each step goes from the last converged load factor
+to the next one its increment control gives, with Newton and cutbacks (``Newton.advance``). The increment
+control is a small object of its own (``FixedIncrements``: the stage's ``count`` or ``factors``), so that a
+control that chooses its increments from the last ones can take its place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .state import State
+
+
+class FixedIncrements:
+    """The load factors of a stage as its input gives them (``count`` or ``factors``)."""
+
+    def __init__(self, factors):
+        self.factors = tuple(float(f) for f in factors)
+
+    def __len__(self) -> int:
+        return len(self.factors)
+
+    def target(self, done: int) -> float | None:
+        """The load factor of the stage's step after ``done`` converged ones; None when the stage is done."""
+        return self.factors[done] if done < len(self.factors) else None
+
+
+@dataclass
+class Increment:
+    """One step of a stage as the procedure made it: the step number over the whole run, its load factors,
+    whether it converged (with cutbacks), Newton's outcomes, the committed state after it (the one before it
+    when it failed) and ``entry``, its summary record (docs/input.md, summary.json)."""
+
+    step: int
+    lam_a: float
+    lam: float
+    success: bool
+    outcomes: list
+    cutbacks: int
+    why: str
+    state: State
+    entry: dict = field(default_factory=dict)
+
+    @property
+    def iterations(self) -> int:
+        return sum(o.iterations for o in self.outcomes)
+
+    @property
+    def records(self) -> list:
+        """Newton's iteration records of every attempt of the step, in order."""
+        return [r for o in self.outcomes for r in o.records]
+
+    @property
+    def residual(self) -> float:
+        """The last residual norm of the converged attempt (nan when none converged)."""
+        conv = [o for o in self.outcomes if o.converged]
+        return conv[-1].residual_norms[-1] if conv else float("nan")
+
+
+class QuasiStatic:
+    """Quasi-static load stepping of one stage (``spec``, a ``StageSpec``) of ``model`` with ``newton``.
+
+    ``before``: the steps of the earlier stages, ``t_stage`` their total pseudo-time, ``staged``: the problem
+    has several stages (its records then name the stage and carry the time).
+    """
+
+    name = "static"
+
+    def __init__(self, model, newton, spec, before: int, t_stage: float, staged: bool, control=None):
+        self.model = model
+        self.newton = newton
+        self.spec = spec
+        self.before = before
+        self.t_stage = t_stage
+        self.staged = staged
+        self.control = control if control is not None else FixedIncrements(spec.factors)
+        self.augmented = any(c.method == "augmented" for c in model.problem.contacts)
+        self.work = None
+
+    @property
+    def last_step(self) -> int:
+        """The number, over the whole run, of this stage's last step."""
+        return self.before + len(self.control)
+
+    def start(self, state: State) -> None:
+        """Start, or resume, the stage at the committed ``state`` (its plastic work is the reference of the
+        next step's dissipation)."""
+        self.work = self.model.plastic_work(state)
+
+    def next_step(self, state: State) -> tuple[int, float] | None:
+        """(step number, load factor) of the next increment after ``state``; None when the stage is done."""
+        lam = self.control.target(state.step - self.before)
+        return None if lam is None else (state.step + 1, lam)
+
+    def advance(self, u: np.ndarray, state: State, step: int, lam: float) -> Increment:
+        """Make step ``step`` to load factor ``lam`` from the committed ``state`` (``u`` updated in place to the
+        new committed displacement) and report it."""
+        newton = self.newton
+        stats0, time0 = dict(newton.stats), dict(newton.timing)
+        success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
+        inc = Increment(step, state.lam, lam, success, outcomes, cutbacks, why, new if success else state)
+        inc.entry = self._report(inc, u, stats0, time0)
+        return inc
+
+    def _report(self, inc: Increment, u: np.ndarray, stats0: dict, time0: dict) -> dict:
+        """The summary record of ``inc`` (its model reports computed at the new committed state)."""
+        newton, model = self.newton, self.model
+        conv = [o for o in inc.outcomes if o.converged]
+        entry = {
+            "step": inc.step,
+            "load_factor": inc.lam,
+            "converged": inc.success,
+            "iterations": inc.iterations,
+            "residual_norms": [r / max(o.residual_norms[0], 1e-300) for o in conv[-1:] for r in o.residual_norms]
+            if conv else [],
+            "cutbacks": inc.cutbacks,
+            "factorizations": newton.stats["factorizations"] - stats0["factorizations"],
+            "krylov_iterations": newton.stats["krylov_iterations"] - stats0["krylov_iterations"],
+            "factor_s": round(newton.timing["factor"] - time0["factor"], 6),
+            "krylov_s": round(newton.timing["krylov"] - time0["krylov"], 6),
+        }
+        if self.staged:
+            entry["stage"] = self.spec.name
+            entry["time"] = self.t_stage + inc.lam
+        if self.augmented:
+            entry["uzawa_iterations"] = sum(1 for o in inc.outcomes if o.augmentation > 0)
+        if inc.cutbacks:
+            entry["cutback_reasons"] = [o.reason for o in inc.outcomes if not o.converged]
+        if not inc.success:
+            entry["failure"] = inc.why
+            return entry
+        state, lam = inc.state, inc.lam
+        work = model.plastic_work(state)
+        if work is not None:
+            entry["plastic_dissipation"] = work - self.work
+            entry["plastic_work"] = self.work = work
+        state.step = inc.step
+        entry.update(model.step_report(u, lam, state))
+        entry["reactions"] = reactions(model, u, lam, state)
+        rigid = model.rigid_report(u, lam, state)
+        if rigid:
+            entry["rigid_bodies"] = rigid
+        return entry
+
+
+def reactions(model, u: np.ndarray, lam: float, state: State) -> dict:
+    """The resultant reaction of every Dirichlet condition in force (released ones are left out)."""
+    R, _, _ = model.evaluate(u, lam, state, want_K=False)
+    out = {}
+    held = {c.name for c in model.loading.spec.conditions}
+    for i, bc in enumerate(model.problem.dirichlet):
+        if (bc.name or f"#{i}") not in held:
+            continue
+        nodes = model.system.global_nodes(bc.body, bc.set)
+        total = R.reshape(-1, 3)[nodes].sum(axis=0)
+        comp = np.zeros(3, dtype=bool)
+        comp[list(bc.components)] = True
+        out[f"{bc.body}.{bc.set}"] = np.where(comp, total, 0.0).tolist()
+    return out
