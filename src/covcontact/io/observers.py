@@ -143,7 +143,7 @@ class Results(Observer):
 
     def restore(self, arrays: dict, meta: dict) -> None:
         if self.writer is not None:
-            self.writer.restore_series(meta["pvd"])
+            self.writer.restore_series(meta.get("pvd", []))
 
 
 def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:

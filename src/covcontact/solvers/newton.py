@@ -220,6 +220,34 @@ class Newton:
             a0, f0, a1, f1 = a1, f1, eta, ft
         return eta
 
+    def _predict(self, u: np.ndarray, lam_a: float, lam_b: float, du_d: np.ndarray) -> np.ndarray:
+        """The extrapolating predictor (``predictor = "extrapolate"``, continuing a converged step): the previous
+        increment scaled to this step on the free dofs and the prescribed increment ``du_d`` on the others,
+        added to ``u``; returns the prescribed increment the first correction still has to make (zero then)."""
+        last, free = self._last, self.model.free
+        if (self.opt.predictor == "extrapolate" and last is not None and lam_b > lam_a
+                and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
+            u[free] += (lam_b - lam_a) / (last[1] - last[0]) * last[2][free]
+            u[~free] += du_d[~free]
+            return np.zeros_like(du_d)
+        return du_d
+
+    def _converged(self, rs: list, it: int, r_ref: float, scale_k: float, conv_energy: bool, du_norm: float,
+                   u_norm: float) -> bool:
+        """The convergence test after iteration ``it`` (residual norms ``rs``, the last one's): the criterion,
+        or the round-off floor. The floor: the energy criterion holds and the residual stopped falling; or the
+        residual is below rtol of the force scale, stopped falling for two iterations and the correction
+        (``du_norm``) is at round-off of the solution (a step that starts almost converged, e.g. after the
+        extrapolating predictor, has r_ref and the energy reference themselves at round-off, so neither relative
+        test can hold; a slowly converging step still makes corrections and goes on)."""
+        opt, rn = self.opt, rs[-1]
+        conv_res = rn <= max(opt.rtol * r_ref, opt.atol * scale_k)
+        stalled = it >= 2 and rn >= 0.5 * rs[-2]
+        floor = stalled and (conv_energy or (
+            it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k and du_norm <= 1e-10 * u_norm))
+        conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
+        return conv or floor
+
     # ------------------------------------------------------------------------------------------
     def step(self, u: np.ndarray, lam_a: float, lam_b: float, committed, trial=None):
         """Advance ``u`` in place from lam_a to lam_b, starting from the state ``trial`` (default: the
@@ -233,14 +261,7 @@ class Newton:
             trial = m.start_step(committed)
         else:
             m.begin_step()
-        du_d = m.prescribed(lam_b) - m.prescribed(lam_a)
-        last = self._last
-        if (opt.predictor == "extrapolate" and last is not None and lam_b > lam_a
-                and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
-            # the previous increment scaled to this step on the free dofs, the prescribed increment on the others
-            u[free] += (lam_b - lam_a) / (last[1] - last[0]) * last[2][free]
-            u[~free] += du_d[~free]
-            du_d = np.zeros_like(du_d)
+        du_d = self._predict(u, lam_a, lam_b, m.prescribed(lam_b) - m.prescribed(lam_a))
         R, K, trial = self._evaluate(u, lam_b, committed, trial)
         t0 = time.perf_counter()
         rhs = -R - K @ du_d if np.any(du_d) else -R  # (no product with a zero increment: 0.2 s at 1e6 dofs)
@@ -303,20 +324,8 @@ class Newton:
             if it == 1:
                 r_ref = max(r0, rn)
             scale_k = max(scale, reactions)
-            conv_energy = energy <= opt.etol * e0
-            conv_res = rn <= max(opt.rtol * r_ref, opt.atol * scale_k)
-            # round-off floor: the energy criterion holds and the residual stopped falling; or the residual is
-            # below rtol of the force scale, stopped falling for two iterations and the correction is at
-            # round-off of the solution (a step that starts almost converged, e.g. after the extrapolating
-            # predictor, has r_ref and the energy reference themselves at round-off, so neither relative test
-            # can hold; a slowly converging step still makes corrections and goes on)
-            rs = out.residual_norms
-            stalled = it >= 2 and rn >= 0.5 * rs[-2]
-            floor = stalled and (conv_energy or (
-                it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k
-                and eta * float(np.linalg.norm(du[free])) <= 1e-10 * float(np.linalg.norm(u[free]))))
-            conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
-            if conv or floor:
+            if self._converged(out.residual_norms, it, r_ref, scale_k, energy <= opt.etol * e0,
+                               eta * float(np.linalg.norm(du[free])), float(np.linalg.norm(u[free]))):
                 out.converged = True
                 self.scale_seen = max(self.scale_seen, scale_k)
                 return out, trial

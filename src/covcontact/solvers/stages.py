@@ -134,25 +134,7 @@ class StagePlan:
         for k, st in enumerate(problem.stages, start=1):
             prev = self.stages[-1]
             lam_end = prev.lam_end
-            # what the stage before left
-            new_conds = []
-            released = []
-            for c in prev.conditions:
-                if c.rigid is not None:  # rebuilt from the stage's motions
-                    continue
-                if c.name in st.release:
-                    released.append(c.dofs)
-                    continue
-                start, pose = c.end(lam_end)
-                if c.motion is None:
-                    target = np.asarray(st.targets.get(c.name, start), dtype=float)
-                    if target.shape != start.shape:
-                        target = np.broadcast_to(target, start.shape).astype(float)
-                    new_conds.append(_Condition(c.name, c.nodes, c.components, start, target))
-                else:
-                    m = st.motions.get(c.name)
-                    nm = StagedMotion(m, *pose) if m is not None else StagedMotion.hold(*pose)
-                    new_conds.append(_Condition(c.name, c.nodes, c.components, None, None, nm))
+            new_conds, released = _carried_conditions(prev, st)
             values = {key: values[key] + lam_end * (targets[key] - values[key]) for key in loads}
             targets = dict(values)
             for key in loads:
@@ -174,19 +156,7 @@ class StagePlan:
             rel = np.unique(np.concatenate(released)) if released else np.zeros(0, np.int64)
             spec = self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
                               new_motions, new_contacts, tuple(st.release), st.motions, pairs_released)
-            for name, (f0, f1, m0, m1) in prev.rigid_loads.items():
-                f, m = f0 + lam_end * (f1 - f0), m0 + lam_end * (m1 - m0)
-                if name in st.remove:
-                    spec.rigid_loads[name] = (f, 0.0 * f, m, 0.0 * m)
-                elif name in st.targets:  # a new force, or a table with a new force and/or moment
-                    tgt = st.targets[name]
-                    if isinstance(tgt, dict):
-                        spec.rigid_loads[name] = (f, np.asarray(tgt.get("force", f), dtype=float), m,
-                                                  np.asarray(tgt.get("moment", m), dtype=float))
-                    else:
-                        spec.rigid_loads[name] = (f, np.asarray(tgt, dtype=float), m, m)
-                else:
-                    spec.rigid_loads[name] = (f, f, m, m)
+            spec.rigid_loads = _carried_rigid_loads(prev, st)
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
@@ -231,6 +201,52 @@ class StagePlan:
 
     def __getitem__(self, k: int) -> StageSpec:
         return self.stages[k]
+
+
+def _carried_conditions(prev: StageSpec, st) -> tuple[list[_Condition], list[np.ndarray]]:
+    """The Dirichlet conditions of stage ``st`` from those its previous stage ``prev`` left (values from their
+    end value to the new target or held, motions continued from their pose), and the dofs of those ``st``
+    releases. The conditions of rigid bodies are rebuilt from the stage's motions, not carried."""
+    lam_end = prev.lam_end
+    new_conds, released = [], []
+    for c in prev.conditions:
+        if c.rigid is not None:
+            continue
+        if c.name in st.release:
+            released.append(c.dofs)
+            continue
+        start, pose = c.end(lam_end)
+        if c.motion is None:
+            target = np.asarray(st.targets.get(c.name, start), dtype=float)
+            if target.shape != start.shape:
+                target = np.broadcast_to(target, start.shape).astype(float)
+            new_conds.append(_Condition(c.name, c.nodes, c.components, start, target))
+        else:
+            m = st.motions.get(c.name)
+            nm = StagedMotion(m, *pose) if m is not None else StagedMotion.hold(*pose)
+            new_conds.append(_Condition(c.name, c.nodes, c.components, None, None, nm))
+    return new_conds, released
+
+
+def _carried_rigid_loads(prev: StageSpec, st) -> dict:
+    """The applied force and moment of every reference body in stage ``st``: (force, its target, moment, its
+    target), from where the stage before left them to the stage's new values (removed: zero; else held)."""
+    out = {}
+    lam_end = prev.lam_end
+    for name, (f0, f1, m0, m1) in prev.rigid_loads.items():
+        f, m = f0 + lam_end * (f1 - f0), m0 + lam_end * (m1 - m0)
+        if name in st.remove:
+            out[name] = (f, 0.0 * f, m, 0.0 * m)
+        elif name in st.targets:  # a new force, or a table with a new force and/or moment
+            tgt = st.targets[name]
+            if isinstance(tgt, dict):
+                out[name] = (f, np.asarray(tgt.get("force", f), dtype=float), m,
+                             np.asarray(tgt.get("moment", m), dtype=float))
+            else:
+                out[name] = (f, np.asarray(tgt, dtype=float), m, m)
+        else:
+            out[name] = (f, f, m, m)
+    return out
 
 
 class Loading:
