@@ -232,20 +232,21 @@ def cmd_check_tangent(args) -> int:
 
     problem = load_problem(args.problem)
     stages = stage_steps(problem)
-    total = sum(n for _, n in stages)
-    step = args.step
+    step, stage = args.step, None
     if args.stage is not None:
         names = [n for n, _ in stages]
         if args.stage not in names:
             raise InputError(f"--stage: no stage named {args.stage!r} in {args.problem} (stages: "
                              f"{', '.join(names)})")
-        k = names.index(args.stage)
-        count = stages[k][1]
-        if not 1 <= step <= count:
-            raise InputError(f"--step: stage {args.stage!r} has steps 1 to {count}, got {step}")
-        step += sum(n for _, n in stages[:k])
-    elif step < 0 or step > total:
-        raise InputError(f"--step: must lie between 0 and {total} (the steps of all stages), got {step}")
+        stage = names.index(args.stage)
+        count = stages[stage][1]
+        if step < 1 or (count is not None and step > count):
+            raise InputError(f"--step: stage {args.stage!r} has steps 1 to {count if count is not None else 'N'}, "
+                             f"got {step}")
+    else:
+        total = None if any(n is None for _, n in stages) else sum(n for _, n in stages)
+        if step < 0 or (total is not None and step > total):
+            raise InputError(f"--step: must lie between 0 and {total} (the steps of all stages), got {step}")
     if not args.tol > 0:
         raise InputError(f"--tol: must be > 0, got {args.tol}")
     if args.h is not None and not args.h > 0:
@@ -255,7 +256,7 @@ def cmd_check_tangent(args) -> int:
         raise InputError(f"--columns: a whole number > 0 or `all`, got {args.columns!r}")
     _check_solver(args.solver or problem.solver.linear)
     rep = check_tangent(problem, step=step, tangent=args.tangent, columns=None if cols == "all" else int(cols),
-                        h=args.h, solver=args.solver, run_tangent=args.run_tangent)
+                        h=args.h, solver=args.solver, run_tangent=args.run_tangent, stage=stage)
     for line in report_lines(rep, args.tol):
         print(line)
     if args.json:

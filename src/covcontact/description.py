@@ -93,13 +93,31 @@ class ContactPair:
 
 @dataclass
 class Steps:
-    """Load-factor schedule: ``factors`` are the load factors at the end of each step."""
+    """Load-factor schedule: ``factors`` are the load factors at the end of each step; or, with ``initial``
+    (and ``min``, ``max``), automatic increments of the load factor up to ``factors[-1]`` (the stage's end),
+    chosen as the steps go (docs/input.md, ``[steps]``)."""
 
     factors: tuple[float, ...]
+    initial: float | None = None
+    min: float | None = None
+    max: float | None = None
 
     @classmethod
-    def equal(cls, n: int, final: float = 1.0) -> "Steps":
+    def equal(cls, n: int, final: float = 1.0) -> Steps:
         return cls(tuple(float(final) * (k + 1) / n for k in range(n)))
+
+    @classmethod
+    def automatic(cls, initial: float, min: float, max: float, final: float = 1.0) -> Steps:
+        return cls((float(final),), float(initial), float(min), float(max))
+
+    @property
+    def is_automatic(self) -> bool:
+        return self.initial is not None
+
+    @property
+    def count(self) -> int | None:
+        """The number of steps where it is known beforehand (None: automatic increments)."""
+        return None if self.is_automatic else len(self.factors)
 
 
 @dataclass

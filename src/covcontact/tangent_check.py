@@ -53,27 +53,40 @@ class Reached:
 
 
 class _Probe(Observer):
-    """An observer that stops a run after ``step`` and keeps the last converged increment of that step."""
+    """An observer that stops a run after a step and keeps that step's last converged increment: step ``step``
+    counted over all stages, or with ``stage`` (an index) the ``step``-th step of that stage."""
 
-    def __init__(self, step: int):
-        self.step = step
+    def __init__(self, step: int, stage: int | None = None):
+        self.step, self.stage = step, stage
+        self.in_stage = 0  # steps started in the current stage
+        self.current = -1  # the current stage's index
         self.last = None
+        self.found: tuple[int, str] | None = None  # (step over all stages, stage name) of the step checked
+
+    def stage_entered(self, run, procedure, entering: bool) -> None:
+        self.current, self.in_stage = procedure.spec.index, 0
+
+    def _wanted(self, step: int) -> bool:
+        return step == self.step if self.stage is None else (self.current == self.stage and self.in_stage == self.step)
 
     def increment_started(self, run, step: int, lam: float) -> None:
-        run.newton.on_converged = self.increment if step == self.step else None
+        self.in_stage += 1
+        wanted = self._wanted(step)
+        if wanted:
+            self.found = (step, run.procedure.spec.name)
+        run.newton.on_converged = self.increment if wanted else None
 
     def increment(self, u, lam_a, lam_b, committed, trial) -> None:
         self.last = (u.copy(), lam_b, committed, trial)
 
     def increment_converged(self, run, inc) -> None:
-        if inc.step == self.step:
+        if self._wanted(inc.step):
             run.request_stop("stopped")
 
 
-def stage_steps(problem) -> list[tuple[str, int]]:
-    """(name, number of steps) of every stage of ``problem``, the first stage first."""
-    return [(problem.stage_name, len(problem.steps.factors))] + [(st.name, len(st.steps.factors))
-                                                                 for st in problem.stages]
+def stage_steps(problem) -> list[tuple[str, int | None]]:
+    """(name, number of steps; None where the stage chooses its increments) of every stage, the first first."""
+    return [(problem.stage_name, problem.steps.count)] + [(st.name, st.steps.count) for st in problem.stages]
 
 
 def serial_solver(problem, solver: str | None) -> str | None:
@@ -85,33 +98,40 @@ def serial_solver(problem, solver: str | None) -> str | None:
     return "auto" if distributes(name) else solver
 
 
-def reach(problem, step: int, tangent: str | None = None, solver: str | None = None) -> Reached:
+def reach(problem, step: int, tangent: str | None = None, solver: str | None = None,
+          stage: int | None = None) -> Reached:
     """Run ``problem`` as ``covcontact run`` does up to ``step`` (counted over all stages; 0: the undeformed
-    start) and return the state of its last converged increment. ``tangent``: the run's ``--tangent`` (None:
-    each pair's own case, as ``covcontact run`` without the option)."""
-    names = [n for n, count in stage_steps(problem) for _ in range(count)]
+    start; with ``stage``, an index, the ``step``-th step of that stage) and return the state of its last
+    converged increment. ``tangent``: the run's ``--tangent`` (None: each pair's own case, as ``covcontact
+    run`` without the option)."""
     if step == 0:
         model = Model(problem, tangent=tangent)
         committed = model.initial_state()
-        return Reached(model, 0, names[0] if names else problem.stage_name, 0.0, model.prescribed(0.0),
-                       committed, model.start_step(committed))
+        return Reached(model, 0, problem.stage_name, 0.0, model.prescribed(0.0), committed,
+                       model.start_step(committed))
     from .solvers.run import solve_problem
 
     prob = copy.copy(problem)
     prob.output = replace(problem.output, vtu=False, pictures=False, checkpoint_every=10**9)
-    probe = _Probe(step)
+    probe = _Probe(step, stage)
     with tempfile.TemporaryDirectory() as tmp:
         res = solve_problem(prob, out=tmp, tangent=tangent, quiet=True, linear=serial_solver(problem, solver),
                             observers=[probe])
     steps = res.summary["steps"]
-    if probe.last is None or res.exit_code != 0 or not steps or steps[-1]["step"] != step:
+    number, name = probe.found if probe.found is not None else (step, problem.stage_name)
+    if probe.last is None or res.exit_code != 0 or not steps or steps[-1]["step"] != number:
         last = steps[-1] if steps else {}
-        why = (f"step {last.get('step')} did not converge: {last.get('failure', '')}" if last and
-               not last.get("converged", True) else f"the run ended with status {res.summary['status']!r}")
-        return Reached(res.model, step, names[step - 1], float("nan"), converged=False, reason=why,
+        if last and not last.get("converged", True):
+            why = f"step {last.get('step')} did not converge: {last.get('failure', '')}"
+        elif res.summary["status"] == "completed":
+            where = f"stage {stage_steps(problem)[stage][0]!r}" if stage is not None else "the run"
+            why = f"{where} ends before step {step}"
+        else:
+            why = f"the run ended with status {res.summary['status']!r}"
+        return Reached(res.model, number, name, float("nan"), converged=False, reason=why,
                        exit_code=res.exit_code or 1)
     u, lam, committed, trial = probe.last
-    return Reached(res.model, step, names[step - 1], lam, u, committed, trial,
+    return Reached(res.model, number, name, lam, u, committed, trial,
                    cutbacks=sum(int(e.get("cutbacks", 0)) for e in steps))
 
 
@@ -310,7 +330,8 @@ def _rel(err2: float, ref2: float) -> float:
 
 
 def check_tangent(problem, step: int = 1, tangent: str = "exact", columns: int | None = 60, seed: int = 0,
-                  h: float | None = None, solver: str | None = None, run_tangent: str | None = None) -> dict:
+                  h: float | None = None, solver: str | None = None, run_tangent: str | None = None,
+                  stage: int | None = None) -> dict:
     """Reach ``step`` as a run does (:func:`reach`, with the tangent case ``run_tangent``, default each
     pair's own) and compare the tangent of case ``tangent`` with differences of the residual there.
 
@@ -324,8 +345,8 @@ def check_tangent(problem, step: int = 1, tangent: str = "exact", columns: int |
     (relative errors of the central, forward and backward differences over the columns smooth at every step
     size), ``worst`` (the columns with the largest errors) and ``residual_norm`` of the checked state.
     """
-    reached = reach(problem, step, run_tangent, solver)
-    base = {"step": step, "stage": reached.stage, "load_factor": reached.lam, "converged": reached.converged,
+    reached = reach(problem, step, run_tangent, solver, stage)
+    base = {"step": reached.step, "stage": reached.stage, "load_factor": reached.lam, "converged": reached.converged,
             "cutbacks": reached.cutbacks}
     if not reached.converged:
         return {**base, "relative_error": float("nan"), "columns": 0, "reason": reached.reason,

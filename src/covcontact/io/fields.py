@@ -72,15 +72,33 @@ def names(sec: Section, key: str) -> tuple[str, ...]:
 
 
 def read_steps(sec: Section | None) -> Steps:
-    """A ``[steps]`` table (``count`` and ``final``, or ``factors``); none: one step to 1."""
+    """A ``[steps]`` table: ``count`` (and ``final``), ``factors``, or automatic increments ``initial``, ``min``,
+    ``max`` (and ``final``); none: one step to 1."""
     if sec is None:
         return Steps.equal(1)
+    auto = [k for k in ("initial", "min", "max") if sec.has(k)]
+    fixed = [k for k in ("count", "factors") if sec.has(k)]
+    if auto and fixed:
+        sec.fail(f"give either {' / '.join(fixed)} or automatic increments (initial, min, max), not both", auto[0])
     if sec.has("factors"):
         factors = sec.get("factors", "floats")
         sec.done()
         if not factors or any(b <= a for a, b in zip((0.0,) + factors, factors)):
             sec.fail("must be a non-empty, strictly increasing list of positive load factors", "factors")
         return Steps(factors)
+    if auto:
+        final = sec.get("final", "float", 1.0, positive=True)
+        initial = sec.get("initial", "float", positive=True)
+        lo = sec.get("min", "float", min(initial, 1e-5 * final), positive=True)
+        hi = sec.get("max", "float", final, positive=True)
+        sec.done()
+        if lo > hi:
+            sec.fail(f"min = {lo:g} is above max = {hi:g}; min must not exceed max", "min")
+        if not lo <= initial <= hi:
+            sec.fail(f"must lie between min = {lo:g} and max = {hi:g}, got {initial:g}", "initial")
+        if hi > final:
+            sec.fail(f"must not exceed the stage's final load factor {final:g}, got {hi:g}", "max")
+        return Steps.automatic(initial, lo, hi, final)
     n = sec.get("count", "int", 1, positive=True)
     final = sec.get("final", "float", 1.0, positive=True)
     sec.done()

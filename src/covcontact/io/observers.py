@@ -128,7 +128,7 @@ class Results(Observer):
 
     def increment_converged(self, run, inc) -> None:
         k, proc = inc.step, run.procedure
-        if k % self.every == 0 or k == run.n_steps or k == proc.last_step:
+        if k % self.every == 0 or inc.ends_stage:  # the last step of each stage, and so of the run
             self._write(run, inc.lam, k, proc.t_stage + inc.lam)
 
     def _write(self, run, lam: float, step: int, time_value: float) -> None:
@@ -189,7 +189,7 @@ class Checkpoints(Observer):
 
     def increment_converged(self, run, inc) -> None:
         k = inc.step
-        if not (k % self.every == 0 or k == run.n_steps or k == run.procedure.last_step):
+        if not (k % self.every == 0 or inc.ends_stage):
             return
         arrays, meta = {}, {"problem_hash": self.problem_hash}
         for part in self.parts:
@@ -246,7 +246,9 @@ class Progress(Observer):
         # computed on every rank of a distributed run alike (the count is collective), printed by the first
         active = run.model.active_count(run.state)
         self.say(("" if not run.procedure.staged else f"stage {run.procedure.spec.name}  ")
-                 + f"step {inc.step:4d}/{run.n_steps}  lambda {inc.lam:.4g}  iterations {inc.iterations:3d}  "
+                 + f"step {inc.step:4d}" + (f"/{run.n_steps}" if run.n_steps is not None else "")
+                 + f"  lambda {inc.lam:.4g}" + (f"  increment {inc.lam - inc.lam_a:.3g}" if run.procedure.automatic else "")
+                 + f"  iterations {inc.iterations:3d}  "
                  f"residual {inc.residual:.2e}  active {active:5d}"
                  + (f"  cutbacks {inc.cutbacks}" if inc.cutbacks else "")
                  + (f"  FAILED: {inc.why}" if not inc.success else ""))

@@ -102,6 +102,7 @@ class Newton:
         #: ``on_converged(u, lam_a, lam_b, committed, trial)``: the converged displacement, the increment's
         #: load factors, the committed state it started from and its converged trial (check-tangent's probe)
         self.on_converged = None
+        self.converged_increments: list[tuple[float, float]] = []  # of the last advance
 
     # checkpoints -------------------------------------------------------------------------------
     def checkpoint(self) -> tuple[dict, dict]:
@@ -338,12 +339,17 @@ class Newton:
         except (InvertedElementError, LinearSolverError) as exc:
             return StepOutcome(converged=False, reason=str(exc)), None
 
-    def advance(self, u: np.ndarray, lam_a: float, lam_b: float, committed):
-        """Reach lam_b from lam_a from the committed state, cutting back on failure.
+    def advance(self, u: np.ndarray, lam_a: float, lam_b: float, committed, min_increment: float | None = None,
+                single: bool = False):
+        """Reach lam_b from lam_a from the committed state, cutting back on failure (at most ``max_cutbacks``
+        times in a row, and not below ``min_increment`` where given). ``single``: stop at the first increment
+        that converges (after cutbacks short of lam_b; automatic incrementation goes on from there).
 
         Returns (ok, list of StepOutcome, cutbacks, why, state): ``state`` is the new committed state (the
-        one given if nothing converged). ``u`` holds the displacement of that state.
+        one given if nothing converged). ``u`` holds the displacement of that state. ``converged_increments``
+        then lists the (lam_a, lam_b) of every increment that converged on the way.
         """
+        self.converged_increments = []
         outcomes: list[StepOutcome] = []
         cutbacks = 0
         depth = 0
@@ -368,14 +374,17 @@ class Newton:
                 if self.on_converged is not None:
                     self.on_converged(u, lam, target, committed, trial)
                 committed = trial
+                self.converged_increments.append((lam, target))
                 lam = target
                 depth = max(depth - 1, 0)
+                if single:
+                    break
                 continue
             u[:] = saved  # the trial is dropped
             why = res.reason
             depth += 1
             cutbacks += 1
-            if depth > self.opt.max_cutbacks:
-                return False, outcomes, cutbacks, why, committed
             inc = (target - lam) / 2.0
+            if depth > self.opt.max_cutbacks or (min_increment is not None and inc < min_increment * (1 - 1e-12)):
+                return False, outcomes, cutbacks, why, committed
         return True, outcomes, cutbacks, why, committed

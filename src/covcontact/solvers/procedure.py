@@ -22,12 +22,77 @@ class FixedIncrements:
     def __init__(self, factors):
         self.factors = tuple(float(f) for f in factors)
 
-    def __len__(self) -> int:
-        return len(self.factors)
+    def target(self, lam: float) -> float | None:
+        """The load factor of the step after the converged load factor ``lam``; None when the stage is done."""
+        tol = 1e-12 * max(1.0, abs(lam))
+        return next((f for f in self.factors if f > lam + tol), None)
 
-    def target(self, done: int) -> float | None:
-        """The load factor of the stage's step after ``done`` converged ones; None when the stage is done."""
-        return self.factors[done] if done < len(self.factors) else None
+    def record(self, inc, converged: list) -> None:
+        pass
+
+    def state(self) -> dict:
+        return {}
+
+    def restore(self, state: dict) -> None:
+        pass
+
+
+class AutomaticIncrements:
+    """Increments of the load factor chosen as the steps go (``[steps] initial, min, max``), in the manner of
+    Abaqus/Standard: start with ``initial``; after ``EASY_STEPS`` steps in a row that converged without a
+    cutback in at most ``EASY_ITERATIONS`` iterations, grow by ``GROW``; after a step that needed more than
+    ``HARD_ITERATIONS``, shrink by ``SHRINK``; after a step that needed cutbacks, go on with the increment that
+    finally converged; never below ``min`` (Newton's cutbacks stop there) nor above ``max``; the last step
+    ends exactly at the stage's end (a remainder below ``min`` is taken with the step before it)."""
+
+    EASY_ITERATIONS = 5
+    EASY_STEPS = 2
+    HARD_ITERATIONS = 12
+    GROW = 1.5
+    SHRINK = 0.75
+
+    def __init__(self, initial: float, lo: float, hi: float, end: float):
+        self.increment, self.lo, self.hi, self.end = float(initial), float(lo), float(hi), float(end)
+        self.easy = 0  # easy steps in a row
+
+    def target(self, lam: float) -> float | None:
+        if lam >= self.end - 1e-12 * max(1.0, abs(self.end)):
+            return None
+        t = lam + self.increment
+        return self.end if t >= self.end - self.lo else t
+
+    def record(self, inc, converged: list) -> None:
+        """Adapt the increment to how step ``inc`` went (``converged``: its increments that converged, after
+        cutbacks the last one is the size that worked)."""
+        if not inc.success:
+            return
+        if inc.cutbacks:
+            a, b = converged[-1]
+            self.increment, self.easy = min(max(b - a, self.lo), self.hi), 0
+            return
+        its = inc.outcomes[-1].iterations
+        if its <= self.EASY_ITERATIONS:
+            self.easy += 1
+            if self.easy >= self.EASY_STEPS:
+                self.increment, self.easy = min(self.increment * self.GROW, self.hi), 0
+        else:
+            self.easy = 0
+            if its > self.HARD_ITERATIONS:
+                self.increment = max(self.increment * self.SHRINK, self.lo)
+
+    def state(self) -> dict:
+        """What a checkpoint keeps of the control (a resumed run goes on with the same increments)."""
+        return {"increment": self.increment, "easy": self.easy}
+
+    def restore(self, state: dict) -> None:
+        self.increment, self.easy = float(state["increment"]), int(state["easy"])
+
+
+def increment_control(spec, steps):
+    """The increment control of stage ``spec`` from its ``Steps``: automatic or the given load factors."""
+    if steps is not None and steps.is_automatic:
+        return AutomaticIncrements(steps.initial, steps.min, steps.max, spec.lam_end)
+    return FixedIncrements(spec.factors)
 
 
 @dataclass
@@ -45,6 +110,7 @@ class Increment:
     why: str
     state: State
     entry: dict = field(default_factory=dict)
+    ends_stage: bool = False  # the step reached the stage's end
 
     @property
     def iterations(self) -> int:
@@ -65,27 +131,23 @@ class Increment:
 class QuasiStatic:
     """Quasi-static load stepping of one stage (``spec``, a ``StageSpec``) of ``model`` with ``newton``.
 
-    ``before``: the steps of the earlier stages, ``t_stage`` their total pseudo-time, ``staged``: the problem
-    has several stages (its records then name the stage and carry the time).
+    ``t_stage``: the total pseudo-time of the earlier stages, ``staged``: the problem has several stages (its
+    records then name the stage and carry the time); ``control``: the increment control (default: the stage's
+    load factors).
     """
 
     name = "static"
 
-    def __init__(self, model, newton, spec, before: int, t_stage: float, staged: bool, control=None):
+    def __init__(self, model, newton, spec, t_stage: float, staged: bool, control=None):
         self.model = model
         self.newton = newton
         self.spec = spec
-        self.before = before
         self.t_stage = t_stage
         self.staged = staged
         self.control = control if control is not None else FixedIncrements(spec.factors)
+        self.automatic = isinstance(self.control, AutomaticIncrements)
         self.augmented = any(c.method == "augmented" for c in model.problem.contacts)
         self.work = None
-
-    @property
-    def last_step(self) -> int:
-        """The number, over the whole run, of this stage's last step."""
-        return self.before + len(self.control)
 
     def start(self, state: State) -> None:
         """Start, or resume, the stage at the committed ``state`` (its plastic work is the reference of the
@@ -94,7 +156,7 @@ class QuasiStatic:
 
     def next_step(self, state: State) -> tuple[int, float] | None:
         """(step number, load factor) of the next increment after ``state``; None when the stage is done."""
-        lam = self.control.target(state.step - self.before)
+        lam = self.control.target(state.lam)
         return None if lam is None else (state.step + 1, lam)
 
     def advance(self, u: np.ndarray, state: State, step: int, lam: float) -> Increment:
@@ -102,9 +164,16 @@ class QuasiStatic:
         new committed displacement) and report it."""
         newton = self.newton
         stats0, time0 = dict(newton.stats), dict(newton.timing)
-        success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
-        inc = Increment(step, state.lam, lam, success, outcomes, cutbacks, why, new if success else state)
+        if self.automatic:  # one converged increment per step: after cutbacks, the step ends where it got to
+            success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state, self.control.lo,
+                                                                   single=True)
+            lam = newton.converged_increments[-1][1] if success else lam
+        else:
+            success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
+        inc = Increment(step, state.lam, lam, success, outcomes, cutbacks, why, new if success else state,
+                        ends_stage=success and self.control.target(lam) is None)
         inc.entry = self._report(inc, u, stats0, time0)
+        self.control.record(inc, newton.converged_increments)
         return inc
 
     def _report(self, inc: Increment, u: np.ndarray, stats0: dict, time0: dict) -> dict:
@@ -127,6 +196,8 @@ class QuasiStatic:
         if self.staged:
             entry["stage"] = self.spec.name
             entry["time"] = self.t_stage + inc.lam
+        if self.automatic:
+            entry["increment"] = inc.lam - inc.lam_a
         if self.augmented:
             entry["uzawa_iterations"] = sum(1 for o in inc.outcomes if o.augmentation > 0)
         if inc.cutbacks:

@@ -25,7 +25,7 @@ from ..io.output import ResultWriter
 from .choice import auto_line, distributes, run_solver
 from .model import Model
 from .newton import Newton
-from .procedure import QuasiStatic
+from .procedure import QuasiStatic, increment_control
 from .signals import Interrupted, StopSignals
 from .state import State
 
@@ -65,6 +65,11 @@ def strategy_for(linear: str):
 
         return backend_class(linear).run_strategy()
     return SerialRun()
+
+
+def stage_steps(problem) -> list:
+    """The ``Steps`` of every stage of ``problem``, the first stage first."""
+    return [problem.steps] + [st.steps for st in problem.stages]
 
 
 def _tangent_name(problem, tangent: str | None) -> str:
@@ -113,13 +118,15 @@ class Run:
         self.state = model.initial_state()
         plan = model.stages
         self.n_stages = len(plan)
-        self.n_steps = sum(len(spec.factors) for spec in plan.stages)
+        counts = [st.count for st in stage_steps(problem)]
+        self.n_steps = None if None in counts else sum(counts)  # None: automatic increments somewhere
         self.procedure = None
         self.warnings: list[str] = []
         self.interruption: Interrupted | None = None
         self.summary_timing: dict = {}
         self.total_time = 0.0
         self.stop_status: str | None = None  # set by an observer to end the run after the current step
+        self.control_state: dict = {}  # the increment control's state of a resumed stage (from the checkpoint)
         self.partition = model.partition_report()  # collective under mpiexec
         root = model.is_root
         writer = ResultWriter(out) if root else None
@@ -131,7 +138,7 @@ class Run:
         # what a checkpoint holds besides u and the committed state, each part its own
         convergence = Convergence(writer) if writer else None
         self.parts = [self.summary, *(p for p in (self.results, convergence) if p is not None), self.newton,
-                      self.model, self.newton.linear]
+                      self.model, self.newton.linear, self]
         out_obs = [convergence] if convergence else []
         if self.results is not None:
             out_obs.append(self.results)
@@ -140,6 +147,15 @@ class Run:
         if root and problem.output.pictures and problem.output.vtu:
             out_obs.append(Pictures(out, self.progress.say))
         self.observers = [*out_obs, self.progress, *extra_observers]
+
+    def checkpoint(self) -> tuple[dict, dict]:
+        """The run's own part of a checkpoint: its increment control's state in the current stage."""
+        if self.procedure is None:
+            return {}, {}
+        return {}, {"increment_control": {"stage": self.procedure.spec.index, **self.procedure.control.state()}}
+
+    def restore(self, arrays: dict, meta: dict) -> None:
+        self.control_state = dict(meta.get("increment_control") or {})
 
     def emit(self, event: str, *args) -> None:
         for obs in self.observers:
@@ -203,9 +219,11 @@ class Run:
             if entering:
                 self.state = model.enter_stage(self.u, self.state)
                 self.newton.linear.set_near_null_space(model.near_null_space())
-            before = sum(len(q.factors) for q in plan.stages[:si])  # steps of the earlier stages
-            t_stage = sum(q.lam_end for q in plan.stages[:si])     # their total pseudo-time
-            self.procedure = QuasiStatic(model, self.newton, spec, before, t_stage, len(plan) > 1)
+            t_stage = sum(q.lam_end for q in plan.stages[:si])     # the earlier stages' total pseudo-time
+            control = increment_control(spec, stage_steps(self.problem)[si])
+            if self.control_state.get("stage") == si:  # resumed inside this stage
+                control.restore(self.control_state)
+            self.procedure = QuasiStatic(model, self.newton, spec, t_stage, len(plan) > 1, control)
             self.procedure.start(self.state)
             self.emit("stage_entered", self.procedure, entering)
             while (nxt := self.procedure.next_step(self.state)) is not None:
