@@ -185,3 +185,17 @@ def test_check_tangent_inside_an_automatic_stage(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 0 and out.splitlines()[1].startswith("PASS"), out
     assert "step 3 (stage 'press', load factor 0.175)" in out  # 0.05 + 0.05 + 0.075: grown after two easy steps
+
+
+def test_quiet_run_still_says_why_it_failed(tmp_path, capsys):
+    """--quiet silences the progress lines, never the reason a run failed (exit 1)."""
+    text = BLOCK.replace("translation = [0.0, 0.0, -0.2]", "translation = [0.0, 0.0, -0.4]")
+    path = tmp_path / "fail.toml"
+    path.write_text(text.replace("STEPS", "initial = 1.0").replace("LIFT", "{ initial = 1.0, min = 0.9 }")
+                    + "\n[solver]\nmax_iterations = 4\n")
+    code = main(["run", str(path), "--quiet", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 1
+    lines = [ln for ln in err.splitlines() if "failed after" in ln]
+    assert len(lines) == 1 and lines[0].startswith("step 2 (load factor 1) failed after")
+    assert "step    1" not in err  # no progress lines

@@ -61,3 +61,22 @@ def test_overlapping_bodies_are_warned(tmp_path):
     raw["bodies"][1]["mesh"]["origin"] = [0.0, 0.0, 1.0]  # placed right: touching
     model = Model(problem_from_dict(raw, tmp_path / "p.toml"))
     assert model.start_warnings(model.prescribed(0.0), model.initial_state()) == []
+
+
+def test_a_few_nodes_deep_inside_are_warned():
+    """A minority of slave nodes starting deeper than a tenth of the node spacing inside the master is warned
+    too (with how many, how deep and the deepest node); touching or grazing is not."""
+    from covcontact.solvers.model import Model
+
+    for dip, warned in ((0.05, True), (0.01, False)):  # node spacing about 0.28: 0.05 is 18 % of it, 0.01 4 %
+        raw = _raw(True, 1.0 + 0.3 - dip)
+        raw["rigid"][0]["radius"] = 0.3
+        raw["bodies"][0]["mesh"].update(nx=4, ny=4)  # a node at the centre of the top, under the sphere
+        model = Model(problem_from_dict(raw, Path("dip.toml")))
+        warnings = model.start_warnings(model.prescribed(0.0), model.initial_state())
+        if warned:
+            assert len(warnings) == 1 and "slave nodes start inside the analytic sphere 'ball'" in warnings[0]
+            assert "1 of 25 slave nodes start inside" in warnings[0] and "down to -0.05 (node" in warnings[0]
+            assert "move the bodies apart or check the geometry" in warnings[0]
+        else:
+            assert warnings == []

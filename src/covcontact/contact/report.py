@@ -92,11 +92,15 @@ def point_data(manager, n_nodes: int, state: ContactState) -> dict:
     return {"gap": gap[:n_nodes], "contact_pressure": pressure[:n_nodes], "contact_status": status[:n_nodes]}
 
 
+#: a slave node deeper inside its master than this fraction of the node spacing at the start is warned about
+INSIDE_FRACTION = 0.1
+
+
 def start_warnings(manager, x: np.ndarray, state: ContactState, names: dict[str, str]) -> list[str]:
     """Warnings about a set-up that is legal but almost certainly wrong: most slave nodes of a pass start
     inside the master (deeper than 1 % of their typical spacing: touching is fine), as an analytic surface
     turned inside out, master faces whose normals point into their body, or a body misplaced or in other
-    units would make them.
+    units would make them; or some start deeper than ``INSIDE_FRACTION`` of the spacing.
 
     ``x`` the positions at the start, ``names`` pass name -> a description of its master for the message.
     """
@@ -109,12 +113,18 @@ def start_warnings(manager, x: np.ndarray, state: ContactState, names: dict[str,
         xs = manager.extended(x, 0.0)[p.slaves]
         spacing = _spacing(xs, p)
         deep = np.isfinite(g) & (g < -0.01 * spacing)
+        master = names.get(p.name, "its master")
         if deep.sum() > 0.5 * p.ns:
-            master = names.get(p.name, "its master")
             out.append(f"contact {p.name!r}: {int(deep.sum())} of {p.ns} slave nodes start inside {master} (gap "
                        f"down to {float(g[deep].min()):.3g} against a node spacing of {spacing:.3g}); likely an "
                        f"analytic surface with the wrong 'outside', a master face set whose normals point into "
                        f"its body, or a body misplaced or in other units")
+        elif np.any(deeper := np.isfinite(g) & (g < -INSIDE_FRACTION * spacing)):
+            worst = int(p.slaves[np.argmin(np.where(deeper, g, np.inf))])
+            out.append(f"contact {p.name!r}: {int(deeper.sum())} of {p.ns} slave nodes start inside {master}, "
+                       f"down to {float(g[deeper].min()):.3g} (node {worst}) against a node spacing of "
+                       f"{spacing:.3g}; the first step pushes them out at once, with a large force and often "
+                       f"cutbacks: move the bodies apart or check the geometry")
     return out
 
 

@@ -253,7 +253,12 @@ class Progress(Observer):
                  + (f"  cutbacks {inc.cutbacks}" if inc.cutbacks else "")
                  + (f"  FAILED: {inc.why}" if not inc.success else ""))
 
-    increment_failed = increment_converged
+    def increment_failed(self, run, inc) -> None:
+        if not self.quiet:
+            self.increment_converged(run, inc)
+        else:  # --quiet silences the progress, never why a run failed
+            self.say(f"step {inc.step} (load factor {inc.lam:.4g}) failed after {inc.cutbacks} cutbacks: {inc.why}",
+                     always=True)
 
     def ended(self, run, status: str) -> None:
         if run.interruption is not None:
