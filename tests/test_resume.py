@@ -185,8 +185,9 @@ def test_sigint_exit_code_and_status(tmp_path):
     # every file on disk is valid: the summary parsed above, the checkpoint loads, the CSV is complete
     with np.load(out / "checkpoint.npz") as data:
         assert np.all(np.isfinite(data["u"]))
-    for row in (out / "convergence.csv").read_text().splitlines()[1:]:
-        assert len(row.split(",")) == 7
+    rows = (out / "convergence.csv").read_text().splitlines()
+    for row in rows[1:]:
+        assert len(row.split(",")) == len(rows[0].split(",")) == 8
 
 
 def _one_error_line(res: subprocess.CompletedProcess, *words: str) -> None:

@@ -40,7 +40,8 @@ class ResultWriter:
         self.out = Path(out)
         self.out.mkdir(parents=True, exist_ok=True)
         self.pvd_entries: list[tuple[float, str]] = []
-        self.csv_rows: list[str] = ["step,iteration,residual_norm,energy_norm,active_contacts,linear,krylov_iterations"]
+        self.csv_rows: list[str] = ["step,iteration,residual_norm,energy_norm,active_contacts,linear,krylov_iterations,"
+                                    "status_changes"]
 
     def write_vtu(self, step: int, time_value: float, points: np.ndarray,
                   blocks: list[tuple[str, np.ndarray, dict[str, np.ndarray]]],
@@ -100,7 +101,7 @@ class ResultWriter:
     def add_iterations(self, step: int, records) -> None:
         for r in records:
             self.csv_rows.append(f"{step},{r.iteration},{r.residual:.6e},{r.energy:.6e},{r.active},{r.linear},"
-                                 f"{r.krylov}")
+                                 f"{r.krylov},{r.changes}")
         atomic_write_text(self.out / "convergence.csv", "\n".join(self.csv_rows) + "\n")
 
     def write_summary(self, summary: dict) -> None:

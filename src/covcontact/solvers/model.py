@@ -238,6 +238,13 @@ class Model:
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)
 
+    def contact_codes(self, state: State) -> np.ndarray:
+        """The contact status of every slave node of every pass in ``state``: 0 open, 1 closed (stick), 2
+        slip; the changes from one Newton iteration to the next measure how much the active set moves."""
+        out = [np.where(self.contact.active_mask(k, state.contact), np.where(p.status == 2, 2, 1), 0)
+               for k, p in enumerate(state.contact.passes)]
+        return np.concatenate(out) if out else np.zeros(0, np.int64)
+
     def plastic_work(self, state: State) -> float | None:
         """Plastic work of all bodies in ``state``; None when no body has a plastic material."""
         from ..materials.plasticity import J2

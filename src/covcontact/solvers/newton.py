@@ -62,6 +62,7 @@ class IterationRecord:
     active: int
     linear: str = ""      # how the correction was solved: "factor" (new factorisation) or "krylov"
     krylov: int = 0       # GMRES iterations spent on it (including a failed attempt before a factorisation)
+    changes: int = 0      # slave nodes whose contact status (open, closed/stick, slip) this iteration changed
 
 
 @dataclass
@@ -103,6 +104,11 @@ class Newton:
         #: load factors, the committed state it started from and its converged trial (check-tangent's probe)
         self.on_converged = None
         self.converged_increments: list[tuple[float, float]] = []  # of the last advance
+
+    def _contact_codes(self, trial) -> np.ndarray:
+        """The model's contact status codes of ``trial`` (an empty array for a model without contact)."""
+        codes = getattr(self.model, "contact_codes", None)
+        return codes(trial) if codes is not None else np.zeros(0, np.int64)
 
     # checkpoints -------------------------------------------------------------------------------
     def checkpoint(self) -> tuple[dict, dict]:
@@ -274,6 +280,7 @@ class Newton:
                     1e-300)
         out.residual_norms.append(r0)
         out.records.append(IterationRecord(0, r0, 0.0, m.active_count(trial)))
+        codes = self._contact_codes(trial)
         if r0 <= opt.atol * scale and not np.any(du_d):
             out.converged = True
             return out, trial
@@ -316,9 +323,11 @@ class Newton:
                 self._stalled = True
             rn_prev = rn
             out.residual_norms.append(rn)
+            codes_prev, codes = codes, self._contact_codes(trial)
             out.records.append(IterationRecord(it, rn, energy, m.active_count(trial),
                                                "krylov" if inexact else "factor",
-                                               self.stats["krylov_iterations"] - n_kry))
+                                               self.stats["krylov_iterations"] - n_kry,
+                                               int(np.count_nonzero(codes != codes_prev))))
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
                 return out, trial
