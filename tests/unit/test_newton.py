@@ -164,3 +164,17 @@ def test_step_starting_almost_converged_stops_at_the_round_off_floor():
     out, _ = newton.step(u, 0.0, 1.0, None)
     assert out.converged and out.residual_norms[-1] < 1e-13
 
+
+
+def test_a_cycling_iteration_is_recognised():
+    """Residual norms that repeat with a period of 2..4 iterations three times over (to 1e-6) are a cycle (an
+    active set going round, as measured on the U-channel's flange: 3.65e-2, 11.26, 3.46, ...); a converging or
+    merely oscillating-and-falling sequence is not."""
+    from covcontact.solvers.newton import _cycle
+
+    cyc = [5.0, 4.0] + [3.648597e-02, 1.125925e+01, 3.455922e+00] * 3 + [3.648596e-02]
+    assert _cycle(cyc) == 3
+    assert _cycle([1.0] + [2.0, 1.5] * 3 + [2.0]) == 2
+    assert _cycle([1.0, 2.0, 1.5] * 2) == 0  # two periods are not enough
+    assert _cycle([2.0 * 0.9 ** k for k in range(20)]) == 0  # falling
+    assert _cycle([1.0, 2.0, 1.5, 2.0, 1.5 * (1 + 1e-5), 2.0, 1.5, 2.0]) == 0  # a period differs beyond 1e-6

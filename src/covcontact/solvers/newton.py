@@ -43,6 +43,22 @@ import numpy as np
 from ..assembly.system import InvertedElementError
 from .linear import LinearSolverError, SingularMatrixError, gmres_right, make_solver
 
+#: from this iteration on, a step whose residuals repeat with a period of up to CYCLE_PERIOD iterations three
+#: times over (to CYCLE_RTOL) is given up as cycling instead of iterating on to max_iterations
+CYCLE_FROM = 10
+CYCLE_PERIOD = 4
+CYCLE_RTOL = 1e-6
+
+
+def _cycle(rs: list) -> int:
+    """The period p (2..CYCLE_PERIOD) with which the last 3 p residual norms ``rs`` repeat, else 0."""
+    for p in range(2, CYCLE_PERIOD + 1):
+        if len(rs) >= 3 * p + 1 and all(abs(rs[-i] - rs[-i - p]) <= CYCLE_RTOL * max(rs[-i], rs[-i - p])
+                                        for i in range(1, 2 * p + 1)):
+            return p
+    return 0
+
+
 #: relative residual of the first correction of a step with an AMG solver and reuse on
 AMG_FIRST = 1e-6
 #: a later correction of the step keeps its AMG hierarchy if CG converges within this many times the first
@@ -330,6 +346,11 @@ class Newton:
                                                int(np.count_nonzero(codes != codes_prev))))
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
+                return out, trial
+            period = _cycle(out.residual_norms) if it >= CYCLE_FROM else 0
+            if period:  # the iteration goes round in a circle (an active set that cycles): cut back now
+                out.reason = (f"the active set cycles (the same {period} residuals, {rn:.3e} among them, three times "
+                              f"over)")
                 return out, trial
             if it == 1:
                 r_ref = max(r0, rn)
