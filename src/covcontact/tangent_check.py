@@ -86,7 +86,10 @@ class _Probe(Observer):
 
 def stage_steps(problem) -> list[tuple[str, int | None]]:
     """(name, number of steps; None where the stage chooses its increments) of every stage, the first first."""
-    return [(problem.stage_name, problem.steps.count)] + [(st.name, st.steps.count) for st in problem.stages]
+    from .solvers.run import stage_steps as steps_of
+
+    names = [problem.stage_name] + [st.name for st in problem.stages]
+    return [(name, steps.count) for name, steps in zip(names, steps_of(problem))]
 
 
 def serial_solver(problem, solver: str | None) -> str | None:
@@ -260,12 +263,12 @@ def choose_columns(model, state: State, columns: int | None, seed: int = 0) -> t
     for g in groups:
         pool = np.setdiff1d(z[g], chosen)
         take = pool if len(pool) <= share else rng.choice(pool, share, replace=False)
-        picked[g] = int(len(take))
+        picked[g] = len(take)
         chosen = np.union1d(chosen, take)
     pool = np.setdiff1d(free, chosen)
     rest = columns - len(chosen)
     take = pool if len(pool) <= rest else rng.choice(pool, rest, replace=False)
-    picked["other"] = int(len(take))
+    picked["other"] = len(take)
     return np.union1d(chosen, take), picked
 
 
@@ -393,7 +396,7 @@ def check_tangent(problem, step: int = 1, tangent: str = "exact", columns: int |
     worst = sorted(judged, key=lambda ci: -ci[0].central[ci[1]])[:5]
     scale = max(float(np.linalg.norm(model.external(lam))), float(np.linalg.norm(R0)), 1e-300)
     return {**base, "relative_error": _rel(err2, ref2) if judged else float("nan"),
-            "columns": int(len(cols)), "judged": len(judged), "zones": picked, "h": hs,
+            "columns": len(cols), "judged": len(judged), "zones": picked, "h": hs,
             "by_step_size": by_h, "smooth_columns": len(smooth), "kinks": kinks,
             "worst": [{"dof": c.dof, "label": dof_label(model, c.dof), "h": hs[i],
                        "error": _rel(c.central[i], c.k2)} for c, i in worst],
@@ -407,8 +410,8 @@ def report_lines(rep: dict, tol: float) -> list[str]:
     if not rep["converged"]:
         return [f"{where}: not reached: {rep['reason']}", "NOT CHECKED: the run does not reach this step"]
     err = rep["relative_error"]
-    lines = [f"{where}  tangent {rep['tangent']}  columns {rep['columns']} (judged {rep['judged']})  "
-             f"relative error {err:.3e}"]
+    lines = [(f"{where}  tangent {rep['tangent']}  columns {rep['columns']} (judged {rep['judged']})  "
+              f"relative error {err:.3e}")]
     if not rep["judged"]:
         lines.append("NO VERDICT: every column's perturbation changes a status at every step size")
     else:

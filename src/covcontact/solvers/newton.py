@@ -255,19 +255,21 @@ class Newton:
             return np.zeros_like(du_d)
         return du_d
 
-    def _converged(self, rs: list, it: int, r_ref: float, scale_k: float, conv_energy: bool, du_norm: float,
-                   u_norm: float) -> bool:
+    def _converged(self, rs: list, it: int, r_ref: float, scale_k: float, conv_energy: bool, eta: float,
+                   du: np.ndarray, u: np.ndarray) -> bool:
         """The convergence test after iteration ``it`` (residual norms ``rs``, the last one's): the criterion,
         or the round-off floor. The floor: the energy criterion holds and the residual stopped falling; or the
         residual is below rtol of the force scale, stopped falling for two iterations and the correction
-        (``du_norm``) is at round-off of the solution (a step that starts almost converged, e.g. after the
-        extrapolating predictor, has r_ref and the energy reference themselves at round-off, so neither relative
-        test can hold; a slowly converging step still makes corrections and goes on)."""
-        opt, rn = self.opt, rs[-1]
+        ``eta du`` is at round-off of the solution ``u``, whose norms are taken only then (a step that starts
+        almost converged, e.g. after the extrapolating predictor, has r_ref and the energy reference themselves
+        at round-off, so neither relative test can hold; a slowly converging step still makes corrections and
+        goes on)."""
+        opt, rn, free = self.opt, rs[-1], self.model.free
         conv_res = rn <= max(opt.rtol * r_ref, opt.atol * scale_k)
         stalled = it >= 2 and rn >= 0.5 * rs[-2]
         floor = stalled and (conv_energy or (
-            it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k and du_norm <= 1e-10 * u_norm))
+            it >= 3 and rs[-2] >= 0.5 * rs[-3] and rn <= opt.rtol * scale_k
+            and eta * float(np.linalg.norm(du[free])) <= 1e-10 * float(np.linalg.norm(u[free]))))
         conv = {"residual": conv_res, "energy": conv_energy, "both": conv_res and conv_energy}[opt.criterion]
         return conv or floor
 
@@ -355,8 +357,7 @@ class Newton:
             if it == 1:
                 r_ref = max(r0, rn)
             scale_k = max(scale, reactions)
-            if self._converged(out.residual_norms, it, r_ref, scale_k, energy <= opt.etol * e0,
-                               eta * float(np.linalg.norm(du[free])), float(np.linalg.norm(u[free]))):
+            if self._converged(out.residual_norms, it, r_ref, scale_k, energy <= opt.etol * e0, eta, du, u):
                 out.converged = True
                 self.scale_seen = max(self.scale_seen, scale_k)
                 return out, trial
