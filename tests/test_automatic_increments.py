@@ -166,6 +166,36 @@ def test_resume_with_automatic_increments_is_exact(tmp_path, monkeypatch):
     np.testing.assert_array_equal(ref.u, resumed.u)
 
 
+def test_output_at_ends_increments_there_and_writes_them(tmp_path):
+    """output_at: the automatic increments end exactly at each listed load factor and those steps are written
+    (with [output] every = 1000 only they, the start and the stage ends); with fixed steps an output_at that is
+    a step's end is written, one that is not is an input error."""
+    c = AutomaticIncrements(0.3, 0.01, 0.4, 1.0, (0.45, 0.5))
+    assert c.target(0.0) == pytest.approx(0.3)
+    assert c.target(0.3) == 0.45 and c.target(0.45) == 0.5  # cut to the marks
+    assert c.target(0.444) == 0.45  # a remainder below min goes with this step
+    assert c.is_mark(0.45) and not c.is_mark(0.46)
+    out = "\n[output]\nevery = 1000\n"
+    path = _problem(tmp_path, "initial = 0.3\nmin = 0.001\nmax = 0.4\noutput_at = [0.45, 0.5]", extra=out)
+    res = load_problem(path).run(out=tmp_path / "auto")
+    assert res.exit_code == 0
+    press = [s for s in res.summary["steps"] if s["stage"] == "press"]
+    lams = [s["load_factor"] for s in press]
+    assert 0.45 in lams and 0.5 in lams and lams[-1] == 1.0
+    written = sorted(int(f.stem.split("_")[1]) for f in (tmp_path / "auto").glob("step_*.vtu"))
+    marks = [s["step"] for s in press if s["load_factor"] in (0.45, 0.5)]
+    ends = [press[-1]["step"], res.summary["steps"][-1]["step"]]
+    assert written == sorted({0, *marks, *ends})
+    fixed = _problem(tmp_path, "count = 4\noutput_at = [0.5]", extra=out, name="fixed.toml")
+    res = load_problem(fixed).run(out=tmp_path / "fixed")
+    written = sorted(int(f.stem.split("_")[1]) for f in (tmp_path / "fixed").glob("step_*.vtu"))
+    assert written == [0, 2, 4, 6]
+    with pytest.raises(InputError, match="steps.output_at: 0.3 is not the end of a step"):
+        load_problem(_problem(tmp_path, "count = 4\noutput_at = [0.3]", name="bad.toml"))
+    with pytest.raises(InputError, match="steps.output_at: must be a strictly increasing"):
+        load_problem(_problem(tmp_path, "initial = 0.1\noutput_at = [0.5, 0.2]", name="bad2.toml"))
+
+
 @pytest.mark.parametrize("steps, message", [
     ("initial = 0.1\nmin = 0.5\nmax = 0.2", "steps.min: min = 0.5 is above max = 0.2"),
     ("initial = 0.1\ncount = 3", "give either count or automatic increments"),

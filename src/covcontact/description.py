@@ -32,8 +32,8 @@ class Body:
 class RigidBody:
     """A rigid body: an analytic surface or a mesh moving rigidly.
 
-    ``shape`` "plane" (``params`` point, normal), "cylinder" (center, axis, radius, outside) or "sphere"
-    (center, radius, outside) for an analytic surface; or ``mesh``, a Mesh whose nodes carry no unknowns
+    ``shape`` "plane" (``params`` point, normal), "cylinder" (center, axis, radius, outside), "sphere"
+    (center, radius, outside) or "profile" (points, fillets, extrude or revolve) for an analytic surface; or ``mesh``, a Mesh whose nodes carry no unknowns
     (slave nodes and/or master faces of contact pairs), with ``shape`` "mesh".
 
     With ``free`` components the body gets a reference node (six unknowns: translation and rotation vector
@@ -95,12 +95,14 @@ class ContactPair:
 class Steps:
     """Load-factor schedule: ``factors`` are the load factors at the end of each step; or, with ``initial``
     (and ``min``, ``max``), automatic increments of the load factor up to ``factors[-1]`` (the stage's end),
-    chosen as the steps go (docs/input.md, ``[steps]``)."""
+    chosen as the steps go (docs/input.md, ``[steps]``); ``output_at``: load factors where results are written
+    (automatic increments end exactly there; fixed ones must have a step ending there)."""
 
     factors: tuple[float, ...]
     initial: float | None = None
     min: float | None = None
     max: float | None = None
+    output_at: tuple[float, ...] = ()  # load factors at which results are written (increments end there)
 
     @classmethod
     def equal(cls, n: int, final: float = 1.0) -> Steps:

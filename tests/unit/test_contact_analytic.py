@@ -10,6 +10,7 @@ import pytest
 
 from covcontact.contact import CASES, Cylinder, Plane, RigidMotion, Sphere
 from covcontact.motion import rotation_matrix
+from profile_cases import profiles
 
 EPS_N = 3.0
 MOTION = RigidMotion(translation=(0.1, 0.2, -0.3), rotation=(0.2, -0.4, 0.3), center=(1.0, 0.0, 0.0))
@@ -23,6 +24,7 @@ def surfaces():
         "cyl_in": Cylinder((0.0, 0.5, 0.0), (1.0, 1.0, 0.3), 2.0, False, MOTION),
         "sph_out": Sphere((0.3, 0.0, 0.0), 1.5, True, MOTION),
         "sph_in": Sphere((0.3, 0.0, 0.0), 1.5, False, MOTION),
+        **profiles(MOTION),
     }
 
 
@@ -69,7 +71,7 @@ def test_exact_tangent_matches_fd(name, ip, g):
     np.testing.assert_allclose(r.residual, EPS_N * g * r.normal, rtol=1e-7)
 
 
-@pytest.mark.parametrize("name", ["cyl_out", "cyl_in", "sph_out", "sph_in"])
+@pytest.mark.parametrize("name", ["cyl_out", "cyl_in", "sph_out", "sph_in", "ext_ridge", "rev_die"])
 def test_case_a_second_order_and_flipped_curvature(name):
     surf = surfaces()[name]
     diffs = []

@@ -26,6 +26,7 @@ from covcontact.contact.friction import (
 from covcontact.contact.geometry import facet_geometry
 from covcontact.contact.projection import project_on_facet
 from covcontact.motion import rotation_matrix
+from profile_cases import profiles
 from covcontact.fem.shapes import NODES
 
 EPS_N = 7.0
@@ -300,6 +301,7 @@ def surfaces(motion=MOTION):
         "cyl_in": Cylinder((0.0, 0.5, 0.0), (1.0, 1.0, 0.3), 2.0, False, motion),
         "sph_out": Sphere((0.3, 0.0, 0.0), 1.5, True, motion),
         "sph_in": Sphere((0.3, 0.0, 0.0), 1.5, False, motion),
+        **profiles(motion),
     }
 
 
@@ -395,7 +397,7 @@ def test_analytic_batch_matches_single():
         origin, frame = surf.placement(LAM)
         R, K, H = np.zeros((ns, 3)), np.zeros((ns, 3, 3)), np.zeros((ns, HIST_SIZE))
         g, xi, st = np.zeros(ns), np.zeros((ns, 2)), np.zeros(ns, dtype=np.int64)
-        analytic_friction_batch(surf.kind, origin, frame, float(surf.radius), float(surf.sigma), xs, eps_n,
+        analytic_friction_batch(surf.kind, origin, frame, float(surf.radius), float(surf.sigma), surf.prof, xs, eps_n,
                                 eps_t, mu, hist, R, K, H, g, xi, st, np.zeros(ns))
         for k in range(ns):
             s = surface_friction(surf, xs[k], eps_n[k], eps_t[k], mu[k], hist[k], LAM)
@@ -435,7 +437,7 @@ def analytic_eval(surf, y, mu, hist, lam_k):
     origin, frame = surf.placement(LAM)
     R, K, H = np.zeros((1, 3)), np.zeros((1, 3, 3)), np.zeros((1, HIST_SIZE))
     g, xi, st = np.zeros(1), np.zeros((1, 2)), np.zeros(1, dtype=np.int64)
-    analytic_friction_batch(surf.kind, origin, frame, float(surf.radius), float(surf.sigma), y[None, :],
+    analytic_friction_batch(surf.kind, origin, frame, float(surf.radius), float(surf.sigma), surf.prof, y[None, :],
                             np.array([EPS_N]), np.array([EPS_T]), np.array([mu]), hist[None, :], R, K, H, g,
                             xi, st, np.array([lam_k]))
     return R[0], K[0], int(st[0]), float(g[0])

@@ -1,6 +1,6 @@
 """Covariant node-to-surface contact: projection, search, contact element, analytic rigid surfaces."""
 
-from covcontact.contact.analytic import Cylinder, Plane, Sphere
+from covcontact.contact.analytic import Cylinder, Plane, Profile, Sphere
 from covcontact.contact.element import (
     CASE_A,
     CASE_B,
@@ -57,6 +57,7 @@ __all__ = [
     "ContactResult",
     "Cylinder",
     "Plane",
+    "Profile",
     "RigidMotion",
     "Sphere",
     "contact_batch",

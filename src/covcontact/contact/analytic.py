@@ -36,18 +36,25 @@ from covcontact.contact.element import (
     check_multiplier,
 )
 from covcontact.contact.laws import c_inverse, effective_gap, is_active
+from covcontact.contact.profile import PROFILE_COLS, build_profile, profile_closest, profile_point
 from covcontact.motion import RigidMotion, frame_from_axis, unit_vector
 
 PLANE = 0
 CYLINDER = 1
 SPHERE = 2
+EXTRUDED = 3
+REVOLVED = 4
+SHARP_CORNER = 3  # the chart reported at the sharp corner of a profile (a vertex: cases a, c use exact)
+NO_PROFILE = np.zeros((0, PROFILE_COLS))
 
 _CHUNK = 32
 
 
 @njit(cache=True)
-def analytic_geometry(kind, origin, frame, radius, sigma, xs, xi, rho, rho_cov, a_cov, a_con, n, h_cov):
-    """Closed-form projection of ``xs`` and the surface quantities there; returns (g, chart)."""
+def analytic_geometry(kind, origin, frame, radius, sigma, prof, xs, xi, rho, rho_cov, a_cov, a_con, n, h_cov):
+    """Closed-form projection of ``xs`` and the surface quantities there; returns (g, chart).
+
+    prof: the segment table of a profile (``profile.build_profile``; empty for the other kinds)."""
     d0 = xs[0] - origin[0]
     d1 = xs[1] - origin[1]
     d2 = xs[2] - origin[2]
@@ -88,6 +95,57 @@ def analytic_geometry(kind, origin, frame, radius, sigma, xs, xi, rho, rho_cov, 
         a_cov[0, 0] = radius * radius
         a_cov[1, 1] = 1.0
         h_cov[0, 0] = -sigma * radius
+    elif kind == EXTRUDED:
+        pp = d0 * frame[0, 0] + d1 * frame[0, 1] + d2 * frame[0, 2]
+        qq = d0 * frame[1, 0] + d1 * frame[1, 1] + d2 * frame[1, 2]
+        z = d0 * frame[2, 0] + d1 * frame[2, 1] + d2 * frame[2, 2]
+        k, t, _ = profile_closest(prof, pp, qq)
+        cx, cy, tx, ty, c2x, c2y, _, _ = profile_point(prof, k, t)
+        xi[0] = prof[k, 1] + t
+        xi[1] = -z
+        g = -(pp - cx) * ty + (qq - cy) * tx
+        for p in range(3):
+            rho[p] = origin[p] + cx * frame[0, p] + cy * frame[1, p] + z * frame[2, p]
+            rho_cov[0, p] = tx * frame[0, p] + ty * frame[1, p]
+            rho_cov[1, p] = -frame[2, p]
+            n[p] = -ty * frame[0, p] + tx * frame[1, p]
+        a_cov[0, 0] = 1.0
+        a_cov[1, 1] = 1.0
+        h_cov[0, 0] = -c2x * ty + c2y * tx
+        if prof[k, 0] == 1.0 and prof[k, 5] == 1.0:
+            chart = SHARP_CORNER
+    elif kind == REVOLVED:
+        z = d0 * frame[2, 0] + d1 * frame[2, 1] + d2 * frame[2, 2]
+        x1 = d0 * frame[0, 0] + d1 * frame[0, 1] + d2 * frame[0, 2]
+        x2 = d0 * frame[1, 0] + d1 * frame[1, 1] + d2 * frame[1, 2]
+        r = np.sqrt(x1 * x1 + x2 * x2)
+        phi = np.arctan2(x2, x1) if r > 0.0 else 0.0
+        cp = np.cos(phi)
+        sp = np.sin(phi)
+        k, t, _ = profile_closest(prof, r, z)
+        cr, cz, tr, tz, c2r, c2z, _, _ = profile_point(prof, k, t)
+        xi[0] = prof[k, 1] + t
+        xi[1] = phi
+        g = -(r - cr) * tz + (z - cz) * tr
+        h_cov[0, 0] = -c2r * tz + c2z * tr
+        pole = abs(cr) <= 1e-9 * (prof[prof.shape[0] - 1, 1] + prof[prof.shape[0] - 1, 2])
+        for p in range(3):
+            er = cp * frame[0, p] + sp * frame[1, p]
+            ephi = -sp * frame[0, p] + cp * frame[1, p]
+            rho[p] = origin[p] + cr * er + cz * frame[2, p]
+            rho_cov[0, p] = tr * er + tz * frame[2, p]
+            rho_cov[1, p] = ephi if pole else cr * ephi
+            n[p] = -tz * er + tr * frame[2, p]
+        a_cov[0, 0] = 1.0
+        if prof[k, 0] == 1.0 and prof[k, 5] == 1.0:
+            chart = SHARP_CORNER
+        if pole:  # on the axis the surface is umbilic: unit e_phi, the meridian's curvature
+            a_cov[1, 1] = 1.0
+            h_cov[1, 1] = h_cov[0, 0]
+            chart = 1
+        else:
+            a_cov[1, 1] = cr * cr
+            h_cov[1, 1] = cr * tz
     else:
         r = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         if r > 0.0:
@@ -173,7 +231,7 @@ def _add_rr(coef, rho_cov, scale, K):
 
 @njit(cache=True)
 def analytic_core(
-    kind, origin, frame, radius, sigma, xs, eps_n, case, want_parts, xi, R_out, K_out, P_out, work, lam_k=0.0
+    kind, origin, frame, radius, sigma, prof, xs, eps_n, case, want_parts, xi, R_out, K_out, P_out, work, lam_k=0.0
 ):
     """Project ``xs`` and evaluate the 3 x 3 rigid-master contact element; returns (g, chart).
 
@@ -184,7 +242,7 @@ def analytic_core(
     """
     rho, rho_cov, a_cov, a_con, n, h_cov, h_con, c_con, D1, D2 = work
     g, chart = analytic_geometry(
-        kind, origin, frame, radius, sigma, xs, xi, rho, rho_cov, a_cov, a_con, n, h_cov
+        kind, origin, frame, radius, sigma, prof, xs, xi, rho, rho_cov, a_cov, a_con, n, h_cov
     )
     for p in range(3):
         R_out[p] = 0.0
@@ -205,7 +263,7 @@ def analytic_core(
     for p in range(3):
         for q in range(3):
             K_out[p, q] = eps_n * n[p] * n[q]
-    if case == CASE_EXACT:
+    if case == CASE_EXACT or (chart == SHARP_CORNER and (case == CASE_A or case == CASE_C)):
         for i in range(2):
             for j in range(2):
                 D1[i, j] = -D1[i, j]
@@ -219,8 +277,11 @@ def analytic_core(
         for p in range(3):
             for q in range(3):
                 P_out[0, p, q] = eps_n * n[p] * n[q]
-        _add_rr(h_con, rho_cov, -eps_n * ge, P_out[2])
-        _add_rr(D2, rho_cov, eps_n, P_out[3])
+        if chart == SHARP_CORNER:  # a vertex: its whole second-order stiffness is the "curvature" part
+            _add_rr(D1, rho_cov, -eps_n, P_out[2])
+        else:
+            _add_rr(h_con, rho_cov, -eps_n * ge, P_out[2])
+            _add_rr(D2, rho_cov, eps_n, P_out[3])
     return g, chart
 
 
@@ -231,6 +292,7 @@ def analytic_batch(
     frame,
     radius,
     sigma,
+    prof,
     xs,
     eps,
     case,
@@ -265,6 +327,7 @@ def analytic_batch(
                 frame,
                 radius,
                 sigma,
+                prof,
                 xs[s],
                 eps[s],
                 case,
@@ -313,6 +376,7 @@ class _Analytic:
     kind = PLANE
     radius = 0.0
     sigma = 1.0
+    prof = NO_PROFILE
     motion: RigidMotion
     _origin: np.ndarray
     _frame: np.ndarray
@@ -352,7 +416,8 @@ class _Analytic:
             np.zeros((2, 2)),
         )
         g, chart = analytic_geometry(
-            self.kind, origin, frame, float(self.radius), float(self.sigma), xs, xi, rho, rc, a, ac, n, h
+            self.kind, origin, frame, float(self.radius), float(self.sigma), self.prof, xs, xi, rho, rc, a, ac,
+            n, h
         )
         return AnalyticProjection(float(g), xi, int(chart), rho, rc, a, h, n)
 
@@ -374,6 +439,7 @@ class _Analytic:
             frame,
             float(self.radius),
             float(self.sigma),
+            self.prof,
             xs,
             eps,
             case,
@@ -430,6 +496,7 @@ class _Analytic:
                 frame,
                 float(self.radius),
                 float(self.sigma),
+                self.prof,
                 xs,
                 e,
                 case,
@@ -485,3 +552,67 @@ class Sphere(_Analytic):
 
     def __post_init__(self):
         self._place(SPHERE, self.center, "center", radius=self.radius, outside=self.outside)
+
+
+def _axis_pair(e3: np.ndarray, u, v) -> tuple[np.ndarray, np.ndarray]:
+    """The profile plane's directions (u, v) for extrusion along e3: the given ones, or for an axis along x,
+    y or z the other two coordinate axes in order (y, z / x, z / x, y)."""
+    axes = np.eye(3)
+    along = [i for i in range(3) if abs(abs(e3[i]) - 1.0) < 1e-12]
+    others = [i for i in range(3) if along and i != along[0]]
+    if u is None and not along:
+        raise ValueError("extrude.u: needed for an axis that is not along x, y or z (the direction of the "
+                         "profile's first coordinate)")
+    uu = axes[others[0]] if u is None else unit_vector(u, "extrude.u")
+    if abs(uu @ e3) > 1e-9:
+        raise ValueError("extrude.u: must be perpendicular to extrude.axis")
+    if v is None:
+        v = axes[others[1]] if u is None else np.cross(e3, uu)
+    vv = unit_vector(v, "extrude.v")
+    if abs(vv @ e3) > 1e-9 or abs(vv @ uu) > 1e-9:
+        raise ValueError("extrude.v: must be perpendicular to extrude.axis and to extrude.u")
+    return uu, vv
+
+
+@dataclass
+class Profile(_Analytic):
+    """Rigid surface swept by a 2D ``points`` polyline with ``fillets`` (``profile.build_profile``).
+
+    extrude = {axis, origin, u, v}: the profile's (p, q) at origin + p u + q v, swept along axis (u, v
+    default to the other two coordinate axes of an axis along x, y or z). revolve = {axis, center}: (p, q) =
+    (distance from the axis, position along it from center), revolved about the axis. The contact side lies
+    on the left when walking along the points (p to the right, q up).
+    """
+
+    points: tuple | np.ndarray = ((0.0, 0.0), (1.0, 0.0))
+    fillets: tuple | np.ndarray | None = None
+    extrude: dict | None = None
+    revolve: dict | None = None
+    motion: RigidMotion = field(default_factory=RigidMotion)
+
+    def __post_init__(self):
+        if (self.extrude is None) == (self.revolve is None):
+            raise ValueError("give either extrude = {axis, origin} or revolve = {axis, center}")
+        pts = np.asarray(self.points, dtype=np.float64)
+        fil = None if self.fillets is None else np.asarray(self.fillets, dtype=np.float64)
+        if self.extrude is not None:
+            ex = dict(self.extrude)
+            e3 = unit_vector(ex.get("axis"), "extrude.axis")
+            u, v = _axis_pair(e3, ex.get("u"), ex.get("v"))
+            self._place(EXTRUDED, ex.get("origin", (0.0, 0.0, 0.0)), "extrude.origin")
+            e2 = np.cross(e3, u)
+            hand = 1.0 if v @ e2 > 0.0 else -1.0
+            self._frame = np.ascontiguousarray(np.vstack([u, e2, e3]))
+            if pts.ndim == 2 and pts.shape[1:] == (2,):
+                pts = pts * np.array([1.0, hand])
+                if hand < 0.0:  # the mirrored drawing keeps its contact side by walking it backwards
+                    pts = pts[::-1]
+                    fil = None if fil is None else fil[::-1]
+        else:
+            rv = dict(self.revolve)
+            self._place(REVOLVED, rv.get("center", (0.0, 0.0, 0.0)), "revolve.center", rv.get("axis"),
+                        "revolve.axis")
+            if pts.ndim == 2 and pts.shape[1:] == (2,) and np.any(pts[:, 0] < 0.0):
+                raise ValueError("points: the first coordinate of a revolved profile is the distance from the "
+                                 "axis and must not be negative")
+        self.prof = build_profile(pts, fil, axis_ends=self.revolve is not None)

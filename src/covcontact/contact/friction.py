@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit, prange
 
-from covcontact.contact.analytic import CYLINDER, PLANE, analytic_core, new_analytic_work
+from covcontact.contact.analytic import CYLINDER, EXTRUDED, PLANE, REVOLVED, analytic_core, new_analytic_work
 from covcontact.contact.element import (
     CASE_EXACT,
     INSIDE_TOL,
@@ -52,6 +52,7 @@ from covcontact.contact.friction_kernels import (
 )
 from covcontact.contact.geometry import facet_geometry
 from covcontact.contact.laws import is_active
+from covcontact.contact.profile import profile_closest, profile_derivative
 from covcontact.contact.projection import DEGENERATE, project_on_facet
 from covcontact.fem.shapes import NODES
 
@@ -83,12 +84,32 @@ _CHUNK = 16
 
 
 @njit(cache=True)
-def _surface_deriv(kind, origin, frame, radius, sigma, chart, xi, na, nb_, out):
+def _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, na, nb_, out):
     """d^(na + nb_) rho / d xi1^na d xi2^nb_ of an analytic surface in ``chart`` (3,) into out."""
     for p in range(3):
         out[p] = 0.0
     hp = 0.5 * np.pi
-    if kind == PLANE:
+    if kind == EXTRUDED:
+        if nb_ == 0:
+            cx, cy = profile_derivative(prof, xi[0], na)
+            for p in range(3):
+                out[p] = cx * frame[0, p] + cy * frame[1, p]
+                if na == 0:
+                    out[p] += origin[p] - xi[1] * frame[2, p]
+        elif nb_ == 1 and na == 0:
+            for p in range(3):
+                out[p] = -frame[2, p]
+    elif kind == REVOLVED:
+        cr, cz = profile_derivative(prof, xi[0], na)
+        c = np.cos(xi[1] + nb_ * hp)
+        s = np.sin(xi[1] + nb_ * hp)
+        for p in range(3):
+            out[p] = cr * (c * frame[0, p] + s * frame[1, p])
+            if nb_ == 0:
+                out[p] += cz * frame[2, p]
+                if na == 0:
+                    out[p] += origin[p]
+    elif kind == PLANE:
         for p in range(3):
             if na == 0 and nb_ == 0:
                 out[p] = origin[p] + xi[0] * frame[0, p] + xi[1] * frame[1, p]
@@ -122,22 +143,40 @@ def _surface_deriv(kind, origin, frame, radius, sigma, chart, xi, na, nb_, out):
 
 
 @njit(cache=True)
-def surface_derivs(kind, origin, frame, radius, sigma, chart, xi, rho, rho1, rho2, rho3):
+def surface_derivs(kind, origin, frame, radius, sigma, prof, chart, xi, rho, rho1, rho2, rho3):
     """rho and its derivatives by xi up to third order, (3,), (2, 3), (2, 2, 3), (2, 2, 2, 3)."""
-    _surface_deriv(kind, origin, frame, radius, sigma, chart, xi, 0, 0, rho)
+    _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, 0, 0, rho)
     for i in range(2):
-        _surface_deriv(kind, origin, frame, radius, sigma, chart, xi, 1 - i, i, rho1[i])
+        _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, 1 - i, i, rho1[i])
         for j in range(2):
-            _surface_deriv(kind, origin, frame, radius, sigma, chart, xi, 2 - i - j, i + j, rho2[i, j])
+            _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, 2 - i - j, i + j, rho2[i, j])
             for k in range(2):
                 nb_ = i + j + k
-                _surface_deriv(kind, origin, frame, radius, sigma, chart, xi, 3 - nb_, nb_, rho3[i, j, k])
+                _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, 3 - nb_, nb_,
+                               rho3[i, j, k])
 
 
 @njit(cache=True)
-def surface_coords(kind, origin, frame, radius, sigma, chart, point, xi_ref, xi_out):
+def surface_coords(kind, origin, frame, radius, sigma, prof, chart, point, xi_ref, xi_out):
     """Coordinates in ``chart`` of a point on the surface, angles unwrapped to within pi of xi_ref."""
     d = (point[0] - origin[0], point[1] - origin[1], point[2] - origin[2])
+    if kind == EXTRUDED:
+        pp = d[0] * frame[0, 0] + d[1] * frame[0, 1] + d[2] * frame[0, 2]
+        qq = d[0] * frame[1, 0] + d[1] * frame[1, 1] + d[2] * frame[1, 2]
+        k, t, _ = profile_closest(prof, pp, qq)
+        xi_out[0] = prof[k, 1] + t
+        xi_out[1] = -(d[0] * frame[2, 0] + d[1] * frame[2, 1] + d[2] * frame[2, 2])
+        return
+    if kind == REVOLVED:
+        x1 = d[0] * frame[0, 0] + d[1] * frame[0, 1] + d[2] * frame[0, 2]
+        x2 = d[0] * frame[1, 0] + d[1] * frame[1, 1] + d[2] * frame[1, 2]
+        z = d[0] * frame[2, 0] + d[1] * frame[2, 1] + d[2] * frame[2, 2]
+        k, t, _ = profile_closest(prof, np.sqrt(x1 * x1 + x2 * x2), z)
+        phi = np.arctan2(x2, x1)
+        tp = 2.0 * np.pi
+        xi_out[0] = prof[k, 1] + t
+        xi_out[1] = phi + tp * np.round((xi_ref[1] - phi) / tp)
+        return
     if kind == PLANE:
         xi_out[0] = d[0] * frame[0, 0] + d[1] * frame[0, 1] + d[2] * frame[0, 2]
         xi_out[1] = d[0] * frame[1, 0] + d[1] * frame[1, 1] + d[2] * frame[1, 2]
@@ -176,7 +215,7 @@ def new_analytic_friction_work():
 
 
 @njit(cache=True)
-def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t, mu, hist, xi,
+def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, eps_t, mu, hist, xi,
                            R_out, K_out, hist_out, work, lam_k=0.0):
     """Friction element of one slave node against a rigid analytic surface (3 x 3, slave dofs).
 
@@ -186,10 +225,10 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
     """
     aw, fw, geo = work
     rho, rho1, rho2, rho3, a_cov, a_con, a_n, a_ni, ar, d1, d2, r, tvec, dtdx, xin, dxi, T, pt, dummy = geo
-    g, chart = analytic_core(kind, origin, frame, radius, sigma, xs, eps_n, CASE_EXACT, False, xi, R_out,
+    g, chart = analytic_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, CASE_EXACT, False, xi, R_out,
                              K_out, dummy, aw, lam_k)
     nrm = aw[4]
-    surface_derivs(kind, origin, frame, radius, sigma, chart, xi, rho, rho1, rho2, rho3)
+    surface_derivs(kind, origin, frame, radius, sigma, prof, chart, xi, rho, rho1, rho2, rho3)
     for i in range(2):
         for j in range(2):
             a_cov[i, j] = rho1[i, 0] * rho1[j, 0] + rho1[i, 1] * rho1[j, 1] + rho1[i, 2] * rho1[j, 2]
@@ -233,7 +272,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
             pt[p] += frame[e, p] * hist[H_RHO + e]
             tvec[p] += frame[e, p] * (Tu0 * hist[H_RHO_COV + e] + Tu1 * hist[H_RHO_COV + 3 + e])
         r[p] = xs[p] - rho[p]
-    surface_coords(kind, origin, frame, radius, sigma, chart, pt, xi, xin)
+    surface_coords(kind, origin, frame, radius, sigma, prof, chart, pt, xi, xin)
     dxi[0] = xi[0] - xin[0]
     dxi[1] = xi[1] - xin[1]
     state = friction_generic(1, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, dxi, tvec, dtdx,
@@ -244,7 +283,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, xs, eps_n, eps_t,
 
 
 @njit(cache=True, parallel=True)
-def analytic_friction_batch(kind, origin, frame, radius, sigma, xs, eps_n, eps_t, mu, hist, R_out, K_out,
+def analytic_friction_batch(kind, origin, frame, radius, sigma, prof, xs, eps_n, eps_t, mu, hist, R_out, K_out,
                             hist_out, g_out, xi_out, state_out, lam_k):
     """``analytic_friction_core`` for ns slave points (ns, 3), parallel; per-slave eps_n, eps_t, mu, hist and
     lam_k (Uzawa multipliers, zeros for the penalty).
@@ -259,7 +298,7 @@ def analytic_friction_batch(kind, origin, frame, radius, sigma, xs, eps_n, eps_t
         lo = c * _CHUNK
         hi = min(ns, lo + _CHUNK)
         for s in range(lo, hi):
-            g, st = analytic_friction_core(kind, origin, frame, radius, sigma, xs[s], eps_n[s], eps_t[s],
+            g, st = analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs[s], eps_n[s], eps_t[s],
                                            mu[s], hist[s], xi_out[s], R_out[s], K_out[s], hist_out[s], work,
                                            lam_k[s])
             g_out[s] = g
@@ -367,7 +406,7 @@ def node_to_surface_friction(
 
 
 def surface_friction(surface, slave_xyz, eps_n, eps_t, mu, history=None, lam: float = 1.0) -> FrictionResult:
-    """Frictional contact of one slave node against a rigid ``Plane``, ``Cylinder`` or ``Sphere``.
+    """Frictional contact of one slave node against a rigid ``Plane``, ``Cylinder``, ``Sphere`` or ``Profile``.
 
     Arguments as ``node_to_surface_friction``; ``lam`` places the surface (its ``RigidMotion``).
     Residual (3,) and tangent (3, 3) act on the slave dofs only.
@@ -377,7 +416,7 @@ def surface_friction(surface, slave_xyz, eps_n, eps_t, mu, history=None, lam: fl
     origin, frame = surface.placement(lam)
     xi, R, K, ho = np.zeros(2), np.zeros(3), np.zeros((3, 3)), np.zeros(HIST_SIZE)
     g, state = analytic_friction_core(surface.kind, origin, frame, float(surface.radius),
-                                      float(surface.sigma), xs, eps, et, m, hist, xi, R, K, ho,
+                                      float(surface.sigma), surface.prof, xs, eps, et, m, hist, xi, R, K, ho,
                                       new_analytic_friction_work())
     normal = surface.contact(xs, eps, "exact", lam)
     pr = surface.project(xs, lam)

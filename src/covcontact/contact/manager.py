@@ -277,7 +277,7 @@ class ContactManager:
             K = np.zeros((ns, 3, 3))
             hist_out = np.zeros((ns, HIST_SIZE))
             analytic_friction_batch(p.analytic.kind, origin, frame, float(p.analytic.radius),
-                                    float(p.analytic.sigma), xs, np.ascontiguousarray(p.eps),
+                                    float(p.analytic.sigma), p.analytic.prof, xs, np.ascontiguousarray(p.eps),
                                     np.ascontiguousarray(p.eps_t), np.full(ns, p.mu), c.hist.copy(), R, K,
                                     hist_out, t.gap, t.xi, t.status, np.ascontiguousarray(t.multiplier))
         else:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .analytic import Cylinder, Plane, Sphere
+from .analytic import Cylinder, Plane, Profile, Sphere
 from .element import CASES
 from .surface import MeshSurface, facet_sizes, tributary_area
 
@@ -47,8 +47,11 @@ class Pass:
 
 
 def analytic_surface(rb):
-    """The analytic surface of a rigid body with ``shape`` plane, cylinder or sphere."""
+    """The analytic surface of a rigid body with ``shape`` plane, cylinder, sphere or profile."""
     p = rb.params
+    if rb.shape == "profile":
+        return Profile(points=p["points"], fillets=p["fillets"], extrude=p["extrude"], revolve=p["revolve"],
+                       motion=rb.motion)
     if rb.shape == "plane":
         return Plane(point=p["point"], normal=p["normal"], motion=rb.motion)
     if rb.shape == "cylinder":

@@ -3,6 +3,8 @@ values, component names, name lists and load steps (docs/input.md)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import math
 
 from ..description import Steps
@@ -80,12 +82,16 @@ def read_steps(sec: Section | None) -> Steps:
     fixed = [k for k in ("count", "factors") if sec.has(k)]
     if auto and fixed:
         sec.fail(f"give either {' / '.join(fixed)} or automatic increments (initial, min, max), not both", auto[0])
+    marks = sec.get("output_at", "floats", ())
+    if any(b <= a for a, b in zip((0.0,) + marks, marks)):
+        sec.fail("must be a strictly increasing list of positive load factors", "output_at")
     if sec.has("factors"):
         factors = sec.get("factors", "floats")
         sec.done()
         if not factors or any(b <= a for a, b in zip((0.0,) + factors, factors)):
             sec.fail("must be a non-empty, strictly increasing list of positive load factors", "factors")
-        return Steps(factors)
+        _marks_on_steps(sec, marks, factors)
+        return Steps(factors, output_at=marks)
     if auto:
         final = sec.get("final", "float", 1.0, positive=True)
         initial = sec.get("initial", "float", positive=True)
@@ -98,8 +104,21 @@ def read_steps(sec: Section | None) -> Steps:
             sec.fail(f"must lie between min = {lo:g} and max = {hi:g}, got {initial:g}", "initial")
         if hi > final:
             sec.fail(f"must not exceed the stage's final load factor {final:g}, got {hi:g}", "max")
-        return Steps.automatic(initial, lo, hi, final)
+        if marks and marks[-1] > final:
+            sec.fail(f"{marks[-1]:g} lies beyond the stage's final load factor {final:g}", "output_at")
+        return replace(Steps.automatic(initial, lo, hi, final), output_at=marks)
     n = sec.get("count", "int", 1, positive=True)
     final = sec.get("final", "float", 1.0, positive=True)
     sec.done()
-    return Steps.equal(n, final)
+    steps = Steps.equal(n, final)
+    _marks_on_steps(sec, marks, steps.factors)
+    return replace(steps, output_at=marks)
+
+
+def _marks_on_steps(sec: Section, marks: tuple, factors: tuple) -> None:
+    """With fixed steps every ``output_at`` value must be the end of a step."""
+    for m in marks:
+        if not any(abs(m - f) <= 1e-9 * max(1.0, abs(f)) for f in factors):
+            sec.fail(f"{m:g} is not the end of a step ({', '.join(f'{f:g}' for f in factors[:6])}"
+                     f"{', ...' if len(factors) > 6 else ''}); with fixed steps list step ends, or use automatic "
+                     "increments (initial, min, max), which end exactly at each output_at", "output_at")

@@ -114,8 +114,8 @@ class Convergence(Observer):
 
 
 class Results(Observer):
-    """The VTU series and result.pvd: the start (step 0) and every ``every``-th converged step, the last step
-    of each stage and of the run always. ``writer`` None (the ranks other than the first of a distributed run):
+    """The VTU series and result.pvd: the start (step 0), every ``every``-th converged step and the steps that
+    end at an ``output_at`` load factor, the last step of each stage and of the run always. ``writer`` None (the ranks other than the first of a distributed run):
     the fields are computed (their gathering is collective) but not written."""
 
     def __init__(self, writer: ResultWriter | None, every: int):
@@ -128,7 +128,7 @@ class Results(Observer):
 
     def increment_converged(self, run, inc) -> None:
         k, proc = inc.step, run.procedure
-        if k % self.every == 0 or inc.ends_stage:  # the last step of each stage, and so of the run
+        if k % self.every == 0 or inc.ends_stage or inc.output:  # stage ends (so the run's end), output_at
             self._write(run, inc.lam, k, proc.t_stage + inc.lam)
 
     def _write(self, run, lam: float, step: int, time_value: float) -> None:

@@ -1,4 +1,4 @@
-"""The ``[[rigid]]`` section: rigid bodies, analytic (plane, cylinder, sphere) or meshed, with their motion,
+"""The ``[[rigid]]`` section: rigid bodies, analytic (plane, cylinder, sphere, profile) or meshed, with their motion,
 free components and applied force and moment (docs/input.md)."""
 
 from __future__ import annotations
@@ -7,12 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..contact.analytic import Profile
 from ..description import RigidBody
 from .bodies_input import CELLS, build_mesh, user_sets
 from .fields import COMPONENT_NAMES, free_components, read_motion
 from .validate import Section
 
-RIGID_SHAPES = ("plane", "cylinder", "sphere", "mesh")
+RIGID_SHAPES = ("plane", "cylinder", "sphere", "profile", "mesh")
 
 
 def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
@@ -38,6 +39,8 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         elif shape == "sphere":
             params = {"center": r.get("center", "vector"), "radius": r.get("radius", "float", positive=True),
                       "outside": r.get("outside", "bool", True)}
+        elif shape == "profile":
+            params = _read_profile(r)
         else:
             element = r.get("element", "str", None, choices=CELLS)
             mesh = build_mesh(r.get("mesh", "table"), base, element)
@@ -57,3 +60,39 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params, free=free,
                                force=force, moment=moment, reference=reference))
     return rigid
+
+
+def _read_profile(r: Section) -> dict:
+    """points, fillets and extrude or revolve of a profile tool, checked by building it (one line naming
+    the key on error)."""
+    raw = r.get("points", "any")
+    if not (isinstance(raw, list) and all(isinstance(p, list) and len(p) == 2 and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in p) for p in raw)):
+        r.fail("must be an array of [p, q] pairs (the profile in its own plane), e.g. [[35.0, 60.0], "
+               "[35.0, 0.0], [0.0, 0.0]]", "points")
+    points = [tuple(float(v) for v in p) for p in raw]
+    fillets = r.get("fillets", "floats", None)
+    if fillets is None and len(points) > 2:
+        r.fail(f"missing: one radius per interior corner ({len(points) - 2} here; 0 for a sharp corner)",
+               "fillets")
+    params = {"points": points, "fillets": fillets, "extrude": None, "revolve": None}
+    if r.has("extrude") == r.has("revolve"):
+        r.fail("give either extrude = { axis, origin } or revolve = { axis, center }")
+    if r.has("extrude"):
+        ex = r.get("extrude", "table")
+        params["extrude"] = {"axis": ex.get("axis", "vector"), "origin": ex.get("origin", "vector", (0.0, 0.0, 0.0)),
+                             "u": ex.get("u", "vector", None), "v": ex.get("v", "vector", None)}
+        ex.done()
+    else:
+        rv = r.get("revolve", "table")
+        params["revolve"] = {"axis": rv.get("axis", "vector"), "center": rv.get("center", "vector", (0.0, 0.0, 0.0))}
+        rv.done()
+    try:
+        Profile(**params)
+    except ValueError as err:
+        msg = str(err)
+        key, _, text = msg.partition(": ")
+        if key in ("points", "fillets") or key.startswith(("extrude.", "revolve.")):
+            r.fail(text, key)
+        r.fail(msg)
+    return params

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..contact.analytic import CYLINDER, PLANE
+from ..contact.analytic import CYLINDER, EXTRUDED, PLANE, REVOLVED
+from ..contact.profile import ARC, profile_point
 from ..contact.setup import analytic_surface
 
 
@@ -28,6 +29,8 @@ def tessellate(surface, lam: float, center: np.ndarray, size: float) -> tuple[np
     """Points and quads approximating an analytic surface near ``center`` (extent ``size``)."""
     origin, frame = surface.placement(lam)
     e1, e2, e3 = frame
+    if surface.kind in (EXTRUDED, REVOLVED):
+        return _tessellate_profile(surface, origin, frame, center, size)
     if surface.kind == PLANE:
         c = center - np.dot(center - origin, e3) * e3
         s = np.linspace(-0.6 * size, 0.6 * size, 21)
@@ -49,6 +52,32 @@ def tessellate(surface, lam: float, center: np.ndarray, size: float) -> tuple[np
     d = (np.sin(TH) * np.cos(PH)).ravel()[:, None] * e1 + (np.sin(TH) * np.sin(PH)).ravel()[:, None] * e2 \
         + np.cos(TH).ravel()[:, None] * e3
     return origin + R * d, _grid_quads(48, 24, True)
+
+
+def profile_polyline(prof: np.ndarray) -> np.ndarray:
+    """Points (m, 2) along a profile from its first to its last given point, arcs in steps of 10 degrees."""
+    out = []
+    for k, seg in enumerate(prof):
+        n = max(2, int(np.ceil(seg[2] / seg[7] / np.radians(10.0))) + 1) if seg[0] == ARC else 2
+        for t in np.linspace(0.0, seg[2], n)[(1 if k else 0):]:
+            out.append(profile_point(prof, k, t)[:2])
+    return np.array(out)
+
+
+def _tessellate_profile(surface, origin, frame, center, size):
+    """The whole profile, extruded over the model's extent or revolved all round."""
+    e1, e2, e3 = frame
+    c2 = profile_polyline(surface.prof)
+    m = len(c2)
+    if surface.kind == EXTRUDED:
+        z0 = float(np.dot(center - origin, e3))
+        z = np.linspace(z0 - 0.6 * size, z0 + 0.6 * size, 11)
+        pts = [origin + c2[:, :1] * e1 + c2[:, 1:] * e2 + zz * e3 for zz in z]
+        return np.vstack(pts), _grid_quads(m - 1, 10, False)
+    t = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    pts = [origin + c2[i, 0] * (np.cos(t)[:, None] * e1 + np.sin(t)[:, None] * e2) + c2[i, 1] * e3
+           for i in range(m)]
+    return np.vstack(pts), _grid_quads(48, m - 1, True)
 
 
 def rigid_visual(manager, lam: float, fields) -> tuple:

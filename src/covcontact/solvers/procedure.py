@@ -19,8 +19,13 @@ from .state import State
 class FixedIncrements:
     """The load factors of a stage as its input gives them (``count`` or ``factors``)."""
 
-    def __init__(self, factors):
+    def __init__(self, factors, marks=()):
         self.factors = tuple(float(f) for f in factors)
+        self.marks = tuple(float(m) for m in marks)
+
+    def is_mark(self, lam: float) -> bool:
+        """Whether results are requested at load factor ``lam`` (``output_at``)."""
+        return any(abs(lam - m) <= 1e-9 * max(1.0, abs(m)) for m in self.marks)
 
     def target(self, lam: float) -> float | None:
         """The load factor of the step after the converged load factor ``lam``; None when the stage is done."""
@@ -51,15 +56,20 @@ class AutomaticIncrements:
     GROW = 1.5
     SHRINK = 0.75
 
-    def __init__(self, initial: float, lo: float, hi: float, end: float):
+    def __init__(self, initial: float, lo: float, hi: float, end: float, marks=()):
         self.increment, self.lo, self.hi, self.end = float(initial), float(lo), float(hi), float(end)
+        self.marks = tuple(float(m) for m in marks)
         self.easy = 0  # easy steps in a row
+
+    is_mark = FixedIncrements.is_mark
 
     def target(self, lam: float) -> float | None:
         if lam >= self.end - 1e-12 * max(1.0, abs(self.end)):
             return None
         t = lam + self.increment
-        return self.end if t >= self.end - self.lo else t
+        # the next output_at (or the stage's end) is hit exactly; a remainder below min goes with this step
+        stop = next((m for m in self.marks + (self.end,) if m > lam + 1e-9 * max(1.0, abs(m))), self.end)
+        return stop if t >= stop - self.lo else t
 
     def record(self, inc, converged: list) -> None:
         """Adapt the increment to how step ``inc`` went (``converged``: its increments that converged, after
@@ -90,9 +100,10 @@ class AutomaticIncrements:
 
 def increment_control(spec, steps):
     """The increment control of stage ``spec`` from its ``Steps``: automatic or the given load factors."""
+    marks = () if steps is None else steps.output_at
     if steps is not None and steps.is_automatic:
-        return AutomaticIncrements(steps.initial, steps.min, steps.max, spec.lam_end)
-    return FixedIncrements(spec.factors)
+        return AutomaticIncrements(steps.initial, steps.min, steps.max, spec.lam_end, marks)
+    return FixedIncrements(spec.factors, marks)
 
 
 @dataclass
@@ -111,6 +122,7 @@ class Increment:
     state: State
     entry: dict = field(default_factory=dict)
     ends_stage: bool = False  # the step reached the stage's end
+    output: bool = False  # the step ended at a load factor of ``output_at``
 
     @property
     def iterations(self) -> int:
@@ -171,7 +183,8 @@ class QuasiStatic:
         else:
             success, outcomes, cutbacks, why, new = newton.advance(u, state.lam, lam, state)
         inc = Increment(step, state.lam, lam, success, outcomes, cutbacks, why, new if success else state,
-                        ends_stage=success and self.control.target(lam) is None)
+                        ends_stage=success and self.control.target(lam) is None,
+                        output=success and self.control.is_mark(lam))
         inc.entry = self._report(inc, u, stats0, time0)
         self.control.record(inc, newton.converged_increments)
         return inc
