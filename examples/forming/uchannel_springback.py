@@ -81,7 +81,7 @@ def springback_measures(X: np.ndarray, u_loaded: np.ndarray, u_final: np.ndarray
     chord in place of the tangents. Needs a straight sidewall of a few elements (a stroke of about 20 mm
     or more); for short strokes ``theta1_chord`` alone is meaningful."""
     loaded, final = midline(X, u_loaded), midline(X, u_final)
-    zb = loaded[0, 1]
+    zb = 0.5 * T - stroke  # the mid-surface on the punch face at the end of the stroke
     bottom = loaded[:, 0] < 30.0 - margin
     side = ((loaded[:, 0] > 30.0) & (loaded[:, 0] < 42.0) & (loaded[:, 1] > zb + R_PUNCH + margin)
             & (loaded[:, 1] < zb + stroke - R_DIE - margin))
@@ -124,7 +124,7 @@ def load_run(problem_file: Path, out: Path) -> dict:
     summary = json.loads((out / "summary.json").read_text())
     steps = summary["steps"]
     k_draw = [s["step"] for s in steps if s["stage"] == "draw"][-1]
-    stroke = -float(np.ravel(problem.stages[0].targets["pin"])[0])
+    stroke = -round(float(problem.stages[0].motions["punch"].apply(np.zeros((1, 3)), 1.0)[0, 2]), 2)
 
     def u(k):
         return meshio.read(out / f"step_{k:04d}.vtu").point_data["displacement"][:n]
@@ -135,11 +135,12 @@ def load_run(problem_file: Path, out: Path) -> dict:
 
 def punch_force(summary: dict) -> tuple[np.ndarray, np.ndarray]:
     """Punch stroke fraction (load factor of the draw) and punch force on the half model (N) per draw step:
-    the punch's two pairs plus the centre nodes that move with it."""
+    the punch pair's (and, in runs of earlier versions of the example, its corner pair and the centre nodes
+    that moved with it)."""
     steps = [s for s in summary["steps"] if s["stage"] == "draw"]
     lam = np.array([s["load_factor"] for s in steps])
-    f = np.array([-(s["pairs"]["punch"]["contact_force"][2] + s["pairs"]["punch_corner"]["contact_force"][2]
-                    + s["reactions"]["blank.pin"][2]) for s in steps])
+    f = np.array([-(sum(p["contact_force"][2] for k, p in s["pairs"].items() if k.startswith("punch"))
+                    + s["reactions"].get("blank.pin", [0.0, 0.0, 0.0])[2]) for s in steps])
     return lam, f
 
 

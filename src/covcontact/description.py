@@ -89,6 +89,7 @@ class ContactPair:
     max_augmentations: int = 20
     auto_factor: float = 10.0
     enabled: bool = True               # off: the pair does nothing until a stage switches it on
+    smoothing: float = 0.0             # width of the band of gaps over which the normal law is rounded (C1)
 
 
 @dataclass

@@ -4,19 +4,25 @@ springback (examples/forming/uchannel.toml; docs/verification.md, "U-channel dra
 Half model, plane strain: blank 175 x 35 x 0.78 mm, plastic solid-shell hex8 with 5 Gauss points through
 the thickness, Swift hardening sigma = 565.32 (0.007117 + eps_p)^0.2589 MPa; punch half-width 35 mm and die
 opening half-width 37 mm, both corner radii 5 mm; blank holder an analytic plane with only z free, pressed
-with 1225 N (2.45 kN on the whole blank); Coulomb mu = 0.144 on every pair. The release: the holder and die
-pairs released (switched off, the forces they carried ramped to zero), then the punch pairs; the blank is
-then held by the symmetry plane and the centre line's bottom nodes (which followed the punch).
+with 1225 N (2.45 kN on the whole blank); Coulomb mu = 0.144 on every pair; punch and die are one profile
+each (wall, fillet, face), every pair with a contact smoothing of 0.05 mm. The blank is held by contact
+alone. The release: the holder and die pairs released (switched off, the forces they carried ramped to zero),
+then the punch pair.
 
-The full 70 mm stroke takes minutes (docs/verification.md gives the angles); this test runs a CI-size
-version of the same file: a 15 mm stroke in 1 mm steps on the 2 mm mesh (about 30 s). Checked, each a
-quantity that a broken contact, friction, reference-node or plasticity path would change:
+The full 70 mm stroke takes about a minute (docs/verification.md gives the angles); this test runs a CI-size
+version of the same file: a 15 mm stroke in the example's automatic increments (from 0.5 mm, at most 3.5 mm)
+on the 2 mm mesh. Checked, each a quantity that a broken contact, friction, reference-node or plasticity path
+would change:
 
 - the blank holder's equilibrium (summary.json ``rigid_bodies``): the contact force on it balances the
   applied 1225 N at every step, and its friction force never exceeds mu times it and reaches it (full slip)
   in most draw steps;
-- the blank's own z equilibrium: the five pairs' contact forces and the centre node's reaction sum to zero;
-- the punch force (on the punch: its two pairs, plus the centre node that moves with it) is positive and
+- the blank's own z equilibrium: the three pairs' contact forces sum to zero;
+- the iteration budget of the draw: at most 9 Newton iterations per increment on average and at most 2
+  cutbacks (measured: 8.1 and none; the first 15 mm, where the sheet first wraps round both corners, are the
+  hardest part of the draw: the full stroke averages 7.4; without the contact smoothing the first 25 mm take
+  10.8 per increment);
+- the punch force (the punch pair's) is positive and
   of the size of a steady-draw estimate: the sidewall tension T = (2 mu F_h + 2 M_p w / R_m) e^(mu pi / 2)
   (holder and die friction, bending plus unbending over the die corner, capstan friction round it), with
   M_p = sigma_0' t^2 / 4, sigma_0' = 2 / sqrt(3) sigma_Swift(eps_b), eps_b = t / (2 R_m) the bending strain
@@ -71,11 +77,12 @@ def uchannel(stroke: float = 70.0, steps: int | None = None, nx: int | None = No
         blank["options"]["thickness_points"] = thickness_points
     draw = raw["stages"][0]
     assert draw["name"] == "draw"
-    draw["targets"]["pin"] = -stroke
     for m in draw["motions"].values():
         m["translation"] = [0.0, 0.0, -stroke - 0.002]
     if steps is not None:
         draw["steps"] = {"count": steps}
+    else:  # the example's increments in mm of stroke: from 0.5 mm, at most 3.5 mm
+        draw["steps"] = {"initial": 0.5 / stroke, "min": 1e-5, "max": min(3.5 / stroke, 1.0)}
     raw["output"] = {"every": every, "checkpoint_every": 10**6}
     return raw
 
@@ -106,12 +113,20 @@ def tension_estimate() -> float:
     return (2 * MU * F_HOLDER + 2 * m_p * W / r_m) * math.exp(MU * math.pi / 2)
 
 
-STROKE, STEPS = 15.0, 15
+STROKE = 15.0
 
 
 @pytest.fixture(scope="module")
 def ci_run(tmp_path_factory):
-    return run_uchannel(uchannel(STROKE, STEPS), tmp_path_factory.mktemp("uchannel"))
+    return run_uchannel(uchannel(STROKE), tmp_path_factory.mktemp("uchannel"))
+
+
+def test_iteration_budget_of_the_draw(ci_run):
+    draw = [s for s in ci_run["summary"]["steps"] if s["stage"] == "draw"]
+    its = sum(s["iterations"] for s in draw)
+    assert draw[-1]["load_factor"] == 1.0
+    assert its / len(draw) <= 9.0, (its, len(draw))
+    assert sum(s["cutbacks"] for s in draw) <= 2
 
 
 def test_holder_equilibrium_and_full_slip(ci_run):
@@ -132,17 +147,14 @@ def test_holder_equilibrium_and_full_slip(ci_run):
 def test_blank_equilibrium_and_punch_force(ci_run):
     steps = [s for s in ci_run["summary"]["steps"] if s["stage"] == "draw"]
     for s in steps:
-        fz = sum(p["contact_force"][2] for p in s["pairs"].values()) + s["reactions"]["blank.pin"][2]
+        fz = sum(p["contact_force"][2] for p in s["pairs"].values())
         assert fz == pytest.approx(0.0, abs=2e-5 * F_HOLDER)
-    punch = np.array([-(s["pairs"]["punch"]["contact_force"][2] + s["pairs"]["punch_corner"]["contact_force"][2]
-                        + s["reactions"]["blank.pin"][2]) for s in steps])
+    punch = np.array([-s["pairs"]["punch"]["contact_force"][2] for s in steps])
     assert np.all(punch[1:] > 0.0)
     estimate = tension_estimate()  # about 1.3 kN
-    late = punch[len(punch) // 2:]   # after 7.5 mm the sheet has gone round the die corner
+    stroke = np.array([s["load_factor"] for s in steps]) * STROKE
+    late = punch[stroke >= 7.5]   # after 7.5 mm the sheet has gone round the die corner
     assert 0.5 * estimate < late.mean() < 1.5 * estimate
-    # the centre node that moves with the punch carries a small part of it
-    pin = np.array([s["reactions"]["blank.pin"][2] for s in steps[len(steps) // 2:]])
-    assert np.all(np.abs(pin) < 0.15 * late)
 
 
 def test_plastic_strain_in_the_bends(ci_run):

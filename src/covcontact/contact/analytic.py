@@ -35,7 +35,7 @@ from covcontact.contact.element import (
     check_inputs,
     check_multiplier,
 )
-from covcontact.contact.laws import c_inverse, effective_gap, is_active
+from covcontact.contact.laws import c_inverse, effective_gap, is_active, linear_equivalent
 from covcontact.contact.profile import PROFILE_COLS, build_profile, profile_closest, profile_point
 from covcontact.motion import RigidMotion, frame_from_axis, unit_vector
 
@@ -231,14 +231,15 @@ def _add_rr(coef, rho_cov, scale, K):
 
 @njit(cache=True)
 def analytic_core(
-    kind, origin, frame, radius, sigma, prof, xs, eps_n, case, want_parts, xi, R_out, K_out, P_out, work, lam_k=0.0
+    kind, origin, frame, radius, sigma, prof, xs, eps_n, case, want_parts, xi, R_out, K_out, P_out, work, lam_k=0.0,
+    band=0.0,
 ):
     """Project ``xs`` and evaluate the 3 x 3 rigid-master contact element; returns (g, chart).
 
     xi: (2,) out. R_out (3,), K_out (3, 3), P_out (4, 3, 3) out (P_out untouched unless want_parts);
     order of parts as ``PART_NAMES``. ``work[4]`` holds the normal on return. lam_k: Uzawa multiplier
-    (<= 0, fixed during Newton; 0 = penalty). g is the geometric gap; outputs are zero when
-    lam_k + eps_n g > 0.
+    (<= 0, fixed during Newton; 0 = penalty); band: width of the smoothing of the normal law (0: none).
+    g is the geometric gap; outputs are zero when the slave is not active.
     """
     rho, rho_cov, a_cov, a_con, n, h_cov, h_con, c_con, D1, D2 = work
     g, chart = analytic_geometry(
@@ -251,9 +252,10 @@ def analytic_core(
             if want_parts:
                 for k in range(4):
                     P_out[k, p, q] = 0.0
-    ge = effective_gap(g, lam_k, eps_n)  # lam_N = eps_n ge
-    if not is_active(g, lam_k, eps_n):
+    if not is_active(g, lam_k, eps_n, band):
         return g, chart
+    eps_n, lam_k = linear_equivalent(g, lam_k, eps_n, band)  # the smoothed law (band > 0) at this g
+    ge = effective_gap(g, lam_k, eps_n)  # lam_N = eps_n ge
     for p in range(3):
         R_out[p] = eps_n * ge * n[p]
     _mat2_prod3(a_con, h_cov, a_con, h_con, 1.0)
@@ -303,6 +305,7 @@ def analytic_batch(
     n_out,
     chart_out,
     lam_k=None,
+    band=0.0,
 ):
     """Many slave points (ns, 3) against one analytic surface, parallel over slaves.
 
@@ -338,6 +341,7 @@ def analytic_batch(
                 dummy,
                 work,
                 lk,
+                band,
             )
             g_out[s] = g
             chart_out[s] = chart
@@ -422,11 +426,12 @@ class _Analytic:
         return AnalyticProjection(float(g), xi, int(chart), rho, rc, a, h, n)
 
     def contact(
-        self, slave_xyz, eps_n, parts: str = "a", lam: float = 1.0, multiplier: float = 0.0
+        self, slave_xyz, eps_n, parts: str = "a", lam: float = 1.0, multiplier: float = 0.0, band: float = 0.0
     ) -> ContactResult:
         """Contact element of one slave node (3 x 3, slave dofs only); see ``ContactResult``.
 
-        lam is the load factor of the motion; multiplier the Uzawa multiplier lam_k <= 0 (0: penalty).
+        lam is the load factor of the motion; multiplier the Uzawa multiplier lam_k <= 0 (0: penalty); band the
+        width of the normal law's smoothing (0: none).
         """
         xs, eps, case, _ = check_inputs(slave_xyz, eps_n, parts, None)
         lam_k = check_multiplier(multiplier)
@@ -450,6 +455,7 @@ class _Analytic:
             P,
             work,
             lam_k,
+            float(band),
         )
         return ContactResult(
             gap=float(g),
@@ -461,7 +467,8 @@ class _Analytic:
             parts={name: P[k] for k, name in enumerate(PART_NAMES)},
         )
 
-    def evaluate(self, slave_xyz, eps, parts: str = "a", lam: float = 1.0, multiplier=None) -> AnalyticBatch:
+    def evaluate(self, slave_xyz, eps, parts: str = "a", lam: float = 1.0, multiplier=None,
+                 band: float = 0.0) -> AnalyticBatch:
         """Compiled batch over slave points (ns, 3) with penalties ``eps`` (scalar or (ns,)).
 
         lam: load factor of the motion. multiplier: Uzawa multipliers lam_k <= 0 (scalar or (ns,));
@@ -507,6 +514,7 @@ class _Analytic:
                 out.normal,
                 out.chart,
                 lk,
+                float(band),
             )
         return out
 

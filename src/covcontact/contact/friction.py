@@ -51,7 +51,7 @@ from covcontact.contact.friction_kernels import (
     new_friction_work,
 )
 from covcontact.contact.geometry import facet_geometry
-from covcontact.contact.laws import is_active
+from covcontact.contact.laws import is_active, linear_equivalent
 from covcontact.contact.profile import profile_closest, profile_derivative
 from covcontact.contact.projection import DEGENERATE, project_on_facet
 from covcontact.fem.shapes import NODES
@@ -216,7 +216,7 @@ def new_analytic_friction_work():
 
 @njit(cache=True)
 def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, eps_t, mu, hist, xi,
-                           R_out, K_out, hist_out, work, lam_k=0.0):
+                           R_out, K_out, hist_out, work, lam_k=0.0, band=0.0):
     """Friction element of one slave node against a rigid analytic surface (3 x 3, slave dofs).
 
     origin, frame: current placement (frame rows e1, e2, e3). xi: (2,) out, projection. History
@@ -226,7 +226,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, 
     aw, fw, geo = work
     rho, rho1, rho2, rho3, a_cov, a_con, a_n, a_ni, ar, d1, d2, r, tvec, dtdx, xin, dxi, T, pt, dummy = geo
     g, chart = analytic_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, CASE_EXACT, False, xi, R_out,
-                             K_out, dummy, aw, lam_k)
+                             K_out, dummy, aw, lam_k, band)
     nrm = aw[4]
     surface_derivs(kind, origin, frame, radius, sigma, prof, chart, xi, rho, rho1, rho2, rho3)
     for i in range(2):
@@ -249,8 +249,9 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, 
         hist_out[H_RHO_COV + e] = s1
         hist_out[H_RHO_COV + 3 + e] = s2
     hist_out[H_FLAG] = 1.0
-    if not is_active(g, lam_k, eps_n):
+    if not is_active(g, lam_k, eps_n, band):
         return g, OPEN
+    eps_n, lam_k = linear_equivalent(g, lam_k, eps_n, band)  # the smoothed law's traction and slope here
     if mu == 0.0:
         return g, SLIP
     if hist[H_FLAG] == 0.0:
@@ -284,7 +285,7 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, 
 
 @njit(cache=True, parallel=True)
 def analytic_friction_batch(kind, origin, frame, radius, sigma, prof, xs, eps_n, eps_t, mu, hist, R_out, K_out,
-                            hist_out, g_out, xi_out, state_out, lam_k):
+                            hist_out, g_out, xi_out, state_out, lam_k, band=0.0):
     """``analytic_friction_core`` for ns slave points (ns, 3), parallel; per-slave eps_n, eps_t, mu, hist and
     lam_k (Uzawa multipliers, zeros for the penalty).
 
@@ -300,7 +301,7 @@ def analytic_friction_batch(kind, origin, frame, radius, sigma, prof, xs, eps_n,
         for s in range(lo, hi):
             g, st = analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs[s], eps_n[s], eps_t[s],
                                            mu[s], hist[s], xi_out[s], R_out[s], K_out[s], hist_out[s], work,
-                                           lam_k[s])
+                                           lam_k[s], band)
             g_out[s] = g
             state_out[s] = st
 
@@ -405,11 +406,12 @@ def node_to_surface_friction(
         traction_vector=_traction_vector(T, rc), history=ho)
 
 
-def surface_friction(surface, slave_xyz, eps_n, eps_t, mu, history=None, lam: float = 1.0) -> FrictionResult:
+def surface_friction(surface, slave_xyz, eps_n, eps_t, mu, history=None, lam: float = 1.0,
+                     band: float = 0.0) -> FrictionResult:
     """Frictional contact of one slave node against a rigid ``Plane``, ``Cylinder``, ``Sphere`` or ``Profile``.
 
-    Arguments as ``node_to_surface_friction``; ``lam`` places the surface (its ``RigidMotion``).
-    Residual (3,) and tangent (3, 3) act on the slave dofs only.
+    Arguments as ``node_to_surface_friction``; ``lam`` places the surface (its ``RigidMotion``); ``band`` the
+    width of the normal law's smoothing (0: none). Residual (3,) and tangent (3, 3) act on the slave dofs only.
     """
     xs, eps, _, _ = check_inputs(slave_xyz, eps_n, "exact", None)
     et, m, hist = _check_friction(eps_t, mu, history)
@@ -417,8 +419,8 @@ def surface_friction(surface, slave_xyz, eps_n, eps_t, mu, history=None, lam: fl
     xi, R, K, ho = np.zeros(2), np.zeros(3), np.zeros((3, 3)), np.zeros(HIST_SIZE)
     g, state = analytic_friction_core(surface.kind, origin, frame, float(surface.radius),
                                       float(surface.sigma), surface.prof, xs, eps, et, m, hist, xi, R, K, ho,
-                                      new_analytic_friction_work())
-    normal = surface.contact(xs, eps, "exact", lam)
+                                      new_analytic_friction_work(), 0.0, float(band))
+    normal = surface.contact(xs, eps, "exact", lam, band=band)
     pr = surface.project(xs, lam)
     T = ho[H_T:H_T + 2].copy()
     return FrictionResult(

@@ -1,4 +1,5 @@
-"""Contact laws, each written once: the normal law (penalty or augmented Lagrangian) and the inverse of
+"""Contact laws, each written once: the normal law (penalty or augmented Lagrangian, optionally smoothed over
+a band of gaps) and the inverse of
 c_ij = a_ij - g h_ij that the exact tangents and the friction kernels share (docs/theory.md section 3).
 
 Normal law: with the Uzawa multiplier lam_k <= 0 of the last update (0 for pure penalty) the effective
@@ -20,9 +21,50 @@ def effective_gap(g, lam_k, eps_n):
 
 
 @njit(cache=True)
-def is_active(g, lam_k, eps_n):
-    """The activity test g + lam_k / eps_N <= 0 (scalars or arrays; +inf gaps are inactive)."""
+def is_active(g, lam_k, eps_n, band=0.0):
+    """The activity test g + lam_k / eps_N <= 0, or < band / 2 with a smoothing band (scalars or arrays; +inf
+    gaps are inactive)."""
+    if band > 0.0:
+        return effective_gap(g, lam_k, eps_n) < 0.5 * band
     return effective_gap(g, lam_k, eps_n) <= 0.0
+
+
+@njit(cache=True)
+def smooth_law(g, lam_k, eps_n, band):
+    """The smoothed normal law (scalars): (sigma, dsigma), sigma = -lam_N <= 0 the signed normal traction and
+    dsigma its derivative by g. With b = band / 2 and g_e = g + lam_k / eps_N: sigma = eps_N g_e for
+    g_e <= -b (the penalty law itself), -eps_N (b - g_e)^2 / (4 b) for |g_e| < b, 0 beyond: C1 at the
+    band's ends."""
+    ge = effective_gap(g, lam_k, eps_n)
+    b = 0.5 * band
+    if ge <= -b:
+        return eps_n * ge, eps_n
+    if ge >= b:
+        return 0.0, 0.0
+    t = b - ge
+    return -eps_n * t * t / (4.0 * b), eps_n * t / (2.0 * b)
+
+
+@njit(cache=True)
+def linear_equivalent(g, lam_k, eps_n, band):
+    """(eps', lam_k') of the linear law lam_k' + eps' g that has the smoothed law's traction and slope at this
+    g (an active g: g_e < band / 2): the kernels, written for the linear law, then evaluate the smoothed one
+    exactly (residual sigma n, tangent dsigma n n + sigma hess g)."""
+    if band <= 0.0:
+        return eps_n, lam_k
+    sig, dsig = smooth_law(g, lam_k, eps_n, band)
+    return dsig, sig - dsig * g
+
+
+def linear_equivalents(g: np.ndarray, lam_k: np.ndarray, eps_n: np.ndarray, band: float):
+    """``linear_equivalent`` over arrays of active slaves."""
+    if band <= 0.0:
+        return eps_n, lam_k
+    e = np.empty_like(eps_n)
+    m = np.empty_like(lam_k)
+    for k in range(len(g)):
+        e[k], m[k] = linear_equivalent(g[k], lam_k[k], eps_n[k], band)
+    return e, m
 
 
 @njit(cache=True)
@@ -31,9 +73,12 @@ def normal_pressure(g, lam_k, eps_n):
     return lam_k + eps_n * g
 
 
-def uzawa_update(lam_k: np.ndarray, g: np.ndarray, eps_n: np.ndarray) -> np.ndarray:
-    """The augmented-Lagrangian update lam_k <- min(lam_k + eps_N g, 0) (gaps without contact point: 0)."""
+def uzawa_update(lam_k: np.ndarray, g: np.ndarray, eps_n: np.ndarray, band: float = 0.0) -> np.ndarray:
+    """The augmented-Lagrangian update lam_k <- min(lam_k + eps_N g, 0) (gaps without contact point: 0); with
+    a smoothing band lam_k <- sigma(g), the smoothed traction."""
     gg = np.where(np.isfinite(g), g, 0.0)
+    if band > 0.0:
+        return np.array([min(smooth_law(gg[k], lam_k[k], eps_n[k], band)[0], 0.0) for k in range(len(gg))])
     return np.minimum(normal_pressure(gg, lam_k, eps_n), 0.0)
 
 

@@ -23,7 +23,7 @@ from .edgelock import FREE, RELEASED, edge_point, inconsistent, new_locks
 from .element import CASE_A, CASES
 from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, transfer_history
 from .kernels import contact_batch
-from .laws import is_active, uzawa_update
+from .laws import is_active, linear_equivalents, uzawa_update
 from .reference import map_analytic, map_rigid_nodes
 from .search import candidates
 from .setup import Numbering, Pass, make_passes
@@ -171,15 +171,19 @@ class ContactManager:
         t.xi = np.where(ok[:, None], res.xi, 0.0)
         t.gap = np.where(ok, res.g, np.inf)
         t.hist_facet = t.facet.copy()
-        active = ok & is_active(res.g, t.multiplier, p.eps)
+        active = ok & is_active(res.g, t.multiplier, p.eps, p.band)
         nen = p.surface.nen
         nd = 3 * (nen + 1)
+        # the smoothed law as the linear one with its traction and slope at each gap (the same g the kernels
+        # compute from the projection)
+        eps_s, lam_s = linear_equivalents(res.g, t.multiplier, p.eps, p.band) if p.band > 0.0 else \
+            (p.eps, t.multiplier)
         idx = np.flatnonzero(active & (res.kind == FACET))
         if idx.size:
             conn = np.hstack([p.surface.faces[res.facet[idx]], p.slaves[idx][:, None]])
             xi = np.ascontiguousarray(res.xi[idx])
-            eps = np.ascontiguousarray(p.eps[idx])
-            lam_k = np.ascontiguousarray(t.multiplier[idx])
+            eps = np.ascontiguousarray(eps_s[idx])
+            lam_k = np.ascontiguousarray(lam_s[idx])
             g = np.zeros(idx.size)
             R = np.zeros((idx.size, nd))
             K = np.zeros((idx.size, nd, nd))
@@ -215,7 +219,7 @@ class ContactManager:
             for j, s in enumerate(idx):
                 R[j], K[j], t.gap[s] = edge_vertex_contact(
                     xe[conn[j, :nen]], res.xi[s], xe[p.slaves[s]], 1.0 if res.g[s] >= 0.0 else -1.0,
-                    float(p.eps[s]), float(t.multiplier[s]), vertex=bool(res.kind[s] == VERTEX))
+                    float(eps_s[s]), float(lam_s[s]), vertex=bool(res.kind[s] == VERTEX))
             t.force[idx] = -R[:, -3:]
             self._add(ev.blocks, conn, R, K if want_K else None, xe)
             if want_parts:
@@ -279,11 +283,11 @@ class ContactManager:
             analytic_friction_batch(p.analytic.kind, origin, frame, float(p.analytic.radius),
                                     float(p.analytic.sigma), p.analytic.prof, xs, np.ascontiguousarray(p.eps),
                                     np.ascontiguousarray(p.eps_t), np.full(ns, p.mu), c.hist.copy(), R, K,
-                                    hist_out, t.gap, t.xi, t.status, np.ascontiguousarray(t.multiplier))
+                                    hist_out, t.gap, t.xi, t.status, np.ascontiguousarray(t.multiplier), p.band)
         else:
-            out = p.analytic.evaluate(xs, p.eps, parts=_CASE_NAME[case], lam=lam, multiplier=mult)
+            out = p.analytic.evaluate(xs, p.eps, parts=_CASE_NAME[case], lam=lam, multiplier=mult, band=p.band)
             R, K, t.gap, t.xi = out.residual, out.tangent, out.gap, out.xi
-        active = is_active(t.gap, t.multiplier, p.eps)
+        active = is_active(t.gap, t.multiplier, p.eps, p.band)
         if p.mu > 0.0:
             t.hist[active] = hist_out[active]
         t.force = -R
@@ -298,7 +302,8 @@ class ContactManager:
         else:
             ev.blocks.add(conn, R[idx], K[idx] if want_K else None)
         if want_parts:
-            tan = {name: p.analytic.evaluate(xs, p.eps, parts=name, lam=lam, multiplier=mult).tangent[idx]
+            tan = {name: p.analytic.evaluate(xs, p.eps, parts=name, lam=lam, multiplier=mult,
+                                             band=p.band).tangent[idx]
                    for name in ("d", "c", "exact")}
             zero = np.zeros((idx.size, 3))
             ev.parts[0].add(conn, zero, tan["d"])
@@ -320,7 +325,7 @@ class ContactManager:
                 continue
             new = new or trial.copy()
             q = new.passes[k]
-            q.multiplier = uzawa_update(t.multiplier, t.gap, p.eps)
+            q.multiplier = uzawa_update(t.multiplier, t.gap, p.eps, p.band)
             q.n_aug += 1
         return new
 
@@ -361,7 +366,7 @@ class ContactManager:
     # -- queries on a state -----------------------------------------------------------------------
     def active_mask(self, k: int, state: ContactState) -> np.ndarray:
         s = state.passes[k]
-        return is_active(s.gap, s.multiplier, self.passes[k].eps)
+        return is_active(s.gap, s.multiplier, self.passes[k].eps, self.passes[k].band)
 
     def active_count(self, state: ContactState) -> int:
         return int(sum(np.count_nonzero(self.active_mask(k, state)) for k in range(len(self.passes))))

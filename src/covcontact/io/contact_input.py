@@ -46,11 +46,12 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         mu = c.get("friction", "float", 0.0, nonnegative=True)
         eps_t = c.get("tangential_penalty", "float", None, positive=True)
         enabled = c.get("enabled", "bool", True)
+        smoothing = c.get("smoothing", "float", 0.0, nonnegative=True)
         c.done()
         if any(x.name == cname for x in contacts):
             c.fail(f"duplicate contact name {cname!r}", "name")
         contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass,
                                     friction=mu, tangential_penalty=eps_t, method=method, gap_tolerance=gap_tol,
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
-                                    auto_factor=auto_factor, enabled=enabled))
+                                    auto_factor=auto_factor, enabled=enabled, smoothing=smoothing))
     return contacts
