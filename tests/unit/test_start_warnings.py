@@ -80,3 +80,21 @@ def test_a_few_nodes_deep_inside_are_warned():
             assert "move the bodies apart or check the geometry" in warnings[0]
         else:
             assert warnings == []
+
+
+@pytest.mark.parametrize("E, warned", [(206000.0, False), (206.0, True), (2.06e11, True)])
+def test_mixed_units_of_a_plastic_material_are_warned(tmp_path, E, warned):
+    """A J2 bar with the yield stress in MPa and E in MPa (fine), GPa or Pa (E / sigma_y0 = 0.8 or 8e8: mixed
+    units): the run goes on, with a warning naming the body and the ratio."""
+    raw = {"problem": {"name": "bar"},
+           "bodies": [{"name": "bar", "material": {"model": "j2", "E": E, "nu": 0.3, "yield_stress": 250.0,
+                                                   "hardening": {"law": "linear", "modulus": 1000.0}},
+                       "mesh": {"generator": "block", "lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 1, "ny": 1, "nz": 1}}],
+           "dirichlet": [{"set": "bar.zmin"}, {"set": "bar.zmax", "components": "z", "value": 1e-4}],
+           "output": {"vtu": False}}
+    res = problem_from_dict(raw, tmp_path / "p.toml").run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    warnings = res.summary.get("warnings", [])
+    assert bool(warnings) == warned
+    if warned:
+        assert "body 'bar'" in warnings[0] and "same units" in warnings[0]

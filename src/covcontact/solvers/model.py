@@ -219,9 +219,11 @@ class Model:
         return out
 
     def start_warnings(self, u: np.ndarray, state: State) -> list[str]:
-        """Warnings about the start of a run that is legal but almost certainly wrong (contact/report.py)."""
+        """Warnings about the start of a run that is legal but almost certainly wrong: materials whose Young's
+        modulus and yield stress look like mixed units; slave nodes inside their master (contact/report.py)."""
+        out = self._material_warnings()
         if not self.contact.passes or self.size > 1:
-            return []
+            return out
         from ..contact.report import start_warnings
 
         names = {}
@@ -232,7 +234,25 @@ class Model:
                 names[pair.name] = f"the analytic {rb.shape} {rb.name!r}{extra}"
             else:
                 names[pair.name] = f"the faces {pair.master[0]}.{pair.master[1]}"
-        return start_warnings(self.contact, self.positions(u), state.contact, names)
+        return out + start_warnings(self.contact, self.positions(u), state.contact, names)
+
+    def _material_warnings(self) -> list[str]:
+        """E / sigma_y0 of every plastic body against the range of engineering metals and polymers (about 20
+        to 1e4): outside 10..1e5 the two were most likely given in different units (GPa and MPa, Pa and MPa)."""
+        from ..materials.plasticity import J2
+
+        out = []
+        for body, blk in zip(self.problem.bodies, self.system.blocks):
+            mat = blk.solid.material
+            if mat.kind != J2:
+                continue
+            E, sy = float(mat.params[0]), float(mat.params[6])  # Young's modulus, initial yield stress
+            ratio = E / sy if sy > 0.0 else np.inf
+            if not 10.0 <= ratio <= 1e5:
+                out.append(f"body {body.name!r}: Young's modulus E = {E:g} is {ratio:.3g} times the initial yield "
+                           f"stress {sy:g}; metals and polymers lie between about 20 and 1e4: are E and the yield "
+                           f"stress in the same units (MPa and GPa, Pa and MPa)?")
+        return out
 
     # queries on a state -----------------------------------------------------------------------
     def active_count(self, state: State) -> int:
