@@ -57,7 +57,7 @@ def build(nx: int = 18, ny: int = 8, n_phi: int = 48, n_theta: int = 12, penalty
         forces=[NodalForce("plate", "xmax", (0.0, 0.0, -1500.0), "total"),
                 NodalForce("plate", "ymax", (0.0, 0.0, -1000.0), "total")],
         steps=Steps.equal(steps),
-        solver=SolverOptions(rtol=1e-8, etol=1e-16, max_iterations=25),
+        solver=SolverOptions(rtol=1e-8, etol=1e-16, max_iterations=25, predictor="tangent"),
         output=OutputOptions(vtu=True, every=10, pictures=True),
         source=Path(__file__),
     )

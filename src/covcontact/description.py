@@ -167,9 +167,10 @@ class SolverOptions:
     #: (direct solvers); "auto": where the factorisation is expensive enough to pay (PARDISO's flop count)
     reuse_factorization: bool | str = "auto"
     krylov_max: int = 30
-    #: first iterate of a step: "tangent" (the tangent at the converged state with the prescribed increment)
-    #: or "extrapolate" (the previous step's increment scaled to this one, then Newton)
-    predictor: str = "tangent"
+    #: first iterate of a step: "tangent" (the tangent at the converged state with the prescribed increment),
+    #: "extrapolate" (the previous step's increment scaled to this one, then Newton) or "auto" (extrapolate in
+    #: path-dependent problems, those with a plastic material or a frictional pair; tangent otherwise)
+    predictor: str = "auto"
     #: precision of PARDISO's factorisations: "double", "single" (refined to double-precision accuracy by GMRES),
     #: or "auto" (single where it pays: PardisoSolver's rule); the other solvers factorise in double precision
     factorization_precision: str = "auto"

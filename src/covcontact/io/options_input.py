@@ -31,7 +31,7 @@ def read_solver(top: Section) -> SolverOptions:
             divergence_factor=s.get("divergence_factor", "float", solver.divergence_factor, positive=True),
             reuse_factorization=_reuse_option(s, solver.reuse_factorization),
             krylov_max=s.get("krylov_max", "int", solver.krylov_max, positive=True),
-            predictor=s.get("predictor", "str", solver.predictor, choices=("tangent", "extrapolate")),
+            predictor=s.get("predictor", "str", solver.predictor, choices=("auto", "tangent", "extrapolate")),
             factorization_precision=s.get("factorization_precision", "str", solver.factorization_precision,
                                           choices=("auto", "double", "single")),
             reproducible=s.get("reproducible", "bool", solver.reproducible),

@@ -91,6 +91,20 @@ class StepOutcome:
     augmentation: int = 0
 
 
+def extrapolates(predictor: str, problem) -> bool:
+    """Whether ``predictor`` extrapolates in ``problem``: "extrapolate", or "auto" in a path-dependent problem
+    (a plastic material or a frictional contact pair), where the previous step's increment is a far better
+    start than the tangent at the converged state (docs/performance.md, "Predictors")."""
+    if predictor != "auto":
+        return predictor == "extrapolate"
+    if problem is None:
+        return False
+    from ..materials.plasticity import J2
+
+    plastic = any(getattr(b.material, "kind", None) == J2 for b in problem.bodies)
+    return plastic or any((c.friction or 0.0) > 0.0 for c in problem.contacts)
+
+
 class Newton:
     """Newton solver over a ``Model`` (``covcontact.solvers.model``).
 
@@ -114,6 +128,7 @@ class Newton:
         self._stalled = False  # the last inexact correction did not reduce the residual enough
         self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
+        self.extrapolate = extrapolates(options.predictor, getattr(model, "problem", None))
         self.poll = None  # called before every iteration (a distributed run's stop signals: StopSignals.poll)
         #: called after every converged increment of :meth:`advance` (after its Uzawa updates) as
         #: ``on_converged(u, lam_a, lam_b, committed, trial)``: the converged displacement, the increment's
@@ -131,7 +146,7 @@ class Newton:
         """Newton's part of a checkpoint: the largest force scale met, and the last step's increment where the
         extrapolating predictor continues from it."""
         arrays, meta = {}, {"force_scale": self.scale_seen, "last_step_lams": None}
-        if self._last is not None and self.opt.predictor == "extrapolate":
+        if self._last is not None and self.extrapolate:
             arrays["newton.last_increment"] = self._last[2]
             meta["last_step_lams"] = [self._last[0], self._last[1]]
         return arrays, meta
@@ -248,7 +263,7 @@ class Newton:
         increment scaled to this step on the free dofs and the prescribed increment ``du_d`` on the others,
         added to ``u``; returns the prescribed increment the first correction still has to make (zero then)."""
         last, free = self._last, self.model.free
-        if (self.opt.predictor == "extrapolate" and last is not None and lam_b > lam_a
+        if (self.extrapolate and last is not None and lam_b > lam_a
                 and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
             u[free] += (lam_b - lam_a) / (last[1] - last[0]) * last[2][free]
             u[~free] += du_d[~free]
