@@ -97,6 +97,20 @@ def test_control_grows_shrinks_and_ends_exactly():
     assert [f.target(x) for x in (0.0, 0.25, 0.5 - 1e-15, 1.0)] == [0.25, 0.5, 1.0, None]
 
 
+def test_control_shrinks_when_the_active_set_moves_a_lot():
+    """A step of 6-12 iterations (neither easy nor hard) in which more than a quarter of the contact nodes
+    (and more than 8) opened or closed shrinks the next increment; a small change, a few nodes, or an easy
+    step (a face touching at once) does not."""
+    c = AutomaticIncrements(0.1, 0.01, 0.4, 1.0)
+    for its, changed, active, expect in ((8, 20, 40, 0.075), (8, 5, 40, 0.075), (8, 6, 10, 0.075),
+                                         (8, 12, 40, 0.05625), (3, 40, 40, 0.05625)):
+        inc = _inc(iterations=its)
+        inc.opened_closed, inc.active = changed, active
+        c.record(inc, [(0.0, 0.1)])
+        assert c.increment == pytest.approx(expect), (its, changed, active)
+    assert c.easy == 1  # the easy step counted towards growth
+
+
 def test_run_with_automatic_increments(tmp_path):
     """The press grows its increment from 0.05 (the elastic block converges in two iterations a step: every two
     steps by 1.5) and ends exactly at 1; the lift stage (initial 1.0) is one step; every step reports its increment, which

@@ -39,22 +39,38 @@ def poke(force: float) -> Problem:
                    steps=Steps.equal(1), output=OutputOptions(vtu=False))
 
 
-def test_inversion_triggers_cutbacks_then_converges(tmp_path):
-    """The full step's predictor inverts an element; the step is cut back and then converges."""
-    res = poke(4.0).run(out=tmp_path)
+def test_inversion_is_backtracked_inside_newton(tmp_path):
+    """The full step's predictor inverts an element: Newton halves that correction (and any later one that
+    inverts) until every element is valid and converges in the one step, without a cutback; the answer is
+    the one reached with cutbacks (two half steps)."""
+    res = poke(4.0).run(out=tmp_path / "one")
     s = res.summary["steps"][0]
-    assert res.exit_code == 0 and s["converged"]
-    assert s["cutbacks"] >= 1
-    assert any("inverted" in r for r in s["cutback_reasons"]), s["cutback_reasons"]
+    assert res.exit_code == 0 and s["converged"] and s["cutbacks"] == 0
+    assert s["backtracks"] >= 1
     # the poked node went down by more than the element height (0.5) without any element inverting
-    assert res.u.reshape(-1, 3)[res.model.problem.bodies[0].mesh.node_sets["centre"][0], 2] < -0.5
+    centre = res.model.problem.bodies[0].mesh.node_sets["centre"][0]
+    assert res.u.reshape(-1, 3)[centre, 2] < -0.5
+    prob = poke(4.0)
+    prob.steps = Steps.equal(4)
+    ref = prob.run(out=tmp_path / "four")
+    np.testing.assert_allclose(res.u, ref.u, atol=1e-8)
 
 
-def test_cutback_budget_exhausted_keeps_converged_steps(tmp_path):
+def test_inversion_past_the_backtracks_cuts_back_and_exhausted_cutbacks_keep_converged_steps(tmp_path,
+                                                                                            monkeypatch):
+    """With no backtracking left, an inverting correction cuts the increment back; with no cutbacks left
+    either, the run stops with the converged steps kept (exit 1) and says why."""
+    from covcontact.solvers import newton
+
+    monkeypatch.setattr(newton, "MAX_BACKTRACKS", 0)
+    res = poke(4.0).run(out=tmp_path / "cut")
+    s = res.summary["steps"][0]
+    assert res.exit_code == 0 and s["cutbacks"] >= 1
+    assert any("inverted" in r for r in s["cutback_reasons"]), s["cutback_reasons"]
     prob = poke(4.0)
     prob.steps = Steps((0.05, 1.0))
     prob.solver = SolverOptions(max_cutbacks=0)
-    res = prob.run(out=tmp_path)
+    res = prob.run(out=tmp_path / "stop")
     assert res.exit_code == 1
     assert res.summary["converged"] is False
     assert [s["converged"] for s in res.summary["steps"]] == [True, False]

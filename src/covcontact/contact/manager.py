@@ -371,6 +371,11 @@ class ContactManager:
     def active_count(self, state: ContactState) -> int:
         return int(sum(np.count_nonzero(self.active_mask(k, state)) for k in range(len(self.passes))))
 
+    def opened_closed(self, a: ContactState, b: ContactState) -> int:
+        """Slave nodes whose contact opened or closed from state ``a`` to state ``b``."""
+        return int(sum(np.count_nonzero(self.active_mask(k, a) != self.active_mask(k, b))
+                       for k in range(len(self.passes))))
+
     def coupled_dofs(self, state: ContactState) -> np.ndarray:
         """Dofs of the deformable nodes of the active contact elements of ``state``."""
         nodes = []

@@ -45,6 +45,9 @@ class DistributedContact(ContactManager):
     def active_count(self, state) -> int:
         return count_all(self.comm, super().active_count(state))
 
+    def opened_closed(self, a, b) -> int:
+        return count_all(self.comm, super().opened_closed(a, b))
+
     def _penetration(self, p, t) -> float:
         """The Uzawa test looks at the slaves of all ranks."""
         return max_all(self.comm, super()._penetration(p, t))

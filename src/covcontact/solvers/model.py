@@ -258,6 +258,11 @@ class Model:
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)
 
+    def active_set_change(self, a: State, b: State) -> tuple[int, int]:
+        """(slave nodes whose contact opened or closed from ``a`` to ``b``, slave nodes in contact in ``b``),
+        over all ranks of a distributed run."""
+        return self.contact.opened_closed(a.contact, b.contact), self.contact.active_count(b.contact)
+
     def contact_codes(self, state: State) -> np.ndarray:
         """The contact status of every slave node of every pass in ``state``: 0 open, 1 closed (stick), 2
         slip; the changes from one Newton iteration to the next measure how much the active set moves."""

@@ -91,6 +91,10 @@ class StepOutcome:
     augmentation: int = 0
 
 
+#: halvings of a Newton correction whose full length inverts an element, before the increment is cut back
+MAX_BACKTRACKS = 5
+
+
 def extrapolates(predictor: str, problem) -> bool:
     """Whether ``predictor`` extrapolates in ``problem``: "extrapolate", or "auto" in a path-dependent problem
     (a plastic material or a frictional contact pair), where the previous step's increment is a far better
@@ -238,6 +242,25 @@ class Newton:
             raise SingularMatrixError("linear solve returned non-finite values")
         return du
 
+    def _backtrack(self, u, du, eta, lam, committed, trial):
+        """u += eta du and evaluate there; where an element inverts, halve eta on the free dofs (the prescribed
+        part of the correction is always made in full) up to ``MAX_BACKTRACKS`` times before giving up (the
+        InvertedElementError then cuts the increment back). Returns (eta, the evaluation)."""
+        free = self.model.free
+        base = u.copy()
+        for k in range(MAX_BACKTRACKS + 1):
+            u[:] = base
+            u[free] += eta * du[free]
+            u[~free] += du[~free]
+            try:
+                return eta, self._evaluate(u, lam, committed, trial)
+            except InvertedElementError:
+                if k == MAX_BACKTRACKS:
+                    raise
+                self.stats["backtracks"] = self.stats.get("backtracks", 0) + 1
+                eta *= 0.5
+        raise AssertionError("unreachable")
+
     def _line_search(self, u, du, lam, R0, committed, trial):
         s0 = float(du @ R0)
         R1, _, _ = self._evaluate(u + du, lam, committed, trial, want_K=False)
@@ -338,13 +361,15 @@ class Newton:
             du[~free] = du_d[~free] if it == 1 else 0.0
             eta = 1.0
             if opt.line_search and it > 1:
-                eta = self._line_search(u, du, lam_b, -rhs, committed, trial)
+                try:
+                    eta = self._line_search(u, du, lam_b, -rhs, committed, trial)
+                except InvertedElementError:  # the full correction inverts an element: backtrack below
+                    eta = 0.5
+            out.iterations = it
+            eta, (R, K, trial) = self._backtrack(u, du, eta, lam_b, committed, trial)
             energy = abs(float(du[free] @ rhs[free])) * eta
             if e0 is None:
                 e0 = max(energy, 1e-300)
-            u += eta * du
-            out.iterations = it
-            R, K, trial = self._evaluate(u, lam_b, committed, trial)
             t0 = time.perf_counter()
             reactions = float(np.linalg.norm(R[~free]))
             rhs = -R

@@ -46,8 +46,9 @@ class AutomaticIncrements:
     """Increments of the load factor chosen as the steps go (``[steps] initial, min, max``), in the manner of
     Abaqus/Standard: start with ``initial``; after ``EASY_STEPS`` steps in a row that converged without a
     cutback in at most ``EASY_ITERATIONS`` iterations, grow by ``GROW``; after a step that needed more than
-    ``HARD_ITERATIONS``, shrink by ``SHRINK``; after a step that needed cutbacks, go on with the increment that
-    finally converged; never below ``min`` (Newton's cutbacks stop there) nor above ``max``; the last step
+    ``HARD_ITERATIONS``, or more than ``EASY_ITERATIONS`` while more than ``SET_CHANGE`` of the active slave
+    nodes (and more than ``SET_CHANGE_MIN``) opened or closed, shrink by ``SHRINK``; after a step that needed cutbacks, go on
+    with the increment that finally converged; never below ``min`` (Newton's cutbacks stop there) nor above ``max``; the last step
     ends exactly at the stage's end (a remainder below ``min`` is taken with the step before it)."""
 
     EASY_ITERATIONS = 5
@@ -55,6 +56,8 @@ class AutomaticIncrements:
     HARD_ITERATIONS = 12
     GROW = 1.5
     SHRINK = 0.75
+    SET_CHANGE = 0.25  # shrink when more than this fraction of the active slaves opened or closed in a step
+    SET_CHANGE_MIN = 8  # (and more than this many)
 
     def __init__(self, initial: float, lo: float, hi: float, end: float, marks=()):
         self.increment, self.lo, self.hi, self.end = float(initial), float(lo), float(hi), float(end)
@@ -81,6 +84,11 @@ class AutomaticIncrements:
             self.increment, self.easy = min(max(b - a, self.lo), self.hi), 0
             return
         its = inc.outcomes[-1].iterations
+        if its > self.EASY_ITERATIONS and inc.opened_closed > max(self.SET_CHANGE_MIN, self.SET_CHANGE * inc.active):
+            # a step that was not easy and in which the active set changed a lot: the next one is likely to
+            # change it as much
+            self.increment, self.easy = max(self.increment * self.SHRINK, self.lo), 0
+            return
         if its <= self.EASY_ITERATIONS:
             self.easy += 1
             if self.easy >= self.EASY_STEPS:
@@ -123,6 +131,8 @@ class Increment:
     entry: dict = field(default_factory=dict)
     ends_stage: bool = False  # the step reached the stage's end
     output: bool = False  # the step ended at a load factor of ``output_at``
+    opened_closed: int = 0  # slave nodes whose contact opened or closed in the step (automatic increments)
+    active: int = 0  # slave nodes in contact at its end (automatic increments)
 
     @property
     def iterations(self) -> int:
@@ -185,6 +195,8 @@ class QuasiStatic:
         inc = Increment(step, state.lam, lam, success, outcomes, cutbacks, why, new if success else state,
                         ends_stage=success and self.control.target(lam) is None,
                         output=success and self.control.is_mark(lam))
+        if success and self.automatic:  # how much the active set moved in the step (the increment control)
+            inc.opened_closed, inc.active = self.model.active_set_change(state, new)
         inc.entry = self._report(inc, u, stats0, time0)
         self.control.record(inc, newton.converged_increments)
         return inc
@@ -213,6 +225,9 @@ class QuasiStatic:
             entry["increment"] = inc.lam - inc.lam_a
         if self.augmented:
             entry["uzawa_iterations"] = sum(1 for o in inc.outcomes if o.augmentation > 0)
+        backtracks = newton.stats.get("backtracks", 0) - stats0.get("backtracks", 0)
+        if backtracks:  # Newton corrections shortened because their full length inverted an element
+            entry["backtracks"] = backtracks
         if inc.cutbacks:
             entry["cutback_reasons"] = [o.reason for o in inc.outcomes if not o.converged]
         if not inc.success:
