@@ -66,7 +66,7 @@ def test_inversion_past_the_backtracks_cuts_back_and_exhausted_cutbacks_keep_con
     res = poke(4.0).run(out=tmp_path / "cut")
     s = res.summary["steps"][0]
     assert res.exit_code == 0 and s["cutbacks"] >= 1
-    assert any("inverted" in r for r in s["cutback_reasons"]), s["cutback_reasons"]
+    assert any("inverted" in r and "(centre at " in r for r in s["cutback_reasons"]), s["cutback_reasons"]
     prob = poke(4.0)
     prob.steps = Steps((0.05, 1.0))
     prob.solver = SolverOptions(max_cutbacks=0)

@@ -258,6 +258,19 @@ class Model:
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)
 
+    def explain_inversion(self, body: str, element: int) -> str:
+        """Where element ``element`` of ``body`` lies, and the contact pairs whose slave nodes it carries (an
+        element that inverts next to a contact is most often crushed by it: a penalty too soft or too stiff,
+        an increment too large, a tool that cuts in at a sharp corner)."""
+        blk = next((b for b in self.system.blocks if b.name == body), None)
+        if self.size > 1 or blk is None or not hasattr(blk.solid, "cells"):  # (a rank holds part of the mesh)
+            return ""
+        nodes = np.asarray(blk.solid.cells[element]) + blk.offset
+        X = self.system.X[nodes].mean(axis=0)
+        pairs = sorted({p.pair for p in self.contact.passes if np.intersect1d(p.slaves, nodes).size})
+        where = f" (centre at {X[0]:.4g}, {X[1]:.4g}, {X[2]:.4g})"
+        return where + (f", on the slave side of contact pair {', '.join(repr(p) for p in pairs)}" if pairs else "")
+
     def active_set_change(self, a: State, b: State) -> tuple[int, int]:
         """(slave nodes whose contact opened or closed from ``a`` to ``b``, slave nodes in contact in ``b``),
         over all ranks of a distributed run."""

@@ -407,7 +407,11 @@ class Newton:
     def _try(self, u, lam_a, lam_b, committed, trial):
         try:
             return self.step(u, lam_a, lam_b, committed, trial)
-        except (InvertedElementError, LinearSolverError) as exc:
+        except InvertedElementError as exc:
+            explain = getattr(self.model, "explain_inversion", None)
+            where = explain(exc.body, exc.element) if explain is not None else ""
+            return StepOutcome(converged=False, reason=str(exc) + where), None
+        except LinearSolverError as exc:
             return StepOutcome(converged=False, reason=str(exc)), None
 
     def advance(self, u: np.ndarray, lam_a: float, lam_b: float, committed, min_increment: float | None = None,
