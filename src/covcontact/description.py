@@ -90,6 +90,9 @@ class ContactPair:
     auto_factor: float = 10.0
     enabled: bool = True               # off: the pair does nothing until a stage switches it on
     smoothing: float = 0.0             # width of the band of gaps over which the normal law is rounded (C1)
+    law: str = "penalty"               # normal law: "penalty" (with ``smoothing``) or "exponential"
+    clearance: float | None = None     # exponential law: the gap at which the pressure starts
+    pressure: float | None = None      # exponential law: the pressure at zero gap
 
 
 @dataclass

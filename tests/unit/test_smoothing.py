@@ -125,3 +125,81 @@ def test_facet_pair_tangent_with_smoothing(tmp_path, friction):
     g = res.state.contact.passes[0].gap
     band = g[np.abs(g) < 0.002]
     assert band.size > 0  # some slaves sit inside the band: the smoothed part of the law is exercised
+
+
+# ------------------------------------------------------------------ exponential pressure-overclosure law
+
+C0, P0 = 0.05, 20.0
+
+
+def test_exponential_law_shape():
+    """p(0) = p0, p(c0) = 0, convex and C1 on the whole range (its linear continuation beyond an overclosure of
+    2 c0 included); the slope is the derivative of the force."""
+    from covcontact.contact.laws import exponential_law
+
+    assert exponential_law(0.0, P0, C0)[0] == pytest.approx(-P0)
+    assert exponential_law(C0, P0, C0) == (0.0, 0.0) and exponential_law(2 * C0, P0, C0) == (0.0, 0.0)
+    g = np.linspace(-4 * C0, 1.5 * C0, 20001)
+    s = np.array([exponential_law(x, P0, C0) for x in g])
+    h = g[1] - g[0]
+    np.testing.assert_allclose(np.gradient(s[:, 0], h)[1:-1], s[1:-1, 1], rtol=2e-3, atol=1e-4 * P0 / C0)
+    assert np.abs(np.diff(s[:, 1])).max() < 1e-2 * s[:, 1].max()  # no jump in the slope
+    assert np.all(np.diff(s[:, 1]) <= 1e-12)  # the stiffness only grows with the overclosure
+
+
+@pytest.mark.parametrize("name", sorted(SURFACES))
+@pytest.mark.parametrize("g", [-0.15, -0.05, 0.0, 0.03])
+def test_exponential_analytic_tangent(name, g):
+    surf = SURFACES[name]
+    pr = surf.project(np.array([0.3, 0.4, 1.9]))
+    x = pr.rho + g * pr.normal
+    r = surf.contact(x, P0, "exact", band=-C0)
+    from covcontact.contact.laws import exponential_law
+
+    assert np.linalg.norm(r.residual) == pytest.approx(-exponential_law(g, P0, C0)[0], rel=1e-6)
+    K = _fd(lambda y: surf.contact(y, P0, "exact", band=-C0).residual, x)
+    assert np.linalg.norm(r.tangent - K) <= 1e-6 * np.linalg.norm(K)
+    hist = surface_friction(surf, x + 0.01 * pr.rho_cov[0] / np.linalg.norm(pr.rho_cov[0]), P0, P0 / C0, 0.3,
+                            band=-C0).history
+    f = surface_friction(surf, x, P0, P0 / C0, 0.3, hist, band=-C0)
+    K = _fd(lambda y: surface_friction(surf, y, P0, P0 / C0, 0.3, hist, band=-C0).residual, x)
+    assert np.linalg.norm(f.tangent - K) <= 1e-6 * np.linalg.norm(K)
+
+
+EXPONENTIAL = TWO_BLOCKS.replace('penalty = 2.0e4\nweighting = "area"\nsmoothing = 0.004',
+                                 'law = "exponential"\nclearance = 0.004\npressure = 20.0\nweighting = "area"')
+
+
+@pytest.mark.parametrize("friction", ["", "friction = 0.2"], ids=["frictionless", "coulomb"])
+def test_exponential_facet_pair(tmp_path, friction):
+    """The pressed and pulled block on a facet master with the exponential law: check-tangent passes at 1e-6;
+    the mean contact pressure follows the law at the mean gap."""
+    path = tmp_path / "p.toml"
+    path.write_text(EXPONENTIAL.replace("FRICTION", friction))
+    prob = load_problem(path)
+    for step in (1, 3):
+        rep = check_tangent(prob, step=step, columns=None)
+        assert rep["converged"] and rep["judged"] > 0, rep.get("reason")
+        assert rep["relative_error"] <= 1e-6, (step, rep["relative_error"])
+    res = prob.run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    g = res.state.contact.passes[0].gap
+    assert np.any(g > 0.0) and np.all(g[np.isfinite(g)] > -0.02)  # contact before touching: soft law
+
+
+@pytest.mark.parametrize("extra, message", [
+    ('law = "exponential"\nclearance = 0.01\npressure = 10.0\npenalty = 1.0', "contact[0].penalty: not used"),
+    ('law = "exponential"\npressure = 10.0', "contact[0].clearance: missing"),
+    ('law = "exponential"\nclearance = -0.01\npressure = 10.0', "contact[0].clearance: must be > 0"),
+    ('penalty = 1.0\nsmoothing = -0.1', "contact[0].smoothing: must be >= 0"),
+    ('penalty = 1.0\nlaw = "hard"', "contact[0].law: 'hard' is not one of"),
+])
+def test_bad_laws(tmp_path, extra, message):
+    from covcontact.io.validate import InputError
+
+    text = TWO_BLOCKS.replace('penalty = 2.0e4\nweighting = "area"\nsmoothing = 0.004', extra).replace("FRICTION", "")
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert message in str(err.value) and "\n" not in str(err.value), str(err.value)

@@ -2,6 +2,10 @@
 a band of gaps) and the inverse of
 c_ij = a_ij - g h_ij that the exact tangents and the friction kernels share (docs/theory.md section 3).
 
+The kernels take the law as (eps_N, lam_k, band): band = 0 the penalty law, band > 0 the penalty law
+smoothed over that width, band = -c0 < 0 the exponential pressure-overclosure law with clearance c0 (eps_N
+then the nodal force at zero gap).
+
 Normal law: with the Uzawa multiplier lam_k <= 0 of the last update (0 for pure penalty) the effective
 gap is g_e = g + lam_k / eps_N, the normal traction lam_N = eps_N <g_e> = <lam_k + eps_N g> and the pair
 is *active* when g_e <= 0 (also at a small positive geometric gap g when lam_k < 0). The functions are
@@ -22,11 +26,34 @@ def effective_gap(g, lam_k, eps_n):
 
 @njit(cache=True)
 def is_active(g, lam_k, eps_n, band=0.0):
-    """The activity test g + lam_k / eps_N <= 0, or < band / 2 with a smoothing band (scalars or arrays; +inf
-    gaps are inactive)."""
+    """The activity test g + lam_k / eps_N <= 0, or < band / 2 with a smoothing band, or g < c0 for the
+    exponential law (band = -c0) (scalars or arrays; +inf gaps are inactive)."""
     if band > 0.0:
         return effective_gap(g, lam_k, eps_n) < 0.5 * band
+    if band < 0.0:
+        return g < -band
     return effective_gap(g, lam_k, eps_n) <= 0.0
+
+
+#: the exponential law continues linearly beyond this value of t = 1 - g / c0 (an overclosure of 2 c0)
+EXP_T_MAX = 3.0
+
+
+@njit(cache=True)
+def exponential_law(g, eps_n, c0):
+    """The exponential pressure-overclosure law (scalars): (sigma, dsigma). eps_n is the nodal force at zero
+    gap (p0 times the node's area), c0 the clearance at which the force starts; with t = 1 - g / c0:
+    sigma = -eps_n t (e^t - 1) / (e - 1) for 0 < t <= EXP_T_MAX, continued linearly beyond."""
+    t = 1.0 - g / c0
+    if t <= 0.0:
+        return 0.0, 0.0
+    scale = eps_n / (np.e - 1.0)
+    if t <= EXP_T_MAX:
+        et = np.exp(t)
+        return -scale * t * (et - 1.0), scale * (et - 1.0 + t * et) / c0
+    et = np.exp(EXP_T_MAX)
+    slope = scale * (et - 1.0 + EXP_T_MAX * et) / c0
+    return -scale * EXP_T_MAX * (et - 1.0) - slope * (t - EXP_T_MAX) * c0, slope
 
 
 @njit(cache=True)
@@ -50,15 +77,18 @@ def linear_equivalent(g, lam_k, eps_n, band):
     """(eps', lam_k') of the linear law lam_k' + eps' g that has the smoothed law's traction and slope at this
     g (an active g: g_e < band / 2): the kernels, written for the linear law, then evaluate the smoothed one
     exactly (residual sigma n, tangent dsigma n n + sigma hess g)."""
-    if band <= 0.0:
+    if band == 0.0:
         return eps_n, lam_k
-    sig, dsig = smooth_law(g, lam_k, eps_n, band)
+    if band > 0.0:
+        sig, dsig = smooth_law(g, lam_k, eps_n, band)
+    else:
+        sig, dsig = exponential_law(g, eps_n, -band)
     return dsig, sig - dsig * g
 
 
 def linear_equivalents(g: np.ndarray, lam_k: np.ndarray, eps_n: np.ndarray, band: float):
     """``linear_equivalent`` over arrays of active slaves."""
-    if band <= 0.0:
+    if band == 0.0:
         return eps_n, lam_k
     e = np.empty_like(eps_n)
     m = np.empty_like(lam_k)

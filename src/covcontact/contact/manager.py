@@ -176,7 +176,7 @@ class ContactManager:
         nd = 3 * (nen + 1)
         # the smoothed law as the linear one with its traction and slope at each gap (the same g the kernels
         # compute from the projection)
-        eps_s, lam_s = linear_equivalents(res.g, t.multiplier, p.eps, p.band) if p.band > 0.0 else \
+        eps_s, lam_s = linear_equivalents(res.g, t.multiplier, p.eps, p.band) if p.band != 0.0 else \
             (p.eps, t.multiplier)
         idx = np.flatnonzero(active & (res.kind == FACET))
         if idx.size:

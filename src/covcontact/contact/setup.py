@@ -35,7 +35,7 @@ class Pass:
     augmented: bool = False            # augmented Lagrangian (Uzawa) instead of pure penalty
     gap_tol: float = 0.0               # largest accepted penetration of the augmented method
     max_aug: int = 20
-    band: float = 0.0                  # smoothing band of the normal law (0: the kinked penalty law)
+    band: float = 0.0                  # normal law: 0 penalty, > 0 penalty smoothed over band, -c0 exponential
     global_index: np.ndarray | None = None  # distributed runs: positions of these slaves in the whole pass
     pair: str = ""                     # the contact pair this pass belongs to
     rigid: str = ""                    # the rigid body of an analytic master surface
@@ -139,9 +139,14 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
     else:
         eps = np.full(len(slaves), float(penalty))
     ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
+    band = float(pair.smoothing)
+    if pair.law == "exponential":  # eps: the nodal force at zero gap; the kernels' law code: band = -c0
+        band = -float(pair.clearance)
+        if not pair.tangential_penalty:
+            ratio = 1.0 / float(pair.clearance)  # the tangential stiffness p0 / c0 (per area)
     kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
-          "slave_body": slave[0], "master_body": master[0], "band": float(pair.smoothing)}
+          "slave_body": slave[0], "master_body": master[0], "band": band}
     mmesh, moff = num.mesh_of(master[0])
     if mmesh is None:
         rb = next(r for r in num.problem.rigid if r.name == master[0])

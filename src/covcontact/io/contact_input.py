@@ -27,7 +27,17 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
             master = sets.body_set(c, "master", "face")
         if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
             c.fail("slave and master are the same rigid body")
-        if isinstance(c.data.get("penalty"), str):
+        law = c.get("law", "str", "penalty", choices=("penalty", "exponential"))
+        clearance = pressure = None
+        if law == "exponential":
+            for key in ("penalty", "smoothing", "method"):
+                if c.has(key):
+                    c.fail(f"not used by law = \"exponential\" (its pressure-overclosure curve is given by "
+                           f"clearance and pressure)", key)
+            clearance = c.get("clearance", "float", positive=True)
+            pressure = c.get("pressure", "float", positive=True)
+            penalty = pressure
+        elif isinstance(c.data.get("penalty"), str):
             penalty = c.get("penalty", "str", choices=("auto",))
         else:
             penalty = c.get("penalty", "float", positive=True)
@@ -53,5 +63,6 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         contacts.append(ContactPair(cname, slave, master, penalty, weighting, tangent, two_pass,
                                     friction=mu, tangential_penalty=eps_t, method=method, gap_tolerance=gap_tol,
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
-                                    auto_factor=auto_factor, enabled=enabled, smoothing=smoothing))
+                                    auto_factor=auto_factor, enabled=enabled, smoothing=smoothing, law=law,
+                                    clearance=clearance, pressure=pressure))
     return contacts
