@@ -6,6 +6,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+import pytest
+
 from covcontact.io import pictures
 from covcontact.io.loader import problem_from_dict
 from covcontact.study import plot_iterations
@@ -28,9 +31,9 @@ def test_staged_run_draws_every_stage_end_with_units(tmp_path, monkeypatch):
     labels = []
     draw = pictures._draw
 
-    def spy(path, state, lo, hi, vmax, title, view, length=""):
+    def spy(path, state, lo, hi, vmax, title, view, length="", plastic=False):
         labels.append((path.name, title, length))
-        return draw(path, state, lo, hi, vmax, title, view, length)
+        return draw(path, state, lo, hi, vmax, title, view, length, plastic)
 
     monkeypatch.setattr(pictures, "_draw", spy)
     res = _staged(tmp_path)
@@ -63,3 +66,24 @@ def test_coinciding_study_curves_are_told_apart(tmp_path, monkeypatch):
     cumulative = [entry for entry in labels if entry[0] and "(" in entry[0]]
     assert [e[0] for e in cumulative] == ["case a (11) = b", "case b (11) = a", "case c (8)"]
     assert len({(e[1], str(e[2])) for e in cumulative}) == 3  # three different marker/line styles
+
+
+def test_plastic_problem_is_coloured_by_the_plastic_strain(tmp_path, monkeypatch):
+    """A plastic run's pictures show the equivalent plastic strain (its colour scale up to the largest value
+    on the surface), an elastic run's the displacement magnitude."""
+    from covcontact.io.loader import load_problem
+
+    seen = []
+    draw = pictures._draw
+
+    def spy(path, state, lo, hi, vmax, title, view, length="", plastic=False):
+        seen.append((path.name, plastic, vmax, float(np.nanmax(state[4])) if np.isfinite(state[4]).any() else 0.0))
+        return draw(path, state, lo, hi, vmax, title, view, length, plastic)
+
+    monkeypatch.setattr(pictures, "_draw", spy)
+    root = Path(__file__).resolve().parents[2]
+    res = load_problem(root / "examples" / "plasticity" / "bend_and_release.toml").run(out=tmp_path / "p")
+    assert res.exit_code == 0
+    pictures.render_pictures(tmp_path / "p")
+    final = [s for s in seen if s[0] == "final.png"][0]
+    assert final[1] and final[2] == pytest.approx(final[3]) and final[2] > 0.0

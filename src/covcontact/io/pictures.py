@@ -25,6 +25,10 @@ _LIGHT = np.array([0.35, -0.45, 0.82]) / np.linalg.norm([0.35, -0.45, 0.82])
 _STRESS_KEYS = ("von_mises", "cauchy", "pk2", "green_lagrange")
 
 
+#: the cell field a plastic problem's pictures are coloured by
+PLASTIC = "equivalent_plastic_strain"
+
+
 def _step_files(out: Path) -> list[Path]:
     files = [p for p in out.glob("step_*.vtu") if re.fullmatch(r"step_\d+\.vtu", p.name)]
     return sorted(files, key=lambda p: int(p.stem.split("_")[1]))
@@ -53,33 +57,42 @@ def _rigid_mask(mesh, block: int, n: int) -> np.ndarray:
     return np.zeros(n, dtype=bool)
 
 
-def _boundary_quads(hexes: np.ndarray) -> np.ndarray:
-    """Faces of linear hexahedra that belong to one cell only."""
+def _boundary_quads(hexes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Faces of linear hexahedra that belong to one cell only, and the index of that cell."""
     if len(hexes) == 0:
-        return np.zeros((0, 4), dtype=np.int64)
+        return np.zeros((0, 4), dtype=np.int64), np.zeros(0, dtype=np.int64)
     faces = hexes[:, _HEX_FACES].reshape(-1, 4)
     key = np.sort(faces, axis=1)
     _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    return faces[count[inv.ravel()] == 1]
+    outer = count[inv.ravel()] == 1
+    return faces[outer], np.flatnonzero(outer) // len(_HEX_FACES)
 
 
-def surface_quads(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """(quads (m, 4), rigid (m,) bool) of the drawable surface of a meshio mesh of covcontact results."""
-    quads, rigid = [], []
+def surface_quads(mesh, field: str | None = None):
+    """(quads (m, 4), rigid (m,) bool) of the drawable surface of a meshio mesh of covcontact results; with
+    ``field`` also the values (m,) of that cell field on the cell behind each quad (nan where absent)."""
+    quads, rigid, values = [], [], []
     for b, block in enumerate(mesh.cells):
         conn = np.asarray(block.data, dtype=np.int64)
         mask = _rigid_mask(mesh, b, len(conn))
+        data = (np.asarray(mesh.cell_data[field][b], dtype=float).reshape(len(conn), -1)[:, 0]
+                if field is not None and field in mesh.cell_data else np.full(len(conn), np.nan))
         if block.type.startswith("hexahedron"):
             for flag in (False, True):
-                q = _boundary_quads(conn[mask == flag, :8])
+                cells = np.flatnonzero(mask == flag)
+                q, owner = _boundary_quads(conn[cells, :8])
                 quads.append(q)
                 rigid.append(np.full(len(q), flag))
+                values.append(data[cells[owner]])
         elif block.type.startswith("quad"):
             quads.append(conn[:, :4])
             rigid.append(mask)
+            values.append(data)
     if not quads:
-        return np.zeros((0, 4), dtype=np.int64), np.zeros(0, dtype=bool)
-    return np.vstack(quads), np.concatenate(rigid)
+        empty = (np.zeros((0, 4), dtype=np.int64), np.zeros(0, dtype=bool))
+        return empty if field is None else (*empty, np.zeros(0))
+    out = (np.vstack(quads), np.concatenate(rigid))
+    return out if field is None else (*out, np.concatenate(values))
 
 
 def _state(path: Path):
@@ -89,8 +102,8 @@ def _state(path: Path):
     x = np.asarray(mesh.points, dtype=float)
     disp = np.asarray(mesh.point_data.get("displacement", np.zeros_like(x)), dtype=float)
     disp = np.nan_to_num(disp)
-    quads, rigid = surface_quads(mesh)
-    return x + disp, np.linalg.norm(disp, axis=1), quads, rigid
+    quads, rigid, eps_p = surface_quads(mesh, PLASTIC)
+    return x + disp, np.linalg.norm(disp, axis=1), quads, rigid, eps_p
 
 
 def _shade(polys: np.ndarray) -> np.ndarray:
@@ -100,22 +113,23 @@ def _shade(polys: np.ndarray) -> np.ndarray:
 
 
 def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title: str,
-          view: tuple[float, float], length: str = "") -> None:
+          view: tuple[float, float], length: str = "", plastic: bool = False) -> None:
     import matplotlib
     from matplotlib.figure import Figure
     from matplotlib.ticker import MaxNLocator
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    x, mag, quads, rigid = state
+    x, mag, quads, rigid, eps_p = state
     tol = 1e-3 * float((hi - lo).max())
     inside = np.all((x[quads] >= lo - tol) & (x[quads] <= hi + tol), axis=(1, 2))
     keep = ~rigid | inside  # rigid faces leaving the frame are left out (matplotlib does not clip in 3D)
-    quads, rigid = quads[keep], rigid[keep]
+    quads, rigid, eps_p = quads[keep], rigid[keep], eps_p[keep]
     polys = x[quads]
     cmap = matplotlib.colormaps["viridis"]
     norm = matplotlib.colors.Normalize(0.0, vmax)
     colors = np.empty((len(quads), 4))
-    colors[~rigid] = cmap(norm(mag[quads[~rigid]].mean(axis=1)))
+    values = np.nan_to_num(eps_p[~rigid]) if plastic else mag[quads[~rigid]].mean(axis=1)
+    colors[~rigid] = cmap(norm(values))
     colors[rigid] = (0.72, 0.72, 0.75, 0.55)
     colors[:, :3] *= _shade(polys)[:, None]
     edge = np.where(rigid[:, None], (0.35, 0.35, 0.4, 0.35), (0.1, 0.1, 0.1, 0.5))
@@ -138,7 +152,8 @@ def _draw(path: Path, state, lo: np.ndarray, hi: np.ndarray, vmax: float, title:
     for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
         axis.set_major_locator(MaxNLocator(5))
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, shrink=0.55, pad=0.12, label="displacement magnitude" + unit)
+    fig.colorbar(sm, ax=ax, shrink=0.55, pad=0.12,
+                 label="equivalent plastic strain" if plastic else "displacement magnitude" + unit)
     ax.set_title(title)
     tmp = path.with_name("." + path.name + ".tmp.png")
     fig.savefig(tmp, bbox_inches="tight", pad_inches=0.15)
@@ -171,7 +186,11 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
                 lo = np.minimum(lo, rp[near].min(axis=0))
                 hi = np.maximum(hi, rp[near].max(axis=0))
     deform = ~s1[3]
-    vmax = float(s1[1][np.unique(s1[2][deform])].max()) if deform.any() else 1.0
+    # a plastic problem is coloured by the equivalent plastic strain, an elastic one by the displacement
+    peak = float(np.nanmax(s1[4][deform], initial=0.0)) if deform.any() and np.isfinite(s1[4][deform]).any() \
+        else 0.0
+    plastic = peak > 0.0
+    vmax = peak if plastic else (float(s1[1][np.unique(s1[2][deform])].max()) if deform.any() else 1.0)
     vmax = vmax if vmax > 0 else 1.0
     written = []
     lam = _load_factor(out_dir, last.name)
@@ -184,13 +203,13 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
         final = f"final state: step {step}" + (f", load factor {lam:.3g}" if lam is not None else "")
     for state, name, label in ((s0, "initial.png", "initial state"), (s1, "final.png", final)):
         path = out_dir / name
-        _draw(path, state, lo, hi, vmax, label, view, length)
+        _draw(path, state, lo, hi, vmax, label, view, length, plastic)
         written.append(path)
     for name, k in _stage_ends(out_dir)[:-1]:  # a staged run: the end of every stage but the last
         f = out_dir / f"step_{k:04d}.vtu"
         if f.exists():
             path = out_dir / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png"
-            _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view, length)
+            _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view, length, plastic)
             written.append(path)
     return written
 
