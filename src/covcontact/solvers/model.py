@@ -258,6 +258,23 @@ class Model:
     def active_count(self, state: State) -> int:
         return self.contact.active_count(state.contact)
 
+    def floating_dofs(self) -> np.ndarray | None:
+        """The dofs of the deformable bodies whose Dirichlet conditions (in the current stage) leave a rigid-body
+        mode free, so that only contact holds them; None when there is none (or in a distributed run)."""
+        if self.size > 1:
+            return None
+        from .nullspace import rigid_body_modes
+
+        free = self.system.free
+        mask = np.zeros(self.system.n_dofs, dtype=bool)
+        for blk in self.system.blocks:
+            dofs = np.arange(3 * blk.offset, 3 * (blk.offset + blk.n_nodes))
+            fixed = ~free[dofs]
+            modes = rigid_body_modes(self.system.X[blk.offset: blk.offset + blk.n_nodes])
+            if np.linalg.matrix_rank(modes[fixed], tol=1e-8) < 6:
+                mask[dofs] = True
+        return mask if mask.any() else None
+
     def explain_inversion(self, body: str, element: int) -> str:
         """Where element ``element`` of ``body`` lies, and the contact pairs whose slave nodes it carries (an
         element that inverts next to a contact is most often crushed by it: a penalty too soft or too stiff,

@@ -39,6 +39,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..assembly.system import InvertedElementError
 from .linear import LinearSolverError, SingularMatrixError, gmres_right, make_solver
@@ -93,6 +94,8 @@ class StepOutcome:
 
 #: halvings of a Newton correction whose full length inverts an element, before the increment is cut back
 MAX_BACKTRACKS = 5
+#: springs of the stabilisation of bodies held by contact alone, relative to their tangent's mean diagonal
+STABILISATION = 1e-2
 
 
 def extrapolates(predictor: str, problem) -> bool:
@@ -132,6 +135,7 @@ class Newton:
         self._stalled = False  # the last inexact correction did not reduce the residual enough
         self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
+        self._spring: tuple[np.ndarray, np.ndarray] | None = None  # stabilisation: (stiffness per dof, anchor)
         self.extrapolate = extrapolates(options.predictor, getattr(model, "problem", None))
         self.poll = None  # called before every iteration (a distributed run's stop signals: StopSignals.poll)
         #: called after every converged increment of :meth:`advance` (after its Uzawa updates) as
@@ -163,7 +167,13 @@ class Newton:
 
     # ------------------------------------------------------------------------------------------
     def _evaluate(self, u: np.ndarray, lam: float, committed, guess, want_K: bool = True):
-        return self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=self.timing)
+        R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=self.timing)
+        if self._spring is not None:  # the stabilisation of bodies held by contact alone (_stabilised)
+            k, u0 = self._spring
+            R = R + k * (u - u0)
+            if K is not None:
+                K = K + sp.diags(k, format="csr")
+        return R, K, trial
 
     def _inexact(self, K, rhs, eta: float, solve):
         """An inexact correction ``solve()`` -> (du or None, Krylov iterations), timed and counted: (du, its), du
@@ -405,6 +415,7 @@ class Newton:
         return out, trial
 
     def _try(self, u, lam_a, lam_b, committed, trial):
+        u0 = u.copy()
         try:
             return self.step(u, lam_a, lam_b, committed, trial)
         except InvertedElementError as exc:
@@ -412,7 +423,40 @@ class Newton:
             where = explain(exc.body, exc.element) if explain is not None else ""
             return StepOutcome(converged=False, reason=str(exc) + where), None
         except LinearSolverError as exc:
-            return StepOutcome(converged=False, reason=str(exc)), None
+            floating = getattr(self.model, "floating_dofs", lambda: None)()
+            if floating is None:
+                return StepOutcome(converged=False, reason=str(exc)), None
+            u[:] = u0
+            return self._stabilised(u, lam_a, lam_b, committed, trial, floating, str(exc))
+
+    def _stabilised(self, u, lam_a, lam_b, committed, trial, floating, why):
+        """The step again with the bodies held by contact alone tied to where they started by soft springs
+        (stiffness STABILISATION times the mean diagonal of their tangent), so that a body that is not yet in
+        contact, or free to slide, has a regular tangent; once that converged, the springs are taken off and
+        Newton goes on from there to the unstabilised equilibrium (the converged answer is the problem's own).
+        Returns the combined outcome."""
+        try:
+            _, K, _ = self._evaluate(u, lam_b, committed, trial)
+            d = np.abs(K.diagonal())
+            scale = float(np.mean(d[floating & self.model.free & (d > 0)])) if np.any(d[floating] > 0) else 1.0
+            self._spring = (np.where(floating & self.model.free, STABILISATION * scale, 0.0), u.copy())
+            first, t1 = self.step(u, lam_a, lam_b, committed, trial)
+            self._spring = None
+            if not first.converged:
+                first.reason = f"{why}; stabilised: {first.reason}"
+                return first, t1
+            second, t2 = self.step(u, lam_b, lam_b, committed, t1)
+        except (InvertedElementError, LinearSolverError) as exc:
+            return StepOutcome(converged=False, reason=f"{why}; stabilised: {exc}"), None
+        finally:
+            self._spring = None
+        second.iterations += first.iterations
+        second.records = first.records + second.records
+        second.residual_norms = first.residual_norms + second.residual_norms
+        self.stats["stabilised"] = self.stats.get("stabilised", 0) + 1
+        if not second.converged:
+            second.reason = f"{why}; stabilised, then without the stabilisation: {second.reason}"
+        return second, t2
 
     def advance(self, u: np.ndarray, lam_a: float, lam_b: float, committed, min_increment: float | None = None,
                 single: bool = False):

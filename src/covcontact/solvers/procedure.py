@@ -228,6 +228,8 @@ class QuasiStatic:
         backtracks = newton.stats.get("backtracks", 0) - stats0.get("backtracks", 0)
         if backtracks:  # Newton corrections shortened because their full length inverted an element
             entry["backtracks"] = backtracks
+        if newton.stats.get("stabilised", 0) > stats0.get("stabilised", 0):  # a body held by contact alone
+            entry["stabilised"] = True
         if inc.cutbacks:
             entry["cutback_reasons"] = [o.reason for o in inc.outcomes if not o.converged]
         if not inc.success:
