@@ -160,3 +160,21 @@ def test_bad_placement():
         Profile([(0, 0), (1, 0)], extrude={"axis": (0, 0, 1), "u": (0, 0.5, 1)})
     with pytest.raises(ValueError, match="must not be negative"):
         Profile([(-1, 0), (1, 0)], revolve={"axis": (0, 0, 1)})
+
+
+def test_friction_on_the_axis_of_a_revolved_profile():
+    """A slave node on the axis of a revolved tool (the axis node of an axisymmetric blank under a flat punch):
+    no angle coordinate there, so it takes the normal force only (zero tangential force, as symmetry gives
+    it) with a finite tangent; just off the axis friction acts again."""
+    from covcontact.contact.friction import OPEN, SLIP, STICK, surface_friction
+
+    punch = Profile([(0.0, 0.0), (20.0, 0.0), (20.0, -30.0)], [4.0], revolve={"axis": (0, 0, 1)})
+    on = np.array([0.0, 0.0, -0.3])
+    hist = surface_friction(punch, on + [0.01, 0.0, 0.0], EPS, 50.0, 0.3).history
+    r = surface_friction(punch, on, EPS, 50.0, 0.3, hist)
+    assert r.state == SLIP and np.all(np.isfinite(r.tangent))
+    np.testing.assert_allclose(r.residual, [0.0, 0.0, -0.3 * EPS], atol=1e-12)
+    assert not np.any(r.history)
+    assert surface_friction(punch, on + [0.0, 0.0, 0.6], EPS, 50.0, 0.3).state == OPEN
+    off = surface_friction(punch, np.array([1e-3, 0.0, -0.3]), EPS, 50.0, 0.3, hist)
+    assert off.state == STICK and abs(off.residual[0]) > 0.1

@@ -228,6 +228,12 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, 
     g, chart = analytic_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, CASE_EXACT, False, xi, R_out,
                              K_out, dummy, aw, lam_k, band)
     nrm = aw[4]
+    if kind == REVOLVED and chart == 1:
+        # on the axis of a revolved profile the angle is no coordinate: the node takes the normal force only
+        # (in an axisymmetric model its tangential force is zero by symmetry) and keeps no history
+        for k in range(HIST_SIZE):
+            hist_out[k] = 0.0
+        return g, (SLIP if is_active(g, lam_k, eps_n, band) else OPEN)
     surface_derivs(kind, origin, frame, radius, sigma, prof, chart, xi, rho, rho1, rho2, rho3)
     for i in range(2):
         for j in range(2):
