@@ -107,6 +107,15 @@ BAD_CASES = {
     "bad-tangent": (GOOD + '\n[[rigid]]\nname = "floor"\nshape = "plane"\npoint = [0.0, 0.0, 0.0]\n'
                            'normal = [0.0, 0.0, 1.0]\n\n[[contact]]\nslave = "cube.zmin"\nmaster = "floor"\n'
                            'penalty = 1.0\ntangent = "e"\n', "contact[0].tangent"),
+    "same-surface": (GOOD + '\n[[contact]]\nslave = "cube.zmax"\nmaster = "cube.zmax"\npenalty = 1.0\n',
+                     "contact[0].master: slave and master are the same surface 'cube.zmax': a surface in contact "
+                     "with itself needs self-contact"),
+    "area-weighting-on-nodes": (GOOD.replace("[steps]", '[bodies.sets]\ntop = { box = [[-1.0, -1.0, 0.9], [2.0, 2.0, '
+                                                       '1.1]] }\n\n[steps]') + '\n[[rigid]]\nname = "floor"\n'
+                                'shape = "plane"\npoint = [0.0, 0.0, 2.0]\nnormal = [0.0, 0.0, -1.0]\n\n[[contact]]\n'
+                                'slave = "cube.top"\nmaster = "floor"\npenalty = 1.0\nweighting = "area"\n',
+                                'contact[0].slave: weighting = "area" needs the slave\'s faces, but cube.top is a node '
+                                "set only: give a face set of 'cube'"),
 }
 
 

@@ -27,6 +27,10 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
             master = sets.body_set(c, "master", "face")
         if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
             c.fail("slave and master are the same rigid body")
+        if slave == master:
+            c.fail(f"slave and master are the same surface '{slave[0]}.{slave[1]}': a surface in contact with "
+                   f"itself needs self-contact, which covcontact does not have yet; for two parts of one body's "
+                   f"surface name two different face sets", "master")
         law = c.get("law", "str", "penalty", choices=("penalty", "exponential"))
         clearance = pressure = None
         if law == "exponential":
@@ -51,6 +55,14 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         if method == "penalty" and (gap_tol is not None or gap_rel is not None):
             c.fail("gap tolerances need method = \"augmented\"")
         weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area"))
+        if weighting == "area" or penalty == "auto":
+            owner = next((b.mesh for b in sets.bodies if b.name == slave[0]), None) or next(
+                (r.mesh for r in rigid if r.name == slave[0] and r.mesh is not None), None)
+            if owner is not None and slave[1] not in owner.face_sets:
+                faces = ", ".join(sorted(owner.face_sets)) or "none"
+                what = 'weighting = "area"' if weighting == "area" else 'penalty = "auto"'
+                c.fail(f"{what} needs the slave's faces, but {slave[0]}.{slave[1]} is a node set only: give a "
+                       f'face set of {slave[0]!r} ({faces}) or weighting = "nodal"', "slave")
         tangent = c.get("tangent", "str", "a", choices=TANGENT_CASES)
         two_pass = c.get("two_pass", "bool", False)
         mu = c.get("friction", "float", 0.0, nonnegative=True)
