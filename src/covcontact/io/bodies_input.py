@@ -162,6 +162,77 @@ def user_sets(sec: Section | None, mesh) -> None:
         mesh.node_sets[name] = np.unique(ids).astype(np.int64)
 
 
+FACE_FILTERS = ("box", "normal", "cells")
+
+
+def user_faces(sec: Section | None, mesh) -> None:
+    """Face sets defined in the input (docs/input.md, "Face sets of your own"): ``faces = { NAME = { ... } }``,
+    the boundary faces that pass every filter given: ``box = [[x0, y0, z0], [x1, y1, z1]]`` (all their nodes
+    inside, bounds included), ``normal = [nx, ny, nz]`` with ``angle`` (degrees, default 10: the outward
+    normal at the face's centre within that angle of the direction), ``cells = "SET"`` (faces of the elements
+    of that element set); or ``union = ["a", "b", ...]`` of face sets. Each also becomes a node set of the
+    same name (its nodes), as the generators' sets are."""
+    if sec is None:
+        return
+    from ..mesh.faces import boundary_faces, face_normals
+
+    faces, elem, _ = boundary_faces(mesh)
+    X = mesh.points
+    for name in list(sec.data):
+        if name in mesh.face_sets or name in mesh.node_sets:
+            sec.fail(f"a {'face' if name in mesh.face_sets else 'node'} set {name!r} exists already", name)
+        d = sec.get(name, "table")
+        if d.has("union"):
+            parts = d.get("union", "any")
+            d.done()
+            if not (isinstance(parts, list) and parts and all(isinstance(p, str) for p in parts)):
+                d.fail("must be a non-empty array of face set names", "union")
+            missing = [p for p in parts if p not in mesh.face_sets]
+            if missing:
+                d.fail(f"no face set {missing[0]!r}{suggest(missing[0], mesh.face_sets)} (known: "
+                       f"{', '.join(sorted(mesh.face_sets)) or 'none'}; sets defined here count from above)", "union")
+            chosen = np.unique(np.vstack([mesh.face_sets[p] for p in parts]), axis=0)
+        else:
+            if d.has("angle") and not d.has("normal"):
+                d.fail("needs 'normal', the direction the angle is measured from", "angle")
+            if not any(d.has(k) for k in FACE_FILTERS):
+                d.fail("give 'box', 'normal' (with 'angle'), 'cells', any of them together, or 'union'")
+            keep = np.ones(len(faces), dtype=bool)
+            if d.has("box"):
+                box = d.get("box", "any")
+                ok = isinstance(box, list) and len(box) == 2 and all(isinstance(q, list) and len(q) == 3 and all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in q)
+                    for q in box)
+                if not ok:
+                    d.fail("must be two points [[x0, y0, z0], [x1, y1, z1]]", "box")
+                P = np.asarray(box, dtype=float)
+                lo, hi = P.min(axis=0), P.max(axis=0)
+                inside = np.all((X >= lo) & (X <= hi), axis=1)
+                keep &= np.all(inside[faces], axis=1)
+            if d.has("normal"):
+                direction = np.asarray(d.get("normal", "vector"))
+                if not np.linalg.norm(direction) > 0.0:
+                    d.fail("must not be zero", "normal")
+                angle = d.get("angle", "float", 10.0, positive=True)
+                if angle > 180.0:
+                    d.fail(f"must lie in (0, 180] degrees, got {angle:g}", "angle")
+                n = face_normals(X, faces)
+                cosine = n @ direction / np.maximum(np.linalg.norm(n, axis=1) * np.linalg.norm(direction), 1e-300)
+                keep &= cosine >= np.cos(np.radians(angle)) - 1e-12
+            if d.has("cells"):
+                cname = d.get("cells", "str")
+                if cname not in mesh.element_sets:
+                    d.fail(f"no element set {cname!r}{suggest(cname, mesh.element_sets)} (known: "
+                           f"{', '.join(sorted(mesh.element_sets)) or 'none'})", "cells")
+                keep &= np.isin(elem, mesh.element_sets[cname])
+            d.done()
+            chosen = faces[keep]
+        if len(chosen) == 0:
+            sec.fail("no boundary face passes these filters", name)
+        mesh.add_face_set(name, chosen)
+        mesh.add_node_set(name, chosen.ravel())
+
+
 def read_bodies(top: Section, base: Path) -> list[Body]:
     """Every ``[[bodies]]`` entry (at least one); ``base``: the folder mesh files are relative to."""
     bodies: list[Body] = []
@@ -176,6 +247,7 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
         material = read_material(b.get("material", "table"))
         mesh = build_mesh(b.get("mesh", "table"), base, element)
         user_sets(b.get("sets", "table", None), mesh)
+        user_faces(b.get("faces", "table", None), mesh)
         b.done()
         if formulation == "solid-shell":
             from ..elements.solidshell import check_options

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..contact.analytic import Profile
 from ..description import RigidBody
-from .bodies_input import CELLS, build_mesh, user_sets
+from .bodies_input import CELLS, build_mesh, user_faces, user_sets
 from .fields import COMPONENT_NAMES, free_components, read_motion
 from .validate import Section
 
@@ -45,6 +45,7 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
             element = r.get("element", "str", None, choices=CELLS)
             mesh = build_mesh(r.get("mesh", "table"), base, element)
             user_sets(r.get("sets", "table", None), mesh)
+            user_faces(r.get("faces", "table", None), mesh)
         motion = read_motion(r.get("motion", "table", None))
         free = free_components(r)
         force = r.get("force", "vector", (0.0, 0.0, 0.0))
