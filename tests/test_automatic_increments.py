@@ -109,6 +109,10 @@ def test_control_shrinks_when_the_active_set_moves_a_lot():
         c.record(inc, [(0.0, 0.1)])
         assert c.increment == pytest.approx(expect), (its, changed, active)
     assert c.easy == 1  # the easy step counted towards growth
+    inc = _inc(iterations=8)
+    inc.plastic_changed, inc.yielding = 40, 60  # two thirds of the plastic zone moved (more than half)
+    c.record(inc, [(0.0, 0.1)])
+    assert c.increment == pytest.approx(0.05625 * 0.75) and c.easy == 0
 
 
 def test_run_with_automatic_increments(tmp_path):

@@ -19,8 +19,8 @@ would change:
   in most draw steps;
 - the blank's own z equilibrium: the three pairs' contact forces sum to zero;
 - the iteration budget of the draw: at most 9 Newton iterations per increment on average and at most 2
-  cutbacks (measured: 8.1 and none; the first 15 mm, where the sheet first wraps round both corners, are the
-  hardest part of the draw: the full stroke averages 7.4; without the contact smoothing the first 25 mm take
+  cutbacks (measured: 7.9 and none; the first 15 mm, where the sheet first wraps round both corners, are the
+  hardest part of the draw: the full stroke averages 7.0; without the contact smoothing the first 25 mm take
   10.8 per increment);
 - the punch force (the punch pair's) is positive and
   of the size of a steady-draw estimate: the sidewall tension T = (2 mu F_h + 2 M_p w / R_m) e^(mu pi / 2)

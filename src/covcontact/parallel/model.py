@@ -358,6 +358,11 @@ class DistributedModel(Model):
     def eliminate(self, K):
         return self.system.eliminate(K)
 
+    def plastic_change(self, a, b) -> tuple[int, int]:
+        """Summed over the ranks (collective)."""
+        mine = super().plastic_change(a, b)
+        return tuple(int(v) for v in sum_all(self.comm, np.array(mine, dtype=float)))
+
     def plastic_work(self, state) -> float | None:
         """Plastic work of all bodies, summed over the ranks (collective)."""
         mine = super().plastic_work(state)

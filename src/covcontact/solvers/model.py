@@ -286,7 +286,23 @@ class Model:
         X = self.system.X[nodes].mean(axis=0)
         pairs = sorted({p.pair for p in self.contact.passes if np.intersect1d(p.slaves, nodes).size})
         where = f" (centre at {X[0]:.4g}, {X[1]:.4g}, {X[2]:.4g})"
-        return where + (f", on the slave side of contact pair {', '.join(repr(p) for p in pairs)}" if pairs else "")
+        names = ", ".join(repr(p) for p in pairs)
+        return where + (f", on the slave side of contact pair{'s' if len(pairs) > 1 else ''} {names}" if pairs else "")
+
+    def plastic_change(self, a: State, b: State) -> tuple[int, int]:
+        """(Gauss points whose yielding in the step differs between ``a`` and ``b``, Gauss points yielding in
+        the step of ``b``): how much the plastic zone moved; (0, 0) without a plastic body."""
+        from ..materials.plasticity import H_FLAG, J2
+
+        changed = yielding = 0
+        for blk, ea, eb in zip(self.system.blocks, a.elements, b.elements):
+            ha, hb = ea.get("hist"), eb.get("hist")
+            if hb is None or hb.shape[-1] <= H_FLAG or blk.solid.material.kind != J2:
+                continue
+            fa, fb = ha[..., H_FLAG] > 0, hb[..., H_FLAG] > 0
+            changed += int(np.count_nonzero(fa != fb))
+            yielding += int(np.count_nonzero(fb))
+        return changed, yielding
 
     def active_set_change(self, a: State, b: State) -> tuple[int, int]:
         """(slave nodes whose contact opened or closed from ``a`` to ``b``, slave nodes in contact in ``b``),

@@ -36,6 +36,7 @@ Counts and times: ``Newton.stats``.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -171,8 +172,11 @@ class Newton:
         if self._spring is not None:  # the stabilisation of bodies held by contact alone (_stabilised)
             k, u0 = self._spring
             R = R + k * (u - u0)
-            if K is not None:
-                K = K + sp.diags(k, format="csr")
+            if K is not None:  # on the diagonal, keeping every stored entry (a sum would drop stored zeros,
+                K = K.tocsr(copy=True)  # the diagonals of constrained dofs among them)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", sp.SparseEfficiencyWarning)
+                    K.setdiag(K.diagonal() + k)
         return R, K, trial
 
     def _inexact(self, K, rhs, eta: float, solve):
@@ -438,8 +442,11 @@ class Newton:
         try:
             _, K, _ = self._evaluate(u, lam_b, committed, trial)
             d = np.abs(K.diagonal())
-            scale = float(np.mean(d[floating & self.model.free & (d > 0)])) if np.any(d[floating] > 0) else 1.0
-            self._spring = (np.where(floating & self.model.free, STABILISATION * scale, 0.0), u.copy())
+            free = self.model.free
+            scale = float(np.mean(d[floating & free & (d > 0)])) if np.any(d[floating & free] > 0) else 1.0
+            # the floating bodies, and any free dof nothing acts on (a rigid body's reference node out of contact)
+            tied = free & (floating | (d == 0.0))
+            self._spring = (np.where(tied, STABILISATION * scale, 0.0), u.copy())
             first, t1 = self.step(u, lam_a, lam_b, committed, trial)
             self._spring = None
             if not first.converged:

@@ -47,7 +47,8 @@ class AutomaticIncrements:
     Abaqus/Standard: start with ``initial``; after ``EASY_STEPS`` steps in a row that converged without a
     cutback in at most ``EASY_ITERATIONS`` iterations, grow by ``GROW``; after a step that needed more than
     ``HARD_ITERATIONS``, or more than ``EASY_ITERATIONS`` while more than ``SET_CHANGE`` of the active slave
-    nodes (and more than ``SET_CHANGE_MIN``) opened or closed, shrink by ``SHRINK``; after a step that needed cutbacks, go on
+    nodes (and more than ``SET_CHANGE_MIN``) opened or closed, or more than ``ZONE_CHANGE`` of the yielding
+    Gauss points started or stopped yielding, shrink by ``SHRINK``; after a step that needed cutbacks, go on
     with the increment that finally converged; never below ``min`` (Newton's cutbacks stop there) nor above ``max``; the last step
     ends exactly at the stage's end (a remainder below ``min`` is taken with the step before it)."""
 
@@ -58,6 +59,7 @@ class AutomaticIncrements:
     SHRINK = 0.75
     SET_CHANGE = 0.25  # shrink when more than this fraction of the active slaves opened or closed in a step
     SET_CHANGE_MIN = 8  # (and more than this many)
+    ZONE_CHANGE = 0.5  # ... or when more than this fraction of the yielding Gauss points started or stopped
 
     def __init__(self, initial: float, lo: float, hi: float, end: float, marks=()):
         self.increment, self.lo, self.hi, self.end = float(initial), float(lo), float(hi), float(end)
@@ -84,9 +86,11 @@ class AutomaticIncrements:
             self.increment, self.easy = min(max(b - a, self.lo), self.hi), 0
             return
         its = inc.outcomes[-1].iterations
-        if its > self.EASY_ITERATIONS and inc.opened_closed > max(self.SET_CHANGE_MIN, self.SET_CHANGE * inc.active):
-            # a step that was not easy and in which the active set changed a lot: the next one is likely to
-            # change it as much
+        moved = (inc.opened_closed > max(self.SET_CHANGE_MIN, self.SET_CHANGE * inc.active)
+                 or inc.plastic_changed > max(self.SET_CHANGE_MIN, self.ZONE_CHANGE * inc.yielding))
+        if its > self.EASY_ITERATIONS and moved:
+            # a step that was not easy and in which the active set or the plastic zone changed a lot: the next
+            # one is likely to change them as much
             self.increment, self.easy = max(self.increment * self.SHRINK, self.lo), 0
             return
         if its <= self.EASY_ITERATIONS:
@@ -133,6 +137,8 @@ class Increment:
     output: bool = False  # the step ended at a load factor of ``output_at``
     opened_closed: int = 0  # slave nodes whose contact opened or closed in the step (automatic increments)
     active: int = 0  # slave nodes in contact at its end (automatic increments)
+    plastic_changed: int = 0  # Gauss points that started or stopped yielding in the step (automatic increments)
+    yielding: int = 0  # Gauss points yielding in the step (automatic increments)
 
     @property
     def iterations(self) -> int:
@@ -197,6 +203,7 @@ class QuasiStatic:
                         output=success and self.control.is_mark(lam))
         if success and self.automatic:  # how much the active set moved in the step (the increment control)
             inc.opened_closed, inc.active = self.model.active_set_change(state, new)
+            inc.plastic_changed, inc.yielding = self.model.plastic_change(state, new)
         inc.entry = self._report(inc, u, stats0, time0)
         self.control.record(inc, newton.converged_increments)
         return inc
