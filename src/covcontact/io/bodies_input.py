@@ -3,6 +3,7 @@ input and materials (docs/input.md)."""
 
 from __future__ import annotations
 
+import copy
 import inspect
 import math
 from pathlib import Path
@@ -24,27 +25,51 @@ def mesh_generators() -> dict:
             and "cell" in inspect.signature(fn).parameters}
 
 
+_MESH_FILES: dict = {}
+
+
+def _read_once(path: Path):
+    """A mesh file read once per problem file for all the bodies that take parts of it (keyed by path and
+    modification time); callers copy or select from it, never change it."""
+    from ..mesh.io import read_mesh
+
+    key = (str(path.resolve()), path.stat().st_mtime_ns)
+    if key not in _MESH_FILES:
+        _MESH_FILES.clear()  # one file at a time: a problem's bodies come one after the other
+        _MESH_FILES[key] = read_mesh(path)
+    return _MESH_FILES[key]
+
+
 def build_mesh(sec: Section, base: Path, element: str | None):
     """Mesh from ``generator = ...`` plus its arguments, or ``file = ...`` (read through meshio)."""
-    from ..mesh.io import MeshError, read_mesh
+    from ..mesh.io import MeshError
 
     if sec.has("file") == sec.has("generator"):
         sec.fail("give exactly one of 'file' or 'generator'")
     if sec.has("file"):
         fname = sec.get("file", "str")
+        volume = sec.get("volume", "str", None)
         sec.done()
         path = (base / fname) if not Path(fname).is_absolute() else Path(fname)
         if not path.exists():
             sec.fail(f"mesh file {fname!r} does not exist (looked for {path}; a relative path is taken from the "
                      f"problem file's folder)", "file")
         try:
-            mesh = read_mesh(path)
+            mesh = _read_once(path)
         except (MeshError, ValueError, KeyError, OSError) as exc:
             sec.fail(f"cannot read mesh file {path}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}",
                      "file")
         if element is not None and mesh.cell_type != element:
             sec.fail(f"element {element!r} does not match the mesh file's cells ({mesh.cell_type})", "file")
-        return mesh
+        if volume is not None:  # one body of several in the file: its element set (Gmsh physical volume, ELSET)
+            if volume not in mesh.element_sets:
+                known = ", ".join(sorted(mesh.element_sets)) or "none"
+                sec.fail(f"{fname} has no volume (element set) {volume!r}{suggest(volume, mesh.element_sets)} "
+                         f"(known: {known})", "volume")
+            from ..mesh.parts import select
+
+            return select(mesh, mesh.element_sets[volume])
+        return copy.deepcopy(mesh)
     gens = mesh_generators()
     name = sec.get("generator", "str", choices=tuple(sorted(gens)))
     fn = gens[name]

@@ -207,6 +207,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
             mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)
         if faces:
             f = np.concatenate(faces)
+            mesh.face_groups[name] = f[np.all(f >= 0, axis=1)]
             matched, _ = match_boundary_faces(mesh, f[np.all(f >= 0, axis=1)])
             if matched.shape[0]:
                 mesh.add_face_set(name, matched)

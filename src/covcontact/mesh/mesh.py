@@ -30,6 +30,9 @@ class Mesh:
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
     face_sets: dict[str, np.ndarray] = field(default_factory=dict)
     element_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    #: the face groups of a mesh file as read (name -> (nface, >= 4) corner nodes), to be matched again against
+    #: the boundary of a part of the mesh (``select``), where faces between parts become boundary faces
+    face_groups: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         self.points = np.ascontiguousarray(self.points, dtype=np.float64)
