@@ -214,4 +214,47 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         kept = keep(np.concatenate(nodes))
         if name not in mesh.node_sets and kept.size:
             mesh.add_node_set(name, kept)
+    if p.suffix.lower() == ".inp":
+        _abaqus_surfaces(p, m, mesh, vol, first, keep)
     return mesh
+
+
+def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep) -> None:
+    """The deck's *SURFACE definitions as face sets (element surfaces: their faces, matched outward) and node
+    sets (node surfaces), each element surface also a node set of its nodes."""
+    from .abaqus import HEX_FACES, read_surfaces
+
+    try:
+        elem, node = read_surfaces(p)
+    except (ValueError, OSError) as exc:
+        raise _fail(p, str(exc)) from exc
+    for name, refs in elem.items():
+        faces = []
+        for elset, face in refs:
+            parts = m.cell_sets.get(elset)
+            if parts is None:
+                raise _fail(p, f"*SURFACE {name}: no element set {elset!r}")
+            for k, b in enumerate(vol):
+                ids = np.asarray(parts[b], dtype=np.int64) if b < len(parts) and parts[b] is not None else []
+                if len(ids):
+                    faces.append(mesh.cells[first[k] + ids][:, list(HEX_FACES[face])])
+        if not faces:
+            raise _fail(p, f"*SURFACE {name}: its element sets hold no volume cells")
+        f = np.concatenate(faces)
+        matched, found = match_boundary_faces(mesh, f)
+        if not found.all():
+            raise _fail(p, f"*SURFACE {name}: {int((~found).sum())} of its faces are not on the boundary "
+                           f"(a face identifier of another element type?)")
+        mesh.face_groups[name] = f
+        mesh.add_face_set(name, matched)
+        if name not in mesh.node_sets:
+            mesh.add_node_set(name, matched.ravel())
+    for name, refs in node.items():
+        ids = []
+        for r in refs:
+            if r.isdigit():
+                raise _fail(p, f"*SURFACE {name}, TYPE=NODE: node numbers are not supported; name an *NSET")
+            if r not in m.point_sets:
+                raise _fail(p, f"*SURFACE {name}: no node set {r!r}")
+            ids.append(keep(m.point_sets[r]))
+        mesh.add_node_set(name, np.concatenate(ids))
