@@ -295,13 +295,18 @@ class Newton:
             a0, f0, a1, f1 = a1, f1, eta, ft
         return eta
 
+    def _extrapolates_from(self, lam_a: float, lam_b: float) -> bool:
+        """Whether the step from lam_a to lam_b starts from the extrapolating predictor (``_predict``)."""
+        last = self._last
+        return bool(self.extrapolate and last is not None and lam_b > lam_a
+                    and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0])
+
     def _predict(self, u: np.ndarray, lam_a: float, lam_b: float, du_d: np.ndarray) -> np.ndarray:
         """The extrapolating predictor (``predictor = "extrapolate"``, continuing a converged step): the previous
         increment scaled to this step on the free dofs and the prescribed increment ``du_d`` on the others,
         added to ``u``; returns the prescribed increment the first correction still has to make (zero then)."""
         last, free = self._last, self.model.free
-        if (self.extrapolate and last is not None and lam_b > lam_a
-                and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
+        if self._extrapolates_from(lam_a, lam_b):
             u[free] += (lam_b - lam_a) / (last[1] - last[0]) * last[2][free]
             u[~free] += du_d[~free]
             return np.zeros_like(du_d)
@@ -485,8 +490,16 @@ class Newton:
         while lam < lam_b - 1e-14 * max(1.0, abs(lam_b)):
             target = min(lam + inc, lam_b)
             saved = u.copy()
+            extrapolated = self._extrapolates_from(lam, target)
             res, trial = self._try(u, lam, target, committed, None)
             outcomes.append(res)
+            if not res.converged and extrapolated:
+                # the extrapolated start led astray: the same increment again from the tangent predictor before
+                # a cutback
+                u[:] = saved
+                self._last = None
+                res, trial = self._try(u, lam, target, committed, None)
+                outcomes.append(res)
             # the extrapolating predictor continues from a converged step; a failed one retries without it
             self._last = (lam, target, u - saved) if res.converged else None
             augment = 0
