@@ -137,6 +137,7 @@ class Newton:
         self._failed = False  # GMRES missed its tolerance in krylov_max iterations: factorise for the rest of the step
         self._last: tuple[float, float, np.ndarray] | None = None  # (lam_a, lam_b, increment) of the last step
         self._spring: tuple[np.ndarray, np.ndarray] | None = None  # stabilisation: (stiffness per dof, anchor)
+        self._attempt: StepOutcome | None = None  # the outcome of the attempt under way (step)
         self.extrapolate = extrapolates(options.predictor, getattr(model, "problem", None))
         self.poll = None  # called before every iteration (a distributed run's stop signals: StopSignals.poll)
         #: called after every converged increment of :meth:`advance` (after its Uzawa updates) as
@@ -335,7 +336,7 @@ class Newton:
         """Advance ``u`` in place from lam_a to lam_b, starting from the state ``trial`` (default: the
         committed one); returns (StepOutcome, the last trial). On failure ``u`` is left undefined."""
         m, opt = self.model, self.opt
-        out = StepOutcome(converged=False)
+        out = self._attempt = StepOutcome(converged=False)  # (an attempt that raises keeps its iterations)
         free = m.free
         self._failed = False
         self.linear.new_step()
@@ -430,13 +431,20 @@ class Newton:
         except InvertedElementError as exc:
             explain = getattr(self.model, "explain_inversion", None)
             where = explain(exc.body, exc.element) if explain is not None else ""
-            return StepOutcome(converged=False, reason=str(exc) + where), None
+            return self._failed_attempt(str(exc) + where), None
         except LinearSolverError as exc:
             floating = getattr(self.model, "floating_dofs", lambda: None)()
             if floating is None:
-                return StepOutcome(converged=False, reason=str(exc)), None
+                return self._failed_attempt(str(exc)), None
             u[:] = u0
             return self._stabilised(u, lam_a, lam_b, committed, trial, floating, str(exc))
+
+    def _failed_attempt(self, reason: str) -> StepOutcome:
+        """The outcome of the attempt that raised: its iterations, residuals and records so far, and why."""
+        out = self._attempt or StepOutcome(converged=False)
+        self._attempt = None
+        out.converged, out.reason = False, reason
+        return out
 
     def _stabilised(self, u, lam_a, lam_b, committed, trial, floating, why):
         """The step again with the bodies held by contact alone tied to where they started by soft springs
