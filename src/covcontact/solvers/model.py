@@ -289,6 +289,14 @@ class Model:
         names = ", ".join(repr(p) for p in pairs)
         return where + (f", on the slave side of contact pair{'s' if len(pairs) > 1 else ''} {names}" if pairs else "")
 
+    def drive(self, lam: float) -> list[np.ndarray]:
+        """What drives the current stage at load factor ``lam``, per kind: the prescribed displacements, the
+        external forces and the rigid bodies' motions (each applied to four points); the extrapolating
+        predictor compares their increments to notice a turn of the loading."""
+        pts = np.vstack([np.zeros(3), np.eye(3)])
+        motions = [np.ravel(m.apply(pts, lam)) for m in self.contact.num.motions.values()]
+        return [self.prescribed(lam), self.external(lam), np.concatenate(motions) if motions else np.zeros(0)]
+
     def plastic_change(self, a: State, b: State) -> tuple[int, int]:
         """(Gauss points whose yielding in the step differs between ``a`` and ``b``, Gauss points yielding in
         the step of ``b``): how much the plastic zone moved; (0, 0) without a plastic body."""

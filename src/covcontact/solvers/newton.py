@@ -297,10 +297,19 @@ class Newton:
         return eta
 
     def _extrapolates_from(self, lam_a: float, lam_b: float) -> bool:
-        """Whether the step from lam_a to lam_b starts from the extrapolating predictor (``_predict``)."""
+        """Whether the step from lam_a to lam_b starts from the extrapolating predictor (``_predict``): it
+        continues the last converged step, and the loading does not turn (no kind of drive, prescribed
+        displacements, loads or rigid motions, whose increment points against the last step's)."""
         last = self._last
-        return bool(self.extrapolate and last is not None and lam_b > lam_a
-                    and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0])
+        if not (self.extrapolate and last is not None and lam_b > lam_a
+                and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
+            return False
+        drive = getattr(self.model, "drive", None)
+        if drive is None:
+            return True
+        before = [b - a for a, b in zip(drive(last[0]), drive(last[1]))]
+        now = [b - a for a, b in zip(drive(lam_a), drive(lam_b))]
+        return all(float(p @ q) >= 0.0 for p, q in zip(before, now))
 
     def _predict(self, u: np.ndarray, lam_a: float, lam_b: float, du_d: np.ndarray) -> np.ndarray:
         """The extrapolating predictor (``predictor = "extrapolate"``, continuing a converged step): the previous
