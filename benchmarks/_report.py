@@ -15,3 +15,22 @@ def emit(result: dict, out: Path | str | None, table: str) -> None:
     else:
         print(text)
     print(table, file=sys.stderr)
+
+
+def run_record(summary: dict) -> dict:
+    """The figures of a whole run benchmarked by its summary.json: status, steps, Newton iterations, cutbacks
+    and the seconds of the run."""
+    steps = summary["steps"]
+    return {"status": summary["status"], "steps": len(steps), "iterations": summary["total_iterations"],
+            "cutbacks": sum(s["cutbacks"] for s in steps), "wall_s": round(summary["wall_time_s"], 2)}
+
+
+def runs_table(rows: list[dict], key: str) -> str:
+    """Markdown table of ``run_record`` rows of several problems, one column ``key`` telling the variants."""
+    def cell(v):
+        return f"{v:g}" if isinstance(v, float) else str(v)
+
+    lines = [f"| problem | {key} | status | steps | Newton iterations | cutbacks | wall s |", "|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['problem']} | {cell(r[key])} | {r['status']} | {r['steps']} | {r['iterations']} | {r['cutbacks']} | "
+              f"{r['wall_s']} |" for r in rows]
+    return "\n".join(lines)

@@ -19,7 +19,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
-from _report import emit
+from _report import emit, run_record, runs_table
 
 from covcontact.io.loader import load_problem
 
@@ -49,16 +49,10 @@ def main() -> None:
             p.output = replace(p.output, vtu=False)
             with tempfile.TemporaryDirectory() as tmp:
                 s = p.run(out=Path(tmp)).summary
-            rows.append({"problem": name, "predictor": pred, "status": s["status"], "steps": len(s["steps"]),
-                         "iterations": s["total_iterations"], "cutbacks": sum(x["cutbacks"] for x in s["steps"]),
-                         "wall_s": round(s["wall_time_s"], 2)})
+            rows.append({"problem": name, "predictor": pred, **run_record(s)})
             print(rows[-1], file=sys.stderr)
-    table = ["| problem | predictor | status | steps | Newton iterations | cutbacks | wall s |",
-             "|---|---|---|---|---|---|---|"]
-    table += [f"| {r['problem']} | {r['predictor']} | {r['status']} | {r['steps']} | {r['iterations']} | "
-              f"{r['cutbacks']} | {r['wall_s']} |" for r in rows]
     emit({"machine": platform.node(), "python": platform.python_version(), "runs": rows}, args.out,
-         "\n".join(table))
+         runs_table(rows, "predictor"))
 
 
 if __name__ == "__main__":

@@ -24,7 +24,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
-from _report import emit
+from _report import emit, run_record, runs_table
 
 from covcontact.io.loader import problem_from_dict
 
@@ -57,10 +57,7 @@ def _ironing_problem(band: float):
 def _measure(make, band: float) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         res = make(band).run(out=Path(tmp))
-    s = res.summary
-    return {"smoothing": band, "status": s["status"], "steps": len(s["steps"]),
-            "iterations": s["total_iterations"], "cutbacks": sum(x["cutbacks"] for x in s["steps"]),
-            "wall_s": round(s["wall_time_s"], 2)}
+    return {"smoothing": band, **run_record(res.summary)}
 
 
 def main() -> None:
@@ -78,12 +75,8 @@ def main() -> None:
             r = {"problem": name, **_measure(make, band)}
             rows.append(r)
             print(r, file=sys.stderr)
-    table = ["| problem | smoothing | status | steps | Newton iterations | cutbacks | wall s |",
-             "|---|---|---|---|---|---|---|"]
-    table += [f"| {r['problem']} | {r['smoothing']:g} | {r['status']} | {r['steps']} | {r['iterations']} | "
-              f"{r['cutbacks']} | {r['wall_s']} |" for r in rows]
     emit({"machine": platform.node(), "python": platform.python_version(), "runs": rows}, args.out,
-         "\n".join(table))
+         runs_table(rows, "smoothing"))
 
 
 if __name__ == "__main__":

@@ -11,9 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .analytic import Cylinder, Plane, Profile, Sphere
+from .analytic import Cylinder, Plane, Sphere
 from .element import CASES
 from .surface import MeshSurface, facet_sizes, tributary_area
+from .tool_profile import Profile
 
 
 @dataclass

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..contact.analytic import Profile
+from ..contact.tool_profile import Profile
 from ..description import RigidBody
 from .bodies_input import CELLS, build_mesh, user_faces, user_sets
 from .fields import COMPONENT_NAMES, free_components, read_motion
