@@ -61,7 +61,7 @@ class RigidBody:
 
 @dataclass
 class ContactPair:
-    """A node-to-surface contact pair.
+    """A contact pair: node-to-surface (``type`` "nts") or segment-to-surface ("sts"), or self-contact.
 
     slave: (body name, node set name); the body may be deformable or a rigid meshed body.
     master: (body name, face set name) of a deformable or rigid meshed body, or (rigid body name, "")
@@ -93,6 +93,10 @@ class ContactPair:
     law: str = "penalty"               # normal law: "penalty" (with ``smoothing``) or "exponential"
     clearance: float | None = None     # exponential law: the gap at which the pressure starts
     pressure: float | None = None      # exponential law: the pressure at zero gap
+    type: str = "nts"                  # "nts": slave nodes; "sts": Gauss points of the slave facets
+    order: int | None = None           # sts: Gauss points per direction of a slave facet (None: 2 quad4, 3 quad9)
+    self_surfaces: tuple | None = None  # self-contact: the (body, face set) surfaces merged into one
+    tie_tolerance: float | None = None  # law "tied": largest distance of a tied point (None: 5 % facet size)
 
 
 @dataclass

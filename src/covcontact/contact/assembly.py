@@ -26,8 +26,11 @@ class ElementBlocks:
     conn: list[np.ndarray] = field(default_factory=list)   # (m, nen) extended node ids
     R: list[np.ndarray] = field(default_factory=list)      # (m, 3 nen)
     K: list[np.ndarray | None] = field(default_factory=list)  # (m, 3 nen, 3 nen) or None
+    points: object = None  # the segment-to-surface points (.points.VirtualPoints), expanded onto their nodes
 
     def add(self, conn: np.ndarray, R: np.ndarray, K: np.ndarray | None) -> None:
+        if len(conn) and self.points is not None and self.points.count and conn.max() >= self.points.offset:
+            conn, R, K = self.points.expand(np.asarray(conn, dtype=np.int64), R, K)
         if len(conn):
             self.conn.append(np.ascontiguousarray(conn, dtype=np.int64))
             self.R.append(R)

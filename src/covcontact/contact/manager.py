@@ -26,9 +26,11 @@ from .kernels import contact_batch
 from .laws import is_active, linear_equivalents, uzawa_update
 from .reference import map_analytic, map_rigid_nodes
 from .search import candidates
+from .selfcontact import drop_excluded, slave_normals
 from .setup import Numbering, Pass, make_passes
 from .state import ContactState, PassState
 from .surface import facet_sizes
+from .tied import tied_blocks
 
 _CASE_NAME = {v: k for k, v in CASES.items()}
 
@@ -58,6 +60,7 @@ class ContactManager:
         self.num = Numbering(problem, system)
         self.N = self.num.N
         self.passes: list[Pass] = make_passes(self.num, problem, tangent)
+        self.points = self.num.points  # segment-to-surface slave points (ids after the extended nodes)
         self.symmetric = not any(p.mu > 0.0 for p in self.passes)
         self.timing = {"search": 0.0, "projection": 0.0}
         self._cache: list[_SearchCache | None] = [None] * len(self.passes)
@@ -65,7 +68,7 @@ class ContactManager:
         self.enabled = [True] * len(self.passes)  # pairs switched on (stages may switch them)
         # rigid bodies with a reference node: their nodes' rows and columns are mapped onto the node pair
         self.reference = list(getattr(system, "reference", []))
-        self.owner = np.full(self.num.n_ext, -1, dtype=np.int64)
+        self.owner = np.full(self.num.n_ext + self.points.count, -1, dtype=np.int64)
         index = {ref.name: i for i, ref in enumerate(self.reference)}
         for rb in self.num.rigid_meshes:
             if rb.name in index:
@@ -103,7 +106,14 @@ class ContactManager:
 
     # -- positions --------------------------------------------------------------------------------
     def extended(self, x: np.ndarray, lam: float) -> np.ndarray:
-        """Deformable positions x (N, 3) followed by the rigid-mesh nodes at load factor lam."""
+        """Deformable positions x (N, 3) followed by the rigid-mesh nodes at load factor lam, then the
+        segment-to-surface slave points."""
+        xe = self._nodes(x, lam)
+        if not self.points.count:
+            return xe
+        return np.ascontiguousarray(np.vstack([xe, self.points.positions(xe)]))
+
+    def _nodes(self, x: np.ndarray, lam: float) -> np.ndarray:
         if not self.num.rigid_meshes:
             return np.ascontiguousarray(x)
         if self.reference:  # the reference bodies' poses come from x: no cache
@@ -127,8 +137,8 @@ class ContactManager:
         if self.reference:
             self._set_poses(x)
         xe = self.extended(x, lam)
-        ev = ContactEvaluation(ElementBlocks(self.N), [ElementBlocks(self.N) for _ in range(4)] if want_parts
-                               else None)
+        ev = ContactEvaluation(ElementBlocks(self.N, points=self.points),
+                               [ElementBlocks(self.N, points=self.points) for _ in range(4)] if want_parts else None)
         trial = ContactState([], xe)
         for k, p in enumerate(self.passes):
             c, g0 = committed.passes[k], guess.passes[k]
@@ -139,7 +149,9 @@ class ContactManager:
             t.multiplier = g0.multiplier.copy()
             t.n_aug = g0.n_aug
             pcase = p.case if case is None else case
-            if p.surface is not None:
+            if p.tied:
+                self._tied_pass(p, xe, t, want_K, want_parts, ev)
+            elif p.surface is not None:
                 self._mesh_pass(k, p, xe, pcase, c, g0, t, committed.x, want_K, want_parts, ev)
             else:
                 self._analytic_pass(p, xe, lam, pcase, c, t, want_K, want_parts, ev)
@@ -154,6 +166,9 @@ class ContactManager:
         sizes = facet_sizes(xe, p.surface.faces)
         margin = float(sizes.max()) if len(sizes) else 0.0
         cand = candidates(xe, p.surface, xe[p.slaves], margin)
+        if p.self_contact:  # not the slave's own neighbourhood
+            cand = drop_excluded(np.ascontiguousarray(cand[0], np.int64), np.ascontiguousarray(cand[1], np.int64),
+                                 p.exclude)
         self._cache[k] = _SearchCache(cand, xe.copy(), margin)
         self.timing["search"] += time.perf_counter() - t0
         return cand
@@ -162,9 +177,13 @@ class ContactManager:
                    want_parts, ev: ContactEvaluation) -> None:
         cand = self._search(k, p, xe)
         t0 = time.perf_counter()
-        res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi)
+        if p.self_contact:  # every facet near the slave is a candidate: no walks into its own neighbourhood
+            res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi, max_hops=0)
+            self._face_to_face(p, xe, res)
+        else:
+            res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi)
         self.timing["projection"] += time.perf_counter() - t0
-        if p.mu == 0.0:
+        if p.mu == 0.0 and not p.self_contact:
             t.edge_lock = self._hold(p, xe, res, g0)
         ok = res.kind != 0
         t.facet = np.where(ok, res.facet, -1).astype(np.int64)
@@ -224,6 +243,29 @@ class ContactManager:
             self._add(ev.blocks, conn, R, K if want_K else None, xe)
             if want_parts:
                 ev.parts[0].add(conn, np.zeros_like(R), K)
+
+    @staticmethod
+    def _face_to_face(p: Pass, xe: np.ndarray, res) -> None:
+        """Self-contact: contact points whose master normal does not oppose the slave's own normal dropped."""
+        own = slave_normals(xe, p.surface, p.slaves, p.slave_facet)
+        bad = (res.kind != 0) & (np.einsum("si,si->s", own, res.normal) >= 0.0)
+        res.kind[bad] = 0
+        res.facet[bad] = -1
+        res.g[bad] = np.inf
+        res.xi[bad] = 0.0
+
+    def _tied_pass(self, p: Pass, xe, t: PassState, want_K, want_parts, ev: ContactEvaluation) -> None:
+        """Tied slaves: a vector penalty to their fixed tie points (:mod:`.tied`); gap: the points' distance."""
+        idx = np.flatnonzero(p.tie_facet >= 0)
+        faces = p.surface.faces[p.tie_facet[idx]]
+        R, K, d = tied_blocks(xe, faces, p.tie_N[idx], xe[p.slaves[idx]], p.eps[idx], want_K or want_parts)
+        conn = np.hstack([faces, p.slaves[idx][:, None]])
+        t.facet[idx] = p.tie_facet[idx]
+        t.gap[idx] = np.linalg.norm(d, axis=1)
+        t.force[idx] = -R[:, -3:]
+        self._add(ev.blocks, conn, R, K if want_K else None, xe)
+        if want_parts:
+            ev.parts[0].add(conn, np.zeros_like(R), K)
 
     @staticmethod
     def _hold(p: Pass, xe: np.ndarray, res, g0: PassState) -> np.ndarray:
@@ -366,6 +408,8 @@ class ContactManager:
     # -- queries on a state -----------------------------------------------------------------------
     def active_mask(self, k: int, state: ContactState) -> np.ndarray:
         s = state.passes[k]
+        if self.passes[k].tied:
+            return s.facet >= 0
         return is_active(s.gap, s.multiplier, self.passes[k].eps, self.passes[k].band)
 
     def active_count(self, state: ContactState) -> int:
@@ -381,7 +425,7 @@ class ContactManager:
         nodes = []
         for k, p in enumerate(self.passes):
             act = self.active_mask(k, state)
-            nodes.append(p.slaves[act])
+            nodes.append(self.points.nodes(p.slaves[act]))
             if p.surface is not None:
                 f = state.passes[k].facet[act]
                 nodes.append(p.surface.faces[f[f >= 0]].ravel())
@@ -402,6 +446,10 @@ class ContactManager:
 
     def point_data(self, n_nodes: int, state: ContactState) -> dict:
         return report.point_data(self, n_nodes, state)
+
+    def facet_fields(self, state: ContactState) -> list:
+        """(slave faces, mean contact pressure per facet) of every pass with a slave face set."""
+        return report.facet_pressure(self, state)
 
     def node_fields(self, state: ContactState):
         """(gap, pressure, status) over the extended node numbering (deformable nodes, then the nodes of rigid

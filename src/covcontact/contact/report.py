@@ -67,23 +67,63 @@ def step_report(manager, x: np.ndarray, lam: float, state: ContactState) -> dict
 
 def node_fields(manager, n: int, state: ContactState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gap, contact pressure (force over tributary area) and status (-1 not a slave, 0 inactive, 1 active)
-    of nodes 0..n-1 of the extended numbering, from the slaves of all ranks."""
+    of nodes 0..n-1 of the extended numbering, from the slaves of all ranks. Segment-to-surface points give the
+    nodes of their facets the lumped L2 projection of their values (:meth:`.points.VirtualPoints.smooth`); a node
+    is active where an active point's pressure reaches it."""
     gap = np.full(n, np.nan)
     pressure = np.zeros(n)
     status = np.full(n, -1.0)
-    mine = []
+    every = manager.gather(_point_rows(manager, state))
     for k, p in enumerate(manager.passes):
-        s = state.passes[k]
-        fn = np.linalg.norm(s.force, axis=1) / np.maximum(p.area, 1e-300)
-        mine.append((p.slaves, s.gap, manager.active_mask(k, state), fn))
-    every = manager.gather(mine)
-    for k in range(len(manager.passes)):
-        sl, g, act, fn = (np.concatenate([e[k][j] for e in every]) for j in range(4))
+        sl, g, act, fn, area = (np.concatenate([e[k][j] for e in every]) for j in range(5))
+        if p.kind == "sts":
+            pts = manager.points
+            fin = np.isfinite(g)
+            pg, _ = pts.smooth(sl, area * fin, np.where(fin, g, 0.0), n)
+            pp, has = pts.smooth(sl, area, np.where(act, fn, 0.0), n)
+            on, _ = pts.smooth(sl, area, act.astype(float), n)
+            gsum, _ = pts.smooth(sl, area * fin, np.ones(len(sl)), n)
+            gap[gsum > 0] = pg[gsum > 0]
+            pressure[has] = pp[has]
+            status[has] = np.where(on[has] > 0.0, 1.0, 0.0)
+            continue
         sel = sl < n
         gap[sl[sel]] = np.where(np.isfinite(g[sel]), g[sel], np.nan)
         status[sl[sel]] = np.where(act[sel], 1.0, 0.0)
         pressure[sl[sel]] = np.where(act[sel], fn[sel], 0.0)
     return gap, pressure, status
+
+
+def _point_rows(manager, state: ContactState) -> list[tuple]:
+    """Per pass: (slave ids, gap, active, pressure = |force| / area, area, facet of a point or -1) of this rank's
+    slaves."""
+    mine = []
+    for k, p in enumerate(manager.passes):
+        s = state.passes[k]
+        fn = np.linalg.norm(s.force, axis=1) / np.maximum(p.area, 1e-300)
+        facet = p.slave_facet if p.slave_facet is not None else np.full(p.ns, -1, dtype=np.int64)
+        mine.append((p.slaves, s.gap, manager.active_mask(k, state), fn, p.area, facet))
+    return mine
+
+
+def facet_pressure(manager, state: ContactState) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per pass with a slave face set: (faces (nf, nen) extended ids, the mean contact pressure of each facet):
+    the area-weighted mean over its points (sts), the mean over its nodes of the nodal pressure (nts)."""
+    _, nodal, _ = node_fields(manager, manager.num.n_ext, state)
+    every = manager.gather(_point_rows(manager, state))
+    out = []
+    for k, p in enumerate(manager.passes):
+        if p.slave_faces is None:
+            continue
+        nf = len(p.slave_faces)
+        if p.kind == "sts":
+            _, _, act, fn, area, facet = (np.concatenate([e[k][j] for e in every]) for j in range(6))
+            num = np.bincount(facet, area * np.where(act, fn, 0.0), minlength=nf)
+            den = np.bincount(facet, area, minlength=nf)
+            out.append((p.slave_faces, np.divide(num, den, out=np.zeros(nf), where=den > 0)))
+        else:
+            out.append((p.slave_faces, nodal[p.slave_faces].mean(axis=1)))
+    return out
 
 
 def point_data(manager, n_nodes: int, state: ContactState) -> dict:

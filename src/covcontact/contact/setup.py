@@ -7,21 +7,27 @@ contributes to the residual and tangent only through the deformable dofs of its 
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
 from .analytic import Cylinder, Plane, Sphere
 from .element import CASES
+from .points import VirtualPoints, gauss_points
+from .selfcontact import excluded_facets
 from .surface import MeshSurface, facet_sizes, tributary_area
+from .tied import tie
 from .tool_profile import Profile
 
 
 @dataclass
 class Pass:
-    """One slave node set against one master surface (a pair, or one direction of a two-pass pair).
+    """One slave set against one master surface (a pair, or one direction of a two-pass pair).
 
-    Static data only; what changes during a run lives in :class:`covcontact.contact.state.PassState`.
+    The slaves are nodes (node-to-surface) or the Gauss points of the slave facets (segment-to-surface: ids after
+    the extended nodes, :mod:`.points`). Static data only; what changes during a run lives in
+    :class:`covcontact.contact.state.PassState`. The per-slave arrays are cut together by :meth:`subset`.
     """
 
     name: str
@@ -42,10 +48,30 @@ class Pass:
     rigid: str = ""                    # the rigid body of an analytic master surface
     slave_body: str = ""               # the body that carries the slave nodes
     master_body: str = ""              # the body of the master surface
+    kind: str = "nts"                  # "nts" (slave nodes) or "sts" (Gauss points of the slave facets)
+    slave_faces: np.ndarray | None = None  # the slave face set (extended node ids), for the pressure output
+    tie_facet: np.ndarray | None = None    # law "tied": (ns,) the master facet of each slave, -1 not tied
+    tie_N: np.ndarray | None = None        # law "tied": (ns, nen) master shape values at the tie point
+    exclude: np.ndarray | None = None      # self-contact: (ns, k) facets each slave never touches, -1 padded
+    slave_facet: np.ndarray | None = None  # sts: (ns,) each point's facet in slave_faces
 
     @property
     def ns(self) -> int:
         return len(self.slaves)
+
+    @property
+    def tied(self) -> bool:
+        return self.tie_facet is not None
+
+    @property
+    def self_contact(self) -> bool:
+        return self.exclude is not None
+
+    def subset(self, keep: np.ndarray) -> Pass:
+        """The pass over slaves ``keep`` only (a rank's share of a distributed run)."""
+        cut = {name: getattr(self, name)[keep] for name in ("slaves", "eps", "area", "eps_t", "tie_facet", "tie_N",
+                                                            "exclude", "slave_facet") if getattr(self, name) is not None}
+        return dataclasses.replace(self, global_index=keep, **cut)
 
 
 def analytic_surface(rb):
@@ -81,6 +107,7 @@ class Numbering:
         self.n_ext = n
         self.X_rigid = (np.vstack([rb.mesh.points for rb in self.rigid_meshes]) if self.rigid_meshes
                         else np.zeros((0, 3)))
+        self.points = VirtualPoints(n)  # segment-to-surface slave points, numbered after the extended nodes
 
     def mesh_of(self, body: str):
         for b in self.problem.bodies:
@@ -123,18 +150,37 @@ def _auto_penalty(num: Numbering, pair, slave, master) -> float:
                      f"named like its contact set")
 
 
-def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None) -> Pass:
-    """The pass of ``slave`` against ``master`` of ``pair``; ``tangent`` overrides the pair's case."""
+def _slaves(num: Numbering, pair, slave, X) -> tuple:
+    """(slave ids, area per slave, slave faces or None, own facet index or None) of one side of a pair:
+    nodes with their tributary areas (nts), or Gauss points with their weights (sts)."""
     smesh, soff = num.mesh_of(slave[0])
+    faces = smesh.face_sets[slave[1]] + soff if slave[1] in smesh.face_sets else None
+    if pair.type == "sts":
+        conn, N, weight, facet = gauss_points(X, faces, pair.order)
+        return num.points.add(conn, N), weight, faces, facet
     slaves = smesh.node_sets[slave[1]] + soff
+    area = tributary_area(X, faces)[slaves] if faces is not None else np.ones(len(slaves))
+    return slaves, area, faces, None
+
+
+def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None, surfaces=None) -> Pass:
+    """The pass of ``slave`` against ``master`` of ``pair``; ``tangent`` overrides the pair's case. ``surfaces``:
+    the (body, face set) list of a self-contact, merged into one surface that is both slave and master."""
     X = num.reference()
-    if slave[1] in smesh.face_sets:
-        area = tributary_area(X, smesh.face_sets[slave[1]] + soff)[slaves]
+    if surfaces is not None:
+        faces = np.vstack([num.mesh_of(b)[0].face_sets[f] + num.mesh_of(b)[1] for b, f in surfaces])
+        if pair.type == "sts":
+            conn, N, area, own = gauss_points(X, faces, pair.order)
+            slaves = num.points.add(conn, N)
+        else:
+            slaves, own = np.unique(faces), None
+            area = tributary_area(X, faces)[slaves]
+        slave_faces = faces
     else:
-        area = np.ones(len(slaves))
+        slaves, area, slave_faces, own = _slaves(num, pair, slave, X)
     penalty = _auto_penalty(num, pair, slave, master) if pair.penalty == "auto" else pair.penalty
-    if pair.weighting == "area" or pair.penalty == "auto":
-        if slave[1] not in smesh.face_sets:
+    if pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
+        if slave_faces is None:
             raise ValueError(f"contact {pair.name}: area weighting needs a face set named {slave[1]!r}")
         eps = penalty * area
     else:
@@ -147,26 +193,43 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
             ratio = 1.0 / float(pair.clearance)  # the tangential stiffness p0 / c0 (per area)
     kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
-          "slave_body": slave[0], "master_body": master[0], "band": band}
-    mmesh, moff = num.mesh_of(master[0])
-    if mmesh is None:
-        rb = next(r for r in num.problem.rigid if r.name == master[0])
-        h = float(np.mean(facet_sizes(X, smesh.face_sets[slave[1]] + soff))) if slave[1] in smesh.face_sets \
-            else 1.0
-        p = Pass(name, slaves, eps, area, analytic=analytic_surface(rb), rigid=rb.name, **kw)
+          "slave_body": slave[0] if surfaces is None else "", "master_body": master[0] if surfaces is None else "",
+          "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own}
+    if surfaces is not None:
+        surface = MeshSurface(slave_faces, n_nodes=num.n_ext)
+        h = float(np.mean(facet_sizes(X, slave_faces))) / np.sqrt(2.0)
+        exclude = excluded_facets(slave_faces, num.n_ext, slave_nodes=None if own is not None else slaves,
+                                  slave_facets=own)
+        p = Pass(name, slaves, eps, area, surface=surface, exclude=exclude, **kw)
     else:
-        faces = mmesh.face_sets[master[1]] + moff
-        h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)
-        p = Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=num.n_ext), **kw)
+        mmesh, moff = num.mesh_of(master[0])
+        if mmesh is None:
+            rb = next(r for r in num.problem.rigid if r.name == master[0])
+            h = float(np.mean(facet_sizes(X, slave_faces))) if slave_faces is not None else 1.0
+            p = Pass(name, slaves, eps, area, analytic=analytic_surface(rb), rigid=rb.name, **kw)
+        else:
+            faces = mmesh.face_sets[master[1]] + moff
+            h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)
+            p = Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=num.n_ext), **kw)
+    if pair.law == "tied":
+        xs = num.points.positions(X)[slaves - num.n_ext] if pair.type == "sts" else X[slaves]
+        p.tie_facet, p.tie_N = tie(X, p.surface, xs, pair.tie_tolerance)
+        if not (p.tie_facet >= 0).any():
+            raise ValueError(f"contact {pair.name}: no slave point lies within the tie tolerance of the master "
+                             f"surface; the surfaces do not meet: check the geometry or raise tie_tolerance")
     if p.augmented:
         p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
     return p
 
 
 def make_passes(num: Numbering, problem, tangent: str | None = None) -> list[Pass]:
-    """Every pass of the problem's contact pairs (two per two-pass pair)."""
+    """Every pass of the problem's contact pairs (two per two-pass pair, one per self-contact)."""
     out = []
     for pair in problem.contacts:
+        if pair.self_surfaces:
+            out.append(make_pass(num, pair.name, pair.slave, pair.master, pair, tangent,
+                                 surfaces=pair.self_surfaces))
+            continue
         out.append(make_pass(num, pair.name, pair.slave, pair.master, pair, tangent))
         if pair.two_pass:
             out.append(make_pass(num, pair.name + "/reverse", tuple(pair.master), tuple(pair.slave), pair,

@@ -9,30 +9,100 @@ from .fields import split_ref
 from .validate import Section
 
 
+#: the largest number of Gauss points per direction of a segment-to-surface slave facet
+MAX_ORDER = 8
+
+
+def _slave_faces(c, sets) -> None:
+    """An sts pair's slave must be a face set: one line naming it when it is a node set only."""
+    ref = c.data.get("slave")
+    if not isinstance(ref, str):
+        return  # body_set reports it
+    bname, sname = split_ref(c, "slave", ref)
+    owner = next((b.mesh for b in sets.bodies if b.name == bname), None) or next(
+        (r.mesh for r in sets.rigid if r.name == bname and r.mesh is not None), None)
+    if owner is not None and sname in owner.node_sets and sname not in owner.face_sets:
+        faces = ", ".join(sorted(owner.face_sets)) or "none"
+        c.fail(f"type = \"sts\" integrates over the slave's faces, but {ref!r} is a node set only: give a face set "
+               f"of {bname!r} ({faces})", "slave")
+
+
+def _self_surfaces(c, sets) -> tuple:
+    """The face sets of a self-contact: one "BODY.FACESET" or a list of them (merged into one surface)."""
+    val = c.get("self", "any")
+    refs = [val] if isinstance(val, str) else val
+    if not isinstance(refs, list) or not refs or not all(isinstance(r, str) for r in refs):
+        c.fail("give a face set \"BODY.FACESET\" or a list of them", "self")
+    out = []
+    for ref in refs:
+        c.data["self"] = ref
+        bname, sname = split_ref(c, "self", ref)
+        owner = next((b.mesh for b in sets.bodies if b.name == bname), None) or next(
+            (r.mesh for r in sets.rigid if r.name == bname and r.mesh is not None), None)
+        if owner is not None and sname in owner.node_sets and sname not in owner.face_sets:
+            c.fail(f"{ref!r} is a node set; self-contact needs the faces of the surface: give a face set of "
+                   f"{bname!r} ({', '.join(sorted(owner.face_sets)) or 'none'})", "self")
+        out.append(sets.body_set(c, "self", "face"))
+    if len(set(out)) != len(out):
+        c.fail("a face set is listed twice", "self")
+    return tuple(out)
+
+
 def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]:
     """Every ``[[contact]]`` entry."""
     contacts = []
     for i, c in enumerate(top.get("contact", "array", [])):
         cname = c.get("name", "str", f"contact{i + 1}")
-        slave = sets.body_set(c, "slave", "node")
-        mref = c.get("master", "str")
-        mbody, mset = split_ref(c, "master", mref)
-        analytic = next((r for r in rigid if r.name == mbody and r.mesh is None), None)
-        if analytic is not None:
-            if mset:
-                c.fail(f"{mref!r}: the analytic surface {mbody!r} has no sets; name it alone", "master")
-            master = (mbody, "")
+        ctype = c.get("type", "str", "nts", choices=("nts", "sts"))
+        surfaces = None
+        if c.has("self"):
+            for key in ("slave", "master", "two_pass"):
+                if c.has(key):
+                    c.fail(f"not used with self (one surface is slave and master of itself, both sides act): "
+                           f"remove {key!r}", key)
+            surfaces = _self_surfaces(c, sets)
+            slave = master = surfaces[0]
         else:
-            c.data["master"] = mref
-            master = sets.body_set(c, "master", "face")
-        if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
-            c.fail("slave and master are the same rigid body")
-        if slave == master:
-            c.fail(f"slave and master are the same surface '{slave[0]}.{slave[1]}': a surface in contact with "
-                   f"itself needs self-contact, which covcontact does not have yet; for two parts of one body's "
-                   f"surface name two different face sets", "master")
-        law = c.get("law", "str", "penalty", choices=("penalty", "exponential"))
-        clearance = pressure = None
+            if ctype == "sts":
+                _slave_faces(c, sets)
+            slave = sets.body_set(c, "slave", "face" if ctype == "sts" else "node")
+            mref = c.get("master", "str")
+            mbody, mset = split_ref(c, "master", mref)
+            analytic = next((r for r in rigid if r.name == mbody and r.mesh is None), None)
+            if analytic is not None:
+                if mset:
+                    c.fail(f"{mref!r}: the analytic surface {mbody!r} has no sets; name it alone", "master")
+                master = (mbody, "")
+            else:
+                c.data["master"] = mref
+                master = sets.body_set(c, "master", "face")
+            if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
+                c.fail("slave and master are the same rigid body")
+            if slave == master:
+                c.fail(f"slave and master are the same surface '{slave[0]}.{slave[1]}': a surface in contact with "
+                       f"itself is self-contact: write self = \"{slave[0]}.{slave[1]}\" instead of slave and "
+                       f"master", "master")
+        order = None
+        if c.has("order"):
+            if ctype != "sts":
+                c.fail("the Gauss rule of the slave facets is for type = \"sts\"", "order")
+            order = c.get("order", "int")
+            if not 1 <= order <= MAX_ORDER:
+                c.fail(f"{order} Gauss points per direction: the slave facets have rules of 1 to {MAX_ORDER} points "
+                       f"per direction (2 suits quad4 facets, 3 quad9)", "order")
+        law = c.get("law", "str", "penalty", choices=("penalty", "exponential", "tied"))
+        clearance = pressure = tie_tol = None
+        if law == "tied":
+            for key in ("friction", "method", "smoothing", "two_pass"):
+                if c.has(key):
+                    c.fail(f"not used by law = \"tied\" (the surfaces are bonded: no opening, no sliding)", key)
+            if surfaces is not None:
+                c.fail("a surface cannot be tied to itself", "law")
+            if master[1] == "":
+                c.fail(f"law = \"tied\" bonds to a meshed surface; {master[0]!r} is an analytic one", "master")
+            tie_tol = c.get("tie_tolerance", "float", None, positive=True)
+        elif c.has("tie_tolerance"):
+            c.fail("tie_tolerance is for law = \"tied\"", "tie_tolerance")
         if law == "exponential":
             for key in ("penalty", "smoothing", "method"):
                 if c.has(key):
@@ -55,7 +125,12 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         if method == "penalty" and (gap_tol is not None or gap_rel is not None):
             c.fail("gap tolerances need method = \"augmented\"")
         weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area"))
-        if weighting == "area" or penalty == "auto":
+        if ctype == "sts":
+            if c.has("weighting") and weighting != "area":
+                c.fail("type = \"sts\" integrates the gap over the slave surface: its penalty is per unit area "
+                       "(weighting = \"area\" or leave weighting out)", "weighting")
+            weighting = "area"
+        if surfaces is None and (weighting == "area" or penalty == "auto"):
             owner = next((b.mesh for b in sets.bodies if b.name == slave[0]), None) or next(
                 (r.mesh for r in rigid if r.name == slave[0] and r.mesh is not None), None)
             if owner is not None and slave[1] not in owner.face_sets:
@@ -76,5 +151,6 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                                     friction=mu, tangential_penalty=eps_t, method=method, gap_tolerance=gap_tol,
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
                                     auto_factor=auto_factor, enabled=enabled, smoothing=smoothing, law=law,
-                                    clearance=clearance, pressure=pressure))
+                                    clearance=clearance, pressure=pressure, type=ctype, order=order,
+                                    self_surfaces=surfaces, tie_tolerance=tie_tol))
     return contacts

@@ -162,6 +162,12 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
         cd.update(blk.solid.plastic_fields(est))
         cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
         blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
+    if model.contact.passes:  # the slave surfaces with their facets' mean contact pressure
+        for faces, pressure in model.contact.facet_fields(state.contact):
+            keep = (faces < n).all(axis=1)
+            if keep.any():
+                blocks.append(("quad4" if faces.shape[1] == 4 else "quad9", faces[keep],
+                               {"contact_facet_pressure": pressure[keep]}))
     points = sysm.X[:n].copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
     extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, model.contact.node_fields(state.contact))

@@ -57,6 +57,12 @@ def _rigid_mask(mesh, block: int, n: int) -> np.ndarray:
     return np.zeros(n, dtype=bool)
 
 
+def _contact_facets(mesh, block: int) -> bool:
+    """True for a block of slave facets written for their contact pressure (not a body to draw)."""
+    arr = mesh.cell_data.get("contact_facet_pressure")
+    return arr is not None and not np.all(np.isnan(np.asarray(arr[block], dtype=float)))
+
+
 def _boundary_quads(hexes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Faces of linear hexahedra that belong to one cell only, and the index of that cell."""
     if len(hexes) == 0:
@@ -84,7 +90,7 @@ def surface_quads(mesh, field: str | None = None):
                 quads.append(q)
                 rigid.append(np.full(len(q), flag))
                 values.append(data[cells[owner]])
-        elif block.type.startswith("quad"):
+        elif block.type.startswith("quad") and not _contact_facets(mesh, b):
             quads.append(conn[:, :4])
             rigid.append(mask)
             values.append(data)

@@ -9,8 +9,6 @@ Uzawa decisions, reports, output fields) is reduced over the ranks here.
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import scipy.sparse as sp
 
@@ -32,11 +30,17 @@ class DistributedContact(ContactManager):
             own = np.empty(len(s), dtype=np.int64)
             deformable = s < self.N
             own[deformable] = owner[s[deformable]]
+            # a segment-to-surface point goes with the owner of its facet's first node, if deformable
+            pts = self.points
+            virtual = s >= pts.offset
+            first = pts.conn[s[virtual] - pts.offset, 0] if virtual.any() else np.zeros(0, dtype=np.int64)
+            on_body = np.flatnonzero(virtual)[first < self.N]
+            own[on_body] = owner[first[first < self.N]]
+            deformable[on_body] = True
             rigid = np.flatnonzero(~deformable)
             own[rigid] = np.arange(rigid.size) * size // max(rigid.size, 1)
             keep = np.flatnonzero(own == rank)
-            local.append(dataclasses.replace(p, slaves=s[keep], eps=p.eps[keep], area=p.area[keep],
-                                             eps_t=p.eps_t[keep], global_index=keep))
+            local.append(p.subset(keep))
         self.passes = local
         self.enabled = [True] * len(self.passes)
         self._cache = [None] * len(self.passes)
