@@ -124,9 +124,10 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
             gap_rel = 1e-3
         if method == "penalty" and (gap_tol is not None or gap_rel is not None):
             c.fail("gap tolerances need method = \"augmented\"")
+        given = c.has("weighting")
         weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area"))
         if ctype == "sts":
-            if c.has("weighting") and weighting != "area":
+            if given and weighting != "area":
                 c.fail("type = \"sts\" integrates the gap over the slave surface: its penalty is per unit area "
                        "(weighting = \"area\" or leave weighting out)", "weighting")
             weighting = "area"
