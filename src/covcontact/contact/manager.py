@@ -26,13 +26,17 @@ from .kernels import contact_batch
 from .laws import is_active, linear_equivalents, uzawa_update
 from .reference import map_analytic, map_rigid_nodes
 from .search import candidates
-from .selfcontact import drop_excluded, slave_normals
+from .selfcontact import FRONT_COS, HOLD_COS, drop_excluded, facet_normals, slave_normals
 from .setup import Numbering, Pass, make_passes
 from .state import ContactState, PassState
 from .surface import facet_sizes
 from .tied import tied_blocks
 
 _CASE_NAME = {v: k for k, v in CASES.items()}
+#: self-contact projections are accepted this far outside a facet (in xi): the nodes on the boundary of an open
+#: surface (the end of a tube) lie exactly on the boundary of the facets they touch, and round-off alone would
+#: decide whether they have a contact point
+SELF_TOL_INSIDE = 1e-4
 
 
 @dataclass
@@ -166,9 +170,6 @@ class ContactManager:
         sizes = facet_sizes(xe, p.surface.faces)
         margin = float(sizes.max()) if len(sizes) else 0.0
         cand = candidates(xe, p.surface, xe[p.slaves], margin)
-        if p.self_contact:  # not the slave's own neighbourhood
-            cand = drop_excluded(np.ascontiguousarray(cand[0], np.int64), np.ascontiguousarray(cand[1], np.int64),
-                                 p.exclude)
         self._cache[k] = _SearchCache(cand, xe.copy(), margin)
         self.timing["search"] += time.perf_counter() - t0
         return cand
@@ -178,8 +179,13 @@ class ContactManager:
         cand = self._search(k, p, xe)
         t0 = time.perf_counter()
         if p.self_contact:  # every facet near the slave is a candidate: no walks into its own neighbourhood
-            res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi, max_hops=0)
-            self._face_to_face(p, xe, res)
+            fn = facet_normals(xe, p.surface.faces)
+            own = slave_normals(xe, p.surface, p.slaves, p.slave_facet, fn)
+            ptr, fac = drop_excluded(np.ascontiguousarray(cand[0], np.int64), np.ascontiguousarray(cand[1], np.int64),
+                                     p.exclude, own, fn, np.where(g0.facet >= 0, HOLD_COS, 0.0))
+            res = project_slaves(xe, p.surface, xe[p.slaves], ptr, fac, g0.facet, g0.xi, max_hops=0,
+                                 tol_inside=SELF_TOL_INSIDE)
+            self._face_to_face(own, res, g0.facet >= 0)
         else:
             res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi)
         self.timing["projection"] += time.perf_counter() - t0
@@ -245,10 +251,12 @@ class ContactManager:
                 ev.parts[0].add(conn, np.zeros_like(R), K)
 
     @staticmethod
-    def _face_to_face(p: Pass, xe: np.ndarray, res) -> None:
-        """Self-contact: contact points whose master normal does not oppose the slave's own normal dropped."""
-        own = slave_normals(xe, p.surface, p.slaves, p.slave_facet)
-        bad = (res.kind != 0) & (np.einsum("si,si->s", own, res.normal) >= 0.0)
+    def _face_to_face(own: np.ndarray, res, held: np.ndarray) -> None:
+        """Self-contact (:mod:`.selfcontact`): facet points whose normal does not oppose the slave's own normal
+        ``own``, edge and vertex points the slave does not lie in front of, dropped (``held``: slaves with a
+        contact point at the last iterate, which keep theirs up to HOLD_COS more)."""
+        cos = np.einsum("si,si->s", own, res.normal) - np.where(held, HOLD_COS, 0.0)
+        bad = (res.kind != 0) & ((cos >= 0.0) | ((res.kind != FACET) & (cos > -FRONT_COS)))
         res.kind[bad] = 0
         res.facet[bad] = -1
         res.g[bad] = np.inf

@@ -1,11 +1,14 @@
 """Self-contact: one surface is slave and master of itself (docs/theory.md, section 13).
 
 Every slave (a node of the surface, or a Gauss point of one of its facets) searches the whole surface except
-its own neighbourhood: the facets that share a node with a facet around the slave node, or with the slave
-point's own facet (a topological distance of two facets; a surface folding back onto itself closer than that is
-not resolved by its mesh anyway). Among the contact points found, only those whose master normal opposes the
-slave's own outward normal count (n_s . n_m < 0): a surface meets itself face to face, so a point seen from the
-same side is its own neighbourhood seen along the surface, never a contact.
+its own facets: those around the slave node, or those sharing a node with the slave point's facet. The rest is
+told apart geometrically, since a surface meets itself face to face: a candidate facet counts only if its normal
+opposes the slave's own outward normal (n_s . n_f < 0, at the facet's centre), and an edge or vertex point only
+if the slave lies in front of it (the unit vector from the point to the slave within 60 degrees of -n_s); a
+slave that had a contact point at the last iterate keeps them up to a cosine 0.5 larger (hysteresis). A
+neighbour along a smooth surface is seen sideways (its closest point lies on the boundary of the excluded
+facets, in the tangent direction), never in front, so it gives no contact however the surface curves, while the
+other side of a fold does, however close along the surface it is.
 """
 
 from __future__ import annotations
@@ -33,23 +36,31 @@ def _padded(M: sp.csr_matrix) -> np.ndarray:
     return out
 
 
+#: an edge or vertex point counts if the slave lies within this cosine of the direction -n_s from it
+FRONT_COS = 0.5
+#: hysteresis: a slave with a contact point at the last iterate keeps facets and points up to this much more
+#: cosine (a slave passing round a fold otherwise loses and regains its contact point from one iterate to the
+#: next, and Newton cycles)
+HOLD_COS = 0.5
+
+
 def excluded_facets(faces: np.ndarray, n_nodes: int, slave_nodes: np.ndarray | None = None,
                     slave_facets: np.ndarray | None = None) -> np.ndarray:
-    """(ns, width) facets each slave never contacts, -1 padded: for slave nodes the facets sharing a node with a
-    facet around the node, for slave points (given by their facet) those sharing a node with a facet sharing a
-    node with the point's facet."""
+    """(ns, width) facets each slave never contacts, -1 padded: for slave nodes the facets around the node, for
+    slave points (given by their facet) the facets sharing a node with the point's facet."""
     A = _incidence(faces, n_nodes)
-    near = (A @ A.T).astype(bool)                 # facet -> facets sharing a node
     if slave_nodes is not None:
-        ring = (A.T.tocsr()[slave_nodes] @ near).astype(bool)
+        ring = A.T.tocsr()[slave_nodes]
     else:
-        ring = (near[slave_facets] @ near).astype(bool)
+        ring = (A[slave_facets] @ A.T).astype(bool)
     return _padded(ring)
 
 
 @njit(cache=True)
-def drop_excluded(ptr, fac, excl):
-    """The candidate CSR (ptr, fac) without each slave's excluded facets (rows of ``excl``, -1 padded)."""
+def drop_excluded(ptr, fac, excl, own, fn, cos_max):
+    """The candidate CSR (ptr, fac) without each slave's excluded facets (rows of ``excl``, -1 padded) and the
+    facets whose normal ``fn`` (nf, 3) makes a cosine of ``cos_max[s]`` or more with the slave's own normal
+    ``own`` (ns, 3)."""
     ns = ptr.shape[0] - 1
     out_ptr = np.zeros(ns + 1, dtype=np.int64)
     out = np.empty(fac.shape[0], dtype=np.int64)
@@ -57,8 +68,10 @@ def drop_excluded(ptr, fac, excl):
     for s in range(ns):
         for k in range(ptr[s], ptr[s + 1]):
             f = fac[k]
-            hit = False
+            hit = own[s, 0] * fn[f, 0] + own[s, 1] * fn[f, 1] + own[s, 2] * fn[f, 2] >= cos_max[s]
             for e in range(excl.shape[1]):
+                if hit:
+                    break
                 if excl[s, e] == f:
                     hit = True
                     break
@@ -78,9 +91,11 @@ def facet_normals(xe: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.divide(n, ln, out=np.zeros_like(n), where=ln > 0)
 
 
-def slave_normals(xe: np.ndarray, surface, slaves: np.ndarray, own_facet: np.ndarray | None) -> np.ndarray:
-    """The slaves' own outward normals: their facet's (points) or the mean of the facets around them (nodes)."""
-    fn = facet_normals(xe, surface.faces)
+def slave_normals(xe: np.ndarray, surface, slaves: np.ndarray, own_facet: np.ndarray | None,
+                  fn: np.ndarray | None = None) -> np.ndarray:
+    """The slaves' own outward normals: their facet's (points) or the mean of the facets around them (nodes);
+    ``fn`` the facet normals if at hand."""
+    fn = facet_normals(xe, surface.faces) if fn is None else fn
     if own_facet is not None:
         return fn[own_facet]
     out = np.zeros((len(slaves), 3))
