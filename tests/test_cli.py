@@ -109,7 +109,7 @@ BAD_CASES = {
                            'penalty = 1.0\ntangent = "e"\n', "contact[0].tangent"),
     "same-surface": (GOOD + '\n[[contact]]\nslave = "cube.zmax"\nmaster = "cube.zmax"\npenalty = 1.0\n',
                      "contact[0].master: slave and master are the same surface 'cube.zmax': a surface in contact "
-                     "with itself needs self-contact"),
+                     "with itself is self-contact: write self = \"cube.zmax\""),
     "area-weighting-on-nodes": (GOOD.replace("[steps]", '[bodies.sets]\ntop = { box = [[-1.0, -1.0, 0.9], [2.0, 2.0, '
                                                        '1.1]] }\n\n[steps]') + '\n[[rigid]]\nname = "floor"\n'
                                 'shape = "plane"\npoint = [0.0, 0.0, 2.0]\nnormal = [0.0, 0.0, -1.0]\n\n[[contact]]\n'

@@ -95,6 +95,18 @@ def two_blocks(tmp: Path) -> Path:
     return path
 
 
+def sts_friction(tmp: Path) -> Path:
+    """Two deformable blocks, segment-to-surface with Coulomb friction: pressed, then dragged across in 12 steps;
+    the friction history lives at the slave facets' Gauss points."""
+    text = (EXAMPLES / "contact" / "two_blocks.toml").read_text()
+    text = text.replace('weighting = "area"\n', 'type = "sts"\nfriction = 0.2\n', 1)
+    text = text.replace("components = \"xyz\"\nvalue = [0.0, 0.0, -0.02]", "components = \"xyz\"\nvalue = [0.06, 0.0, -0.02]")
+    text = text.replace("[steps]\ncount = 2", _steps(12))
+    path = tmp / "sts_friction.toml"
+    path.write_text(text)
+    return path
+
+
 def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
@@ -138,9 +150,10 @@ def _has_gamg() -> bool:
     return _has_solver("petsc-gamg")
 
 
-@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks],
+@pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks,
+                                  sts_friction],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "petsc-mumps", "two-blocks"])
+                              "petsc-mumps", "two-blocks", "sts-friction"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")
