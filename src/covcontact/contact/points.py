@@ -12,6 +12,7 @@ part exact, since x_g is linear in the nodes.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit, prange
 
 from ..fem.quadrature import gauss_quad
 from ..fem.shapes import shape_functions
@@ -99,18 +100,51 @@ class VirtualPoints:
         return conn, R, K
 
     def _expand_column(self, conn, R, K, j):
-        m, n = conn.shape
         g = conn[:, j] - self.offset
         nen = int(self.nen[g[0]])
-        Nv = self.N[g, :nen]
+        Nv = np.ascontiguousarray(self.N[g, :nen])
         new_conn = np.hstack([conn[:, :j], self.conn[g, :nen], conn[:, j + 1:]])
-        Rr = R.reshape(m, n, 3)
-        Rn = np.concatenate([Rr[:, :j], Nv[:, :, None] * Rr[:, j][:, None], Rr[:, j + 1:]], axis=1)
-        if K is None:
-            return new_conn, Rn.reshape(m, -1), None
-        Kr = K.reshape(m, n, 3, n, 3)
-        Kr = np.concatenate([Kr[:, :j], Nv[:, :, None, None, None] * Kr[:, j][:, None], Kr[:, j + 1:]], axis=1)
-        Kr = np.concatenate([Kr[:, :, :, :j], Nv[:, None, None, :, None] * Kr[:, :, :, j][:, :, :, None],
-                             Kr[:, :, :, j + 1:]], axis=3)
-        n2 = n - 1 + nen
-        return new_conn, Rn.reshape(m, -1), np.ascontiguousarray(Kr.reshape(m, 3 * n2, 3 * n2))
+        Rn = _expand_rows(np.ascontiguousarray(R), j, Nv)
+        Kn = None if K is None else _expand_matrices(np.ascontiguousarray(K), j, Nv)
+        return new_conn, Rn, Kn
+
+
+@njit(cache=True, inline="always")
+def _source(q, j, nen, Nv, e):
+    """Node q of the expanded element: (its node in the point's element, its weight)."""
+    if q < j:
+        return q, 1.0
+    if q < j + nen:
+        return j, Nv[e, q - j]
+    return q - nen + 1, 1.0
+
+
+@njit(cache=True)
+def _expand_rows(R, j, Nv):
+    m, nen = Nv.shape
+    n2 = R.shape[1] // 3 - 1 + nen
+    out = np.empty((m, 3 * n2))
+    for e in range(m):
+        for q in range(n2):
+            o, w = _source(q, j, nen, Nv, e)
+            for i in range(3):
+                out[e, 3 * q + i] = w * R[e, 3 * o + i]
+    return out
+
+
+@njit(cache=True, parallel=True)
+def _expand_matrices(K, j, Nv):
+    """K_ab = N_a N_b K_gg and the mixed blocks, for every element of a block (point column j)."""
+    m, nen = Nv.shape
+    n2 = K.shape[1] // 3 - 1 + nen
+    out = np.empty((m, 3 * n2, 3 * n2))
+    for e in prange(m):
+        for q in range(n2):
+            oq, wq = _source(q, j, nen, Nv, e)
+            for r in range(n2):
+                orr, wr = _source(r, j, nen, Nv, e)
+                w = wq * wr
+                for i in range(3):
+                    for k in range(3):
+                        out[e, 3 * q + i, 3 * r + k] = w * K[e, 3 * oq + i, 3 * orr + k]
+    return out
