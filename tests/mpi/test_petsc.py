@@ -102,8 +102,19 @@ def test_serial_petsc_matches_default(tmp_path):
     (TWO_BLOCKS, "petsc", 1e-9),        # deformable master, MUMPS Cholesky (LDL^T)
     (SLIDING, "petsc", 1e-7),           # Coulomb friction: non-symmetric, MUMPS LU, path-dependent
     (TWO_BLOCKS, "petsc-gamg", 1e-8),   # CG + GAMG with rigid-body modes
-], ids=["deformable-pair", "friction", "gamg"])
+    ("sts", "petsc", 1e-7),             # segment-to-surface with friction: points split by their facet's owner
+    ("self", "petsc", 1e-7),            # self-contact of both blocks' faces merged, with friction
+], ids=["deformable-pair", "friction", "gamg", "sts-friction", "self-contact"])
 def test_two_ranks_match_serial(tmp_path, path, solver, tol):
+    if path in ("sts", "self"):
+        text = TWO_BLOCKS.read_text()
+        pair = 'slave = "punch.zmin"\nmaster = "base.zmax"\n'
+        assert pair in text
+        new = 'type = "sts"\n' + pair if path == "sts" else 'self = ["punch.zmin", "base.zmax"]\n'
+        text = text.replace(pair, new + "friction = 0.2\n").replace("value = [0.0, 0.0, -0.02]",
+                                                                      "value = [0.02, 0.0, -0.02]")
+        path = tmp_path / f"{path}.toml"
+        path.write_text(text)
     if path == SLIDING:  # half the load steps: a shorter test, still sticking and then sliding
         text = path.read_text().replace("count = 10", "count = 5")
         path = tmp_path / path.name
