@@ -79,8 +79,8 @@ def whole_run(path: Path, out: Path) -> float:
 def race(folder: Path, repeats: int) -> dict:
     paths = {typ: variant(folder, typ) for typ in ("nts", "sts")}
     times: dict[str, list[float]] = {"nts": [], "sts": []}
-    for typ in paths:  # warm the compiled kernels' cache
-        whole_run(paths[typ], folder / f"warm_{typ}")
+    for typ, path in paths.items():  # warm the compiled kernels' cache
+        whole_run(path, folder / f"warm_{typ}")
     for k in range(repeats):
         for typ in (("nts", "sts") if k % 2 == 0 else ("sts", "nts")):
             times[typ].append(whole_run(paths[typ], folder / f"race_{typ}"))
@@ -89,7 +89,7 @@ def race(folder: Path, repeats: int) -> dict:
 
 
 def self_search(n_facets: int, repeats: int) -> dict:
-    m = int(round(np.sqrt(n_facets / 2)))
+    m = round(float(np.sqrt(n_facets / 2)))
     lower, faces = wavy_surface(m, quad9=False)
     upper = lower + [0.0, 0.0, 0.02]
     pts = np.vstack([lower, upper])
@@ -138,10 +138,10 @@ def main(argv=None) -> None:
         "| problem | type | slaves | active | evaluation s | per slave us |", "|---|---|---|---|---|---|",
         *[f"| {r['problem']} | {r['type']} | {r['slaves']} | {r['active']} | {r['evaluation_s']:.4f} | {r['per_slave_us']:.2f} |"
           for r in pp],
-        "", f"whole run, median of {args.repeats}: nts {rc['median_s']['nts']:.2f} s, sts {rc['median_s']['sts']:.2f} s,"
-            f" ratio {rc['ratio_sts_nts']:.2f}",
-        f"self-contact search: {ss['facets']} facets, {ss['slaves']} slaves, {ss['iteration_s']:.3f} s per iteration "
-        f"(set-up {ss['setup_s']:.3f} s), contacts found {ss['contacts_found']}"])
+        "", (f"whole run, median of {args.repeats}: nts {rc['median_s']['nts']:.2f} s, sts {rc['median_s']['sts']:.2f} s,"
+             f" ratio {rc['ratio_sts_nts']:.2f}"),
+        (f"self-contact search: {ss['facets']} facets, {ss['slaves']} slaves, {ss['iteration_s']:.3f} s per iteration "
+         f"(set-up {ss['setup_s']:.3f} s), contacts found {ss['contacts_found']}")])
     emit(result, args.out, table)
 
 

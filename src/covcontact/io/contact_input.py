@@ -8,7 +8,6 @@ from .conditions_input import SetRefs
 from .fields import split_ref
 from .validate import Section
 
-
 #: the largest number of Gauss points per direction of a segment-to-surface slave facet
 MAX_ORDER = 8
 
@@ -95,7 +94,7 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         if law == "tied":
             for key in ("friction", "method", "smoothing", "two_pass"):
                 if c.has(key):
-                    c.fail(f"not used by law = \"tied\" (the surfaces are bonded: no opening, no sliding)", key)
+                    c.fail("not used by law = \"tied\" (the surfaces are bonded: no opening, no sliding)", key)
             if surfaces is not None:
                 c.fail("a surface cannot be tied to itself", "law")
             if master[1] == "":
@@ -106,8 +105,8 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         if law == "exponential":
             for key in ("penalty", "smoothing", "method"):
                 if c.has(key):
-                    c.fail(f"not used by law = \"exponential\" (its pressure-overclosure curve is given by "
-                           f"clearance and pressure)", key)
+                    c.fail("not used by law = \"exponential\" (its pressure-overclosure curve is given by "
+                           "clearance and pressure)", key)
             clearance = c.get("clearance", "float", positive=True)
             pressure = c.get("pressure", "float", positive=True)
             penalty = pressure
