@@ -107,6 +107,15 @@ def sts_friction(tmp: Path) -> Path:
     return path
 
 
+def self_friction(tmp: Path) -> Path:
+    """The same drag with the two blocks' faces merged into one self-contact surface (both sides slaves)."""
+    text = sts_friction(tmp).read_text().replace('slave = "punch.zmin"\nmaster = "base.zmax"\n',
+                                                 'self = ["punch.zmin", "base.zmax"]\n')
+    path = tmp / "self_friction.toml"
+    path.write_text(text)
+    return path
+
+
 def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
@@ -151,9 +160,9 @@ def _has_gamg() -> bool:
 
 
 @pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks,
-                                  sts_friction],
+                                  sts_friction, self_friction],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "petsc-mumps", "two-blocks", "sts-friction"])
+                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")

@@ -1,7 +1,7 @@
 """Self-contact: one surface is slave and master of itself (docs/theory.md, section 13).
 
 Every slave (a node of the surface, or a Gauss point of one of its facets) searches the whole surface except
-its own facets: those around the slave node, or those sharing a node with the slave point's facet. The rest is
+its own facets: those around the slave node, or the slave point's facet. The rest is
 told apart geometrically, since a surface meets itself face to face: a candidate facet counts only if its normal
 opposes the slave's own outward normal (n_s . n_f < 0, at the facet's centre), and an edge or vertex point only
 if the slave lies in front of it (the unit vector from the point to the slave within 60 degrees of -n_s); a
@@ -47,12 +47,15 @@ HOLD_COS = 0.5
 def excluded_facets(faces: np.ndarray, n_nodes: int, slave_nodes: np.ndarray | None = None,
                     slave_facets: np.ndarray | None = None) -> np.ndarray:
     """(ns, width) facets each slave never contacts, -1 padded: for slave nodes the facets around the node, for
-    slave points (given by their facet) the facets sharing a node with the point's facet."""
+    slave points (given by their facet) the point's facet. Their neighbours face the same way and are dropped by
+    the facing test (a wider exclusion hid real contacts at a tight fold: points next to a flattened tube's lobe
+    lost their partners across it)."""
     A = _incidence(faces, n_nodes)
     if slave_nodes is not None:
         ring = A.T.tocsr()[slave_nodes]
     else:
-        ring = (A[slave_facets] @ A.T).astype(bool)
+        ring = sp.csr_matrix((np.ones(len(slave_facets)), (np.arange(len(slave_facets)), slave_facets)),
+                             shape=(len(slave_facets), len(faces)))
     return _padded(ring)
 
 
