@@ -14,8 +14,11 @@ import numpy as np
 from numba import get_num_threads, njit, set_parallel_chunksize
 
 from ..assembly.pattern import Pattern, scatter_matrices, scatter_vectors
-from ..fem.shapes import NNODES
+from ..fem.cells import NNODES as _OTHER_NNODES
+from ..fem.shapes import NNODES as _TENSOR_NNODES
 from ..materials.hyperelastic import VOIGT, VOIGT_PAIRS, Material
+
+NNODES = {**_TENSOR_NNODES, **_OTHER_NNODES}
 
 #: parallel blocks per thread and chunk (handed out dynamically, for load balance on shared cores)
 BLOCKS_PER_THREAD = 8

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import get_num_threads, njit, prange
 
+from ..fem import cells as other_cells
 from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
 from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
@@ -23,7 +24,7 @@ from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, b
 
 __all__ = ["BLOCKS_PER_THREAD", "SOLID_CELLS", "SolidBody", "SolidStress", "solid_chunk", "solid_gauss_fields"]
 
-SOLID_CELLS = ("hex8", "hex18", "hex27")
+SOLID_CELLS = ("hex8", "hex18", "hex27", *other_cells.CELLS)
 
 
 @njit(cache=True, inline="always")
@@ -257,6 +258,8 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, 
 
 
 def _rule(cell_type: str, rule) -> tuple[np.ndarray, np.ndarray]:
+    if cell_type in other_cells.CELLS and (rule is None or isinstance(rule, (int, np.integer))):
+        return other_cells.rule(cell_type, rule)
     if rule is None:
         return gauss_tensor(DEFAULT_RULE[cell_type])
     if len(rule) == 3 and all(isinstance(r, (int, np.integer)) for r in rule):
@@ -283,7 +286,9 @@ class SolidBody(ElementBody):
             raise ValueError(f"unknown solid cell type {cell_type!r}; known: {', '.join(SOLID_CELLS)}")
         super().__init__(cell_type, X, cells, material, chunk_bytes)
         self.points, self.weights = _rule(cell_type, rule)
-        self.dNdxi = np.ascontiguousarray(shape_functions(cell_type, self.points)[1])
+        dN = other_cells.shapes(cell_type, self.points)[1] if cell_type in other_cells.CELLS else \
+            shape_functions(cell_type, self.points)[1]
+        self.dNdxi = np.ascontiguousarray(dN)
 
     def new_state(self) -> dict[str, np.ndarray]:
         """Material history per Gauss point, ``hist`` (nelem, ngp, n_hist); n_hist = 0 for hyperelastic

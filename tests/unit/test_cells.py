@@ -1,0 +1,146 @@
+"""The tetrahedra, wedge and 20-node brick (tet4, tet10, wedge6, hex20): shape functions, rules, element tangents
+against finite differences (SVK, Neo-Hooke, J2 in elastic, plastic and unloading states) and the patch test
+(a homogeneous deformation leaves no force on interior nodes of a distorted mesh)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from covcontact.assembly import Pattern
+from covcontact.elements import SolidBody
+from covcontact.fem.cells import CELLS, NODES, rule, shapes
+from covcontact.materials import J2Plasticity, NeoHooke, SaintVenantKirchhoff
+from covcontact.mesh.generators import block
+
+MATERIALS = {"svk": SaintVenantKirchhoff(E=200.0, nu=0.3), "neo-hooke": NeoHooke(E=200.0, nu=0.3)}
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_shapes_interpolate_and_rules_integrate(cell):
+    """N_a(x_b) = delta_ab, sum N = 1, sum dN = 0, dN against differences, the rule's weights sum to the volume
+    and integrate the element's polynomials exactly (the volume of a distorted straight-edged cell)."""
+    N, _ = shapes(cell, NODES[cell])
+    np.testing.assert_allclose(N, np.eye(len(N)), atol=1e-14)
+    p, w = rule(cell)
+    N, dN = shapes(cell, p)
+    np.testing.assert_allclose(N.sum(axis=1), 1.0, atol=1e-14)
+    np.testing.assert_allclose(dN.sum(axis=1), 0.0, atol=1e-13)
+    x = p[0] + 0.013
+    h = 1e-6
+    fd = np.stack([(shapes(cell, x + h * e)[0] - shapes(cell, x - h * e)[0])[0] / (2 * h) for e in np.eye(3)], axis=1)
+    np.testing.assert_allclose(fd, shapes(cell, x)[1][0], atol=1e-9)
+    assert w.sum() == pytest.approx({"tet4": 1 / 6, "tet10": 1 / 6, "wedge6": 1.0, "hex20": 8.0}[cell])
+
+
+def one_element(cell: str, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    X = NODES[cell] * [1.0, 0.8, 1.3] + 0.06 * rng.uniform(-1.0, 1.0, NODES[cell].shape)
+    return np.ascontiguousarray(X), np.arange(len(X))[None]
+
+
+def residual(body, u, state=None) -> np.ndarray:
+    r = np.zeros(3 * body.n_nodes)
+    assert body.assemble(u, np.zeros(0), r, None, want_K=False, state=state) == -1
+    return r
+
+
+def tangent(body, u, state=None):
+    P = Pattern(body.n_nodes, [body.cells])
+    data = P.zeros()
+    r = np.zeros(3 * body.n_nodes)
+    assert body.assemble(u, data, r, P, state=state) == -1
+    return P.csr(data).toarray(), r
+
+
+def _fd(body, u, state=None):
+    h = 1e-6
+    K = np.empty((u.size, u.size))
+    for j in range(u.size):
+        up, um = u.ravel().copy(), u.ravel().copy()
+        up[j] += h
+        um[j] -= h
+        K[:, j] = (residual(body, up, state) - residual(body, um, state)) / (2 * h)
+    return K
+
+
+@pytest.mark.parametrize("mat", list(MATERIALS))
+@pytest.mark.parametrize("cell", CELLS)
+def test_tangent_matches_differences(cell, mat):
+    X, cells = one_element(cell, 1)
+    body = SolidBody(cell, X, cells, MATERIALS[mat])
+    assert body.check_reference() == []
+    u = 0.1 * np.random.default_rng(2).uniform(-1.0, 1.0, X.shape)
+    K, r = tangent(body, u)
+    np.testing.assert_allclose(r, residual(body, u), atol=1e-13 * np.abs(r).max())
+    Kfd = _fd(body, u)
+    assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_plastic_tangent_matches_differences(cell):
+    """J2 with linear hardening: the consistent tangent against differences of the residual with the history of
+    the last commit fixed, in a plastic state and in an unloading (elastic from a plastic) state."""
+    mat = J2Plasticity(E=200.0, nu=0.3, yield_stress=0.5, hardening={"law": "linear", "modulus": 20.0})
+    X, cells = one_element(cell, 3)
+    body = SolidBody(cell, X, cells, mat)
+    rng = np.random.default_rng(4)
+    direction = rng.uniform(-1.0, 1.0, X.shape)
+    state = body.new_state()
+    checked = 0
+    for scale in (0.05, 0.1, 0.08):  # load, load further (plastic), unload
+        u = scale * direction
+        trial = {"hist": state["hist"].copy(), "hist_n": state["hist"].copy()}
+        K, _ = tangent(body, u, trial)
+        Kfd = _fd(body, u, {"hist": state["hist"].copy(), "hist_n": state["hist"].copy()})
+        assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max(), scale
+        state = {"hist": trial["hist"]}
+        checked += 1
+    assert checked == 3 and np.abs(state["hist"]).max() > 0  # it yielded
+
+
+def _split(cell: str, seed: int = 0):
+    """A distorted mesh of ``cell`` on [0, 2]^3 (2 x 2 x 2 bricks split or trimmed) and its interior nodes."""
+    if cell == "hex20":
+        m = block(lx=2.0, ly=2.0, lz=2.0, nx=2, ny=2, nz=2, cell="hex27")
+        cells = m.cells[:, :20]
+        used = np.unique(cells)
+        new = np.full(len(m.points), -1)
+        new[used] = np.arange(len(used))
+        X, cells = m.points[used], new[cells]
+    else:
+        m = block(lx=2.0, ly=2.0, lz=2.0, nx=2, ny=2, nz=2, cell="hex8")
+        X, h = m.points, m.cells
+        if cell == "wedge6":
+            cells = np.vstack([h[:, [0, 1, 3, 4, 5, 7]], h[:, [1, 2, 3, 5, 6, 7]]])
+        else:  # six tetrahedra per brick around the diagonal 0-6
+            t = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
+            cells = np.vstack([h[:, c] for c in t])
+    rng = np.random.default_rng(seed)
+    interior = np.flatnonzero(np.all((X > 1e-9) & (X < 2 - 1e-9), axis=1))
+    X = X.copy()
+    X[interior] += 0.15 * rng.uniform(-1.0, 1.0, (len(interior), 3))
+    if cell == "tet10":  # straight edges: the mid-nodes at the midpoints of the distorted corners
+        edges = cells[:, [[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]]
+        key = np.sort(edges.reshape(-1, 2), axis=1)
+        uniq, inv = np.unique(key, axis=0, return_inverse=True)
+        mid = 0.5 * (X[uniq[:, 0]] + X[uniq[:, 1]])
+        cells = np.hstack([cells, len(X) + inv.reshape(-1, 6)])
+        X = np.vstack([X, mid])
+        interior = np.flatnonzero(np.all((X > 1e-9) & (X < 2 - 1e-9), axis=1))
+    return np.ascontiguousarray(X), np.ascontiguousarray(cells, dtype=np.int64), interior
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_patch_test(cell):
+    """A homogeneous finite deformation x = F X on a distorted mesh: no force on the interior nodes (the stress is
+    uniform and the rule integrates the gradients exactly), and the element stresses are the homogeneous one."""
+    X, cells, interior = _split(cell)
+    body = SolidBody(cell, X, cells, NeoHooke(E=200.0, nu=0.3))
+    assert body.check_reference() == []
+    F = np.array([[1.1, 0.05, 0.0], [0.02, 0.95, 0.03], [0.0, -0.04, 1.05]])
+    u = X @ F.T - X
+    r = residual(body, u).reshape(-1, 3)
+    assert np.abs(r[interior]).max() <= 1e-10 * np.abs(r).max()
+    cauchy = body.stress(u).cauchy
+    np.testing.assert_allclose(cauchy, cauchy[0][None, :].repeat(len(cauchy), 0), atol=1e-9 * np.abs(cauchy).max())
