@@ -144,3 +144,87 @@ def test_patch_test(cell):
     assert np.abs(r[interior]).max() <= 1e-10 * np.abs(r).max()
     cauchy = body.stress(u).cauchy
     np.testing.assert_allclose(cauchy, cauchy[0][None, :].repeat(len(cauchy), 0), atol=1e-9 * np.abs(cauchy).max())
+
+
+TENSION = """
+[problem]
+name = "bar"
+[[bodies]]
+name = "bar"
+element = "CELL"
+material = { model = "svk", E = 200.0, nu = 0.3 }
+mesh = MESH
+[bodies.sets]
+x0 = { box = [[-1e-9, -1.0, -1.0], [1e-9, 3.0, 3.0]] }
+x1 = { box = [[1.999999999, -1.0, -1.0], [2.1, 3.0, 3.0]] }
+y0 = { box = [[-1.0, -1e-9, -1.0], [3.0, 1e-9, 3.0]] }
+z0 = { box = [[-1.0, -1.0, -1e-9], [3.0, 3.0, 1e-9]] }
+[[dirichlet]]
+set = "bar.x0"
+components = "x"
+[[dirichlet]]
+set = "bar.y0"
+components = "y"
+[[dirichlet]]
+set = "bar.z0"
+components = "z"
+[[dirichlet]]
+name = "pull"
+set = "bar.x1"
+components = "x"
+value = 0.1
+[steps]
+count = 2
+"""
+
+
+@pytest.mark.parametrize("cell", CELLS)
+def test_mesh_file_run_and_vtu(tmp_path, cell):
+    """A body of ``cell`` read from a mesh file (VTU written by meshio, the distorted mesh of the patch test)
+    stretched by 5 % in uniaxial stress: the reaction equals the closed form of St. Venant-Kirchhoff and the hex8
+    generator's to 1e-8 (the deformation is homogeneous, which every element reproduces), and the result files
+    hold the cells with their own VTK type."""
+    import meshio
+
+    from covcontact.io.loader import load_problem
+
+    X, cells, _ = _split(cell)
+    vtk = {"tet4": "tetra", "tet10": "tetra10", "wedge6": "wedge", "hex20": "hexahedron20"}[cell]
+    meshio.write(tmp_path / "bar.vtu", meshio.Mesh(X, [(vtk, cells)]))
+    reactions = {}
+    for name, element, mesh in ((cell, cell, '{ file = "bar.vtu" }'), ("hex8", "hex8", '{ generator = "block", '
+                                'lx = 2.0, ly = 2.0, lz = 2.0, nx = 2, ny = 2, nz = 2 }')):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(TENSION.replace("CELL", element).replace("MESH", mesh))
+        res = load_problem(path).run(out=tmp_path / name)
+        assert res.exit_code == 0
+        reactions[name] = res.summary["steps"][-1]["reactions"]["bar.x1"][0]
+    # uniaxial stress, SVK: S = E E_xx with E_xx = (1.05^2 - 1) / 2, first Piola P = F S, on the area 4
+    lam = 1.05
+    assert reactions["hex8"] == pytest.approx(4.0 * lam * 200.0 * (lam ** 2 - 1) / 2, rel=1e-8)
+    assert reactions[cell] == pytest.approx(reactions["hex8"], rel=1e-8)
+    out = meshio.read(tmp_path / cell / "step_0002.vtu")
+    assert [b.type for b in out.cells] == [vtk]
+    assert out.point_data["displacement"][:, 0].max() == pytest.approx(0.1)
+
+
+def test_tetrahedra_have_no_faces_yet(tmp_path):
+    """Contact or pressure on a tetrahedral body: one line saying faces need hexahedra for now."""
+    import meshio
+
+    from covcontact.io.loader import load_problem
+    from covcontact.io.validate import InputError
+
+    X, cells, _ = _split("tet4")
+    meshio.write(tmp_path / "bar.vtu", meshio.Mesh(X, [("tetra", cells)]))
+    path = tmp_path / "p.toml"
+    path.write_text(TENSION.replace("CELL", "tet4").replace("MESH", '{ file = "bar.vtu" }') +
+                    '\n[[pressure]]\nset = "bar.x1"\nvalue = 1.0\n')
+    with pytest.raises((InputError, ValueError)) as err:
+        load_problem(path)
+    assert "\n" not in str(err.value)
+    path.write_text(TENSION.replace("CELL", "tet4").replace("MESH", '{ generator = "block", lx = 1.0, ly = 1.0, '
+                                                                   'lz = 1.0, nx = 1, ny = 1, nz = 1 }'))
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert "come from a mesh file" in str(err.value)

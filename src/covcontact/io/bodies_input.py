@@ -13,7 +13,9 @@ import numpy as np
 from ..description import Body
 from .validate import _REQUIRED, InputError, Section, suggest
 
-CELLS = ("hex8", "hex18", "hex27")
+CELLS = ("hex8", "hex18", "hex27", "tet4", "tet10", "wedge6", "hex20")
+#: cells the mesh generators make
+GENERATED = ("hex8", "hex18", "hex27")
 
 
 def mesh_generators() -> dict:
@@ -89,6 +91,9 @@ def build_mesh(sec: Section, base: Path, element: str | None):
                and k != "cell"]
     if missing:
         sec.fail(f"generator {name!r} needs {', '.join(missing)}")
+    if element is not None and element not in GENERATED:
+        sec.fail(f"the generators make {', '.join(GENERATED)} meshes; {element} elements come from a mesh file "
+                 f"(mesh = {{ file = ... }}, e.g. from Gmsh)", "generator")
     try:
         return fn(cell=element or "hex8", **kwargs)
     except (ValueError, TypeError) as exc:

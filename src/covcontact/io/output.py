@@ -16,7 +16,8 @@ _HEX18_SPLIT = np.array([
     [8, 5, 2, 6, 17, 14, 11, 15],
     [7, 8, 6, 3, 16, 17, 15, 12],
 ])
-_VTK_NAME = {"hex8": "hexahedron", "hex27": "hexahedron27", "quad4": "quad", "quad9": "quad9"}
+_VTK_NAME = {"hex8": "hexahedron", "hex27": "hexahedron27", "quad4": "quad", "quad9": "quad9", "tet4": "tetra",
+             "tet10": "tetra10", "wedge6": "wedge", "hex20": "hexahedron20"}
 
 
 def atomic_write_text(path: Path, text: str) -> None:

@@ -35,8 +35,11 @@ from .mesh import Mesh
 if TYPE_CHECKING:
     import meshio
 
-_VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27"}
-_TO_MESHIO = {"hex8": "hexahedron", "hex27": "hexahedron27"}
+_VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27", "tetra": "tet4", "tetra10": "tet10", "wedge": "wedge6",
+           "hexahedron20": "hex20"}
+_TO_MESHIO = {v: k for k, v in _VOLUME.items()}
+#: cells with quadrilateral faces, whose face groups become face sets (contact and pressure surfaces)
+_QUAD_FACED = ("hex8", "hex27")
 _FACE_CELLS = ("quad", "quad8", "quad9")
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
@@ -168,10 +171,10 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         raise _fail(p, f"cannot read mesh ({why})") from exc
     found = sorted({_VOLUME[b.type] for b in m.cells if b.type in _VOLUME})
     if cell_type is not None and cell_type not in _TO_MESHIO:
-        raise _fail(p, f"cell_type must be 'hex8' or 'hex27', got {cell_type!r}")
+        raise _fail(p, f"cell_type must be one of {', '.join(_TO_MESHIO)}, got {cell_type!r}")
     if not found:
         kinds = ", ".join(sorted({b.type for b in m.cells})) or "none"
-        raise _fail(p, f"no supported volume cells (hexahedron, hexahedron27); found: {kinds}")
+        raise _fail(p, f"no supported volume cells ({', '.join(_VOLUME)}); found: {kinds}")
     if cell_type is None:
         if len(found) > 1:
             raise _fail(p, f"holds {' and '.join(found)} cells; choose one with cell_type")
@@ -201,7 +204,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
             nodes.append(data.ravel())
             if b in vol:
                 elems.append(first[vol.index(b)] + ids)
-            elif m.cells[b].type in _FACE_CELLS and len(data):
+            elif m.cells[b].type in _FACE_CELLS and len(data) and cell_type in _QUAD_FACED:
                 faces.append(new[data[:, :4]])
         if elems:
             mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)
@@ -214,7 +217,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         kept = keep(np.concatenate(nodes))
         if name not in mesh.node_sets and kept.size:
             mesh.add_node_set(name, kept)
-    if p.suffix.lower() == ".inp":
+    if p.suffix.lower() == ".inp" and cell_type in _QUAD_FACED:
         _abaqus_surfaces(p, m, mesh, vol, first, keep)
     return mesh
 

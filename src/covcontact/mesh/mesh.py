@@ -48,6 +48,9 @@ class Mesh:
 
     @property
     def face_type(self) -> str:
+        if self.cell_type not in FACE_TYPE:
+            raise ValueError(f"{self.cell_type} meshes have no contact or pressure faces yet (quadrilateral faces "
+                             f"only: hex8, hex27); use node sets on them")
         return FACE_TYPE[self.cell_type]
 
     def node_set(self, name: str) -> np.ndarray:
