@@ -183,7 +183,7 @@ def test_mesh_file_run_and_vtu(tmp_path, cell):
     """A body of ``cell`` read from a mesh file (VTU written by meshio, the distorted mesh of the patch test)
     stretched by 5 % in uniaxial stress: the reaction equals the closed form of St. Venant-Kirchhoff and the hex8
     generator's to 1e-8 (the deformation is homogeneous, which every element reproduces), and the result files
-    hold the cells with their own VTK type."""
+    hold the cells with their own VTK type, whose boundary the pictures draw."""
     import meshio
 
     from covcontact.io.loader import load_problem
@@ -206,6 +206,12 @@ def test_mesh_file_run_and_vtu(tmp_path, cell):
     out = meshio.read(tmp_path / cell / "step_0002.vtu")
     assert [b.type for b in out.cells] == [vtk]
     assert out.point_data["displacement"][:, 0].max() == pytest.approx(0.1)
+    # the pictures draw the boundary: 6 sides of 2 x 2 squares, as triangles where the cells are tetrahedra (and
+    # on the two sides the wedges' diagonal cuts)
+    from covcontact.io.pictures import surface_quads
+
+    quads, _ = surface_quads(out)
+    assert len(quads) == {"tet4": 48, "tet10": 48, "wedge6": 32, "hex20": 24}[cell]
 
 
 def test_tetrahedra_have_no_faces_yet(tmp_path):

@@ -63,15 +63,24 @@ def _contact_facets(mesh, block: int) -> bool:
     return arr is not None and not np.all(np.isnan(np.asarray(arr[block], dtype=float)))
 
 
-def _boundary_quads(hexes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Faces of linear hexahedra that belong to one cell only, and the index of that cell."""
+#: the faces of a tetrahedron and of a wedge by their corners, triangles as quadrilaterals with a repeated corner
+_TET_FACES = np.array([[0, 2, 1, 1], [0, 1, 3, 3], [1, 2, 3, 3], [0, 3, 2, 2]])
+_WEDGE_FACES = np.array([[0, 2, 1, 1], [3, 4, 5, 5], [0, 1, 4, 3], [1, 2, 5, 4], [0, 3, 5, 2]])
+
+
+def _boundary_quads(hexes: np.ndarray, faces_of=None) -> tuple[np.ndarray, np.ndarray]:
+    """Faces of linear hexahedra (or of the cells whose faces ``faces_of`` lists) that belong to one cell only,
+    and the index of that cell."""
+    table = _HEX_FACES if faces_of is None else faces_of
     if len(hexes) == 0:
         return np.zeros((0, 4), dtype=np.int64), np.zeros(0, dtype=np.int64)
-    faces = hexes[:, _HEX_FACES].reshape(-1, 4)
+    faces = hexes[:, table].reshape(-1, 4)
     key = np.sort(faces, axis=1)
+    key[:, 1:][key[:, 1:] == key[:, :-1]] = -1  # a triangle's repeated corner, wherever it was
+    key = np.sort(key, axis=1)
     _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
     outer = count[inv.ravel()] == 1
-    return faces[outer], np.flatnonzero(outer) // len(_HEX_FACES)
+    return faces[outer], np.flatnonzero(outer) // len(table)
 
 
 def surface_quads(mesh, field: str | None = None):
@@ -83,10 +92,12 @@ def surface_quads(mesh, field: str | None = None):
         mask = _rigid_mask(mesh, b, len(conn))
         data = (np.asarray(mesh.cell_data[field][b], dtype=float).reshape(len(conn), -1)[:, 0]
                 if field is not None and field in mesh.cell_data else np.full(len(conn), np.nan))
-        if block.type.startswith("hexahedron"):
+        solid = {"tetra": (_TET_FACES, 4), "wedge": (_WEDGE_FACES, 6)}.get(block.type.rstrip("0123456789"))
+        if block.type.startswith("hexahedron") or solid is not None:
+            table, corners = solid if solid is not None else (None, 8)
             for flag in (False, True):
                 cells = np.flatnonzero(mask == flag)
-                q, owner = _boundary_quads(conn[cells, :8])
+                q, owner = _boundary_quads(conn[cells, :corners], table)
                 quads.append(q)
                 rigid.append(np.full(len(q), flag))
                 values.append(data[cells[owner]])
