@@ -11,6 +11,7 @@ from covcontact.assembly import Pattern
 from covcontact.elements import SolidBody
 from covcontact.fem.cells import CELLS, NODES, rule, shapes
 from covcontact.materials import J2Plasticity, NeoHooke, SaintVenantKirchhoff
+from covcontact.mesh.convert import SOURCE, convert
 from covcontact.mesh.generators import block
 
 MATERIALS = {"svk": SaintVenantKirchhoff(E=200.0, nu=0.3), "neo-hooke": NeoHooke(E=200.0, nu=0.3)}
@@ -101,33 +102,17 @@ def test_plastic_tangent_matches_differences(cell):
 
 def _split(cell: str, seed: int = 0):
     """A distorted mesh of ``cell`` on [0, 2]^3 (2 x 2 x 2 bricks split or trimmed) and its interior nodes."""
-    if cell == "hex20":
-        m = block(lx=2.0, ly=2.0, lz=2.0, nx=2, ny=2, nz=2, cell="hex27")
-        cells = m.cells[:, :20]
-        used = np.unique(cells)
-        new = np.full(len(m.points), -1)
-        new[used] = np.arange(len(used))
-        X, cells = m.points[used], new[cells]
-    else:
-        m = block(lx=2.0, ly=2.0, lz=2.0, nx=2, ny=2, nz=2, cell="hex8")
-        X, h = m.points, m.cells
-        if cell == "wedge6":
-            cells = np.vstack([h[:, [0, 1, 3, 4, 5, 7]], h[:, [1, 2, 3, 5, 6, 7]]])
-        else:  # six tetrahedra per brick around the diagonal 0-6
-            t = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
-            cells = np.vstack([h[:, c] for c in t])
+    m = convert(block(lx=2.0, ly=2.0, lz=2.0, nx=2, ny=2, nz=2, cell=SOURCE[cell]), cell)
+    X, cells = m.points.copy(), m.cells
     rng = np.random.default_rng(seed)
-    interior = np.flatnonzero(np.all((X > 1e-9) & (X < 2 - 1e-9), axis=1))
-    X = X.copy()
+    corners = np.unique(cells[:, :4]) if cell == "tet10" else np.arange(len(X))
+    interior = corners[np.all((X[corners] > 1e-9) & (X[corners] < 2 - 1e-9), axis=1)]
     X[interior] += 0.15 * rng.uniform(-1.0, 1.0, (len(interior), 3))
     if cell == "tet10":  # straight edges: the mid-nodes at the midpoints of the distorted corners
-        edges = cells[:, [[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]]
-        key = np.sort(edges.reshape(-1, 2), axis=1)
-        uniq, inv = np.unique(key, axis=0, return_inverse=True)
-        mid = 0.5 * (X[uniq[:, 0]] + X[uniq[:, 1]])
-        cells = np.hstack([cells, len(X) + inv.reshape(-1, 6)])
-        X = np.vstack([X, mid])
-        interior = np.flatnonzero(np.all((X > 1e-9) & (X < 2 - 1e-9), axis=1))
+        e = cells[:, 4:].ravel()
+        ends = cells[:, [[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]].reshape(-1, 2)
+        X[e] = 0.5 * (X[ends[:, 0]] + X[ends[:, 1]])
+    interior = np.flatnonzero(np.all((X > 1e-9) & (X < 2 - 1e-9), axis=1))
     return np.ascontiguousarray(X), np.ascontiguousarray(cells, dtype=np.int64), interior
 
 
@@ -215,7 +200,8 @@ def test_mesh_file_run_and_vtu(tmp_path, cell):
 
 
 def test_tetrahedra_have_no_faces_yet(tmp_path):
-    """Contact or pressure on a tetrahedral body: one line saying faces need hexahedra for now."""
+    """Contact or pressure on a tetrahedral body: one line; the block generator with element = "tet10" splits its
+    bricks."""
     import meshio
 
     from covcontact.io.loader import load_problem
@@ -229,8 +215,12 @@ def test_tetrahedra_have_no_faces_yet(tmp_path):
     with pytest.raises((InputError, ValueError)) as err:
         load_problem(path)
     assert "\n" not in str(err.value)
-    path.write_text(TENSION.replace("CELL", "tet4").replace("MESH", '{ generator = "block", lx = 1.0, ly = 1.0, '
-                                                                   'lz = 1.0, nx = 1, ny = 1, nz = 1 }'))
-    with pytest.raises(InputError) as err:
-        load_problem(path)
-    assert "come from a mesh file" in str(err.value)
+    # the generators' meshes split into tetrahedra: the same bar, no face sets
+    path.write_text(TENSION.replace("CELL", "tet10").replace("MESH", '{ generator = "block", lx = 2.0, ly = 2.0, '
+                                                                    'lz = 2.0, nx = 2, ny = 2, nz = 2 }'))
+    prob = load_problem(path)
+    assert prob.bodies[0].mesh.cell_type == "tet10" and prob.bodies[0].mesh.n_cells == 48
+    assert not prob.bodies[0].mesh.face_sets and "xmin" in prob.bodies[0].mesh.node_sets
+    res = prob.run(out=tmp_path / "gen")
+    assert res.exit_code == 0
+    assert res.summary["steps"][-1]["reactions"]["bar.x1"][0] == pytest.approx(43.05, rel=1e-8)

@@ -14,8 +14,6 @@ from ..description import Body
 from .validate import _REQUIRED, InputError, Section, suggest
 
 CELLS = ("hex8", "hex18", "hex27", "tet4", "tet10", "wedge6", "hex20")
-#: cells the mesh generators make
-GENERATED = ("hex8", "hex18", "hex27")
 
 
 def mesh_generators() -> dict:
@@ -91,10 +89,11 @@ def build_mesh(sec: Section, base: Path, element: str | None):
                and k != "cell"]
     if missing:
         sec.fail(f"generator {name!r} needs {', '.join(missing)}")
-    if element is not None and element not in GENERATED:
-        sec.fail(f"the generators make {', '.join(GENERATED)} meshes; {element} elements come from a mesh file "
-                 f"(mesh = {{ file = ... }}, e.g. from Gmsh)", "generator")
+    from ..mesh.convert import SOURCE, convert
+
     try:
+        if element in SOURCE:  # bricks split (tet4, tet10, wedge6) or trimmed (hex20); no face sets
+            return convert(fn(cell=SOURCE[element], **kwargs), element)
         return fn(cell=element or "hex8", **kwargs)
     except (ValueError, TypeError) as exc:
         sec.fail(f"generator {name!r}: {exc}")

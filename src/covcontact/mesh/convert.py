@@ -1,0 +1,50 @@
+"""Hexahedral meshes turned into the other cells (tet4, tet10, wedge6, hex20), for the mesh generators and tests.
+
+hex8 -> tet4: six tetrahedra per brick around its diagonal 0-6 (neighbouring bricks of a structured mesh then
+share their faces' diagonals); tet4 -> tet10: a mid-node on every edge, shared; hex8 -> wedge6: two wedges per
+brick, cut along the diagonal plane through edges 1-5 and 3-7; hex27 -> hex20: the face and body centres
+dropped. Node sets and element sets follow (an element set holds the new cells of its bricks); face sets do not
+(the new cells have no contact or pressure faces yet).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .mesh import Mesh
+
+_TETS = np.array([[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]])
+_WEDGES = np.array([[0, 1, 3, 4, 5, 7], [1, 2, 3, 5, 6, 7]])
+_TET10_EDGES = np.array([[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]])
+
+#: the hexahedron each conversion starts from
+SOURCE = {"tet4": "hex8", "tet10": "hex8", "wedge6": "hex8", "hex20": "hex27"}
+
+
+def convert(mesh: Mesh, cell: str) -> Mesh:
+    """``mesh`` (hex8, or hex27 for hex20) as a mesh of ``cell``."""
+    if mesh.cell_type != SOURCE[cell]:
+        raise ValueError(f"{cell} meshes are made from {SOURCE[cell]} meshes, not {mesh.cell_type}")
+    X, h = mesh.points, mesh.cells
+    if cell == "hex20":
+        cells, per = h[:, :20], 1
+    elif cell == "wedge6":
+        cells, per = h[:, _WEDGES].reshape(-1, 6), 2
+    else:
+        cells, per = h[:, _TETS].reshape(-1, 4), 6
+    if cell == "tet10":
+        key = np.sort(cells[:, _TET10_EDGES].reshape(-1, 2), axis=1)
+        uniq, inv = np.unique(key, axis=0, return_inverse=True)
+        X = np.vstack([X, 0.5 * (X[uniq[:, 0]] + X[uniq[:, 1]])])
+        cells = np.hstack([cells, len(mesh.points) + inv.reshape(-1, 6)])
+    used = np.unique(cells)
+    new = np.full(len(X), -1, dtype=np.int64)
+    new[used] = np.arange(used.size)
+    out = Mesh(X[used], cell, new[cells])
+    for name, nodes in mesh.node_sets.items():
+        k = new[nodes]
+        if np.any(k >= 0):
+            out.add_node_set(name, k[k >= 0])
+    for name, elems in mesh.element_sets.items():
+        out.element_sets[name] = (per * np.asarray(elems)[:, None] + np.arange(per)).ravel()
+    return out
