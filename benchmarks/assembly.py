@@ -27,15 +27,26 @@ import time
 
 import numpy as np
 
-SIZES = {"hex8": [10, 22, 46, 100], "hex27": [10, 22, 46, 64]}
-QUICK = {"hex8": [10, 22], "hex27": [6, 10]}
-#: approximate bytes per element of pattern (data + indices), ranks and mesh, structured cube
-BYTES_PER_ELEMENT = {"hex8": 12 * 9 * 27 + 4 * 64 + 100, "hex27": 12 * 9 * 512 + 4 * 729 + 800}
+SIZES = {"hex8": [10, 22, 46, 100], "hex27": [10, 22, 46, 64], "hex20": [10, 22, 46], "tet10": [10, 22, 32],
+         "tet4": [10, 22, 46], "wedge6": [10, 22, 46]}
+QUICK = {"hex8": [10, 22], "hex27": [6, 10], "hex20": [6, 10], "tet10": [6, 10], "tet4": [10, 22], "wedge6": [10, 22]}
+#: approximate bytes per element of pattern (data + indices), ranks and mesh, structured cube (n^3 bricks)
+BYTES_PER_ELEMENT = {"hex8": 12 * 9 * 27 + 4 * 64 + 100, "hex27": 12 * 9 * 512 + 4 * 729 + 800,
+                     "hex20": 12 * 9 * 300 + 4 * 400 + 600, "tet10": 6 * (12 * 9 * 60 + 4 * 100 + 300),
+                     "tet4": 6 * (12 * 9 * 8 + 4 * 16 + 100), "wedge6": 2 * (12 * 9 * 20 + 4 * 36 + 100)}
 
 
 def cube(cell: str, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """n^3 elements of ``cell`` ("hex8" or "hex27") on the unit cube, VTK node order."""
+    """n^3 bricks of ``cell`` on the unit cube, VTK node order: hex8 or hex27, or those split (tet4, tet10: six
+    tetrahedra per brick; wedge6: two wedges) or trimmed (hex20)."""
     from covcontact.fem.shapes import IDX
+    from covcontact.mesh.convert import SOURCE, convert
+    from covcontact.mesh.mesh import Mesh
+
+    if cell in SOURCE:
+        X, cells = cube(SOURCE[cell], n)
+        m = convert(Mesh(X, SOURCE[cell], cells), cell)
+        return m.points, m.cells
 
     p = 1 if cell == "hex8" else 2
     m = p * n + 1
@@ -113,7 +124,8 @@ def run_single(cell: str, n: int, repeats: int, material: str = "svk", formulati
         "n_dofs": P.n_dofs, "nnz": P.nnz, "chunk": body.chunk, "threads": numba.get_num_threads(),
         "mesh_s": round(t_mesh, 4), "pattern_s": round(t_pattern, 4), "ranks_s": round(t_ranks, 4),
         "assemble_s": round(w_full, 4), "assemble_cpu_s": round(c_full, 4),
-        "assemble_el_per_s": round(ne / w_full), "residual_s": round(w_res, 4),
+        "assemble_el_per_s": round(ne / w_full), "assemble_nodes_per_s": round(X.shape[0] / w_full),
+        "residual_s": round(w_res, 4),
         "residual_el_per_s": round(ne / w_res), "csr_gib": round(12 * P.nnz / 2**30, 3),
         "ranks_gib": round(body.ranks(P).nbytes / 2**30, 3), "peak_rss_gib": round(peak_rss_gib(), 3),
         "loadavg_1min": round(os.getloadavg()[0], 2),
@@ -140,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
     records = []
     for cell in args.cells.split(","):
         for n in sizes[cell]:
-            est = BYTES_PER_ELEMENT[cell] * n**3 / 2**30
+            est = BYTES_PER_ELEMENT[cell] * n**3 / 2**30  # per brick
             if est > args.max_gib:
                 records.append({"cell": cell, "n": n, "n_elements": n**3, "skipped":
                                 f"estimated {est:.1f} GiB > --max-gib {args.max_gib}"})
