@@ -224,3 +224,32 @@ def test_tetrahedra_have_no_faces_yet(tmp_path):
     res = prob.run(out=tmp_path / "gen")
     assert res.exit_code == 0
     assert res.summary["steps"][-1]["reactions"]["bar.x1"][0] == pytest.approx(43.05, rel=1e-8)
+
+
+@pytest.mark.parametrize("cell, kind", [("tet10", "tetra10"), ("hex20", "hexahedron20"), ("wedge6", "wedge"),
+                                        ("tet4", "tetra")])
+def test_read_from_gmsh_and_abaqus_files(tmp_path, cell, kind):
+    """The cells come back from Gmsh (msh 2.2) and Abaqus files in covcontact's node order (meshio maps
+    Gmsh's tet10 and hex20 orders onto VTK's), with positive volumes and the element sets of the file."""
+    import meshio
+
+    from covcontact.mesh.io import read_mesh
+
+    X, cells, _ = _split(cell)
+    half = np.flatnonzero(X[cells].mean(axis=1)[:, 0] < 1.0)
+    for fmt, suffix in (("gmsh22", ".msh"), ("abaqus", ".inp")):
+        path = tmp_path / f"m_{fmt}{suffix}"
+        tags = np.where(np.isin(np.arange(len(cells)), half), 1, 2)
+        m = meshio.Mesh(X, [(kind, cells)], cell_data={"gmsh:physical": [tags], "gmsh:geometrical": [tags]})
+        if fmt.startswith("gmsh"):
+            m.field_data = {"left": np.array([1, 3]), "right": np.array([2, 3])}
+        else:
+            m.cell_sets = {"left": [half]}
+            m.cell_data = {}
+        meshio.write(path, m, file_format=fmt)
+        mesh = read_mesh(path)
+        assert mesh.cell_type == cell
+        np.testing.assert_allclose(mesh.points[mesh.cells], X[cells], atol=1e-12)
+        body = SolidBody(cell, mesh.points, mesh.cells, MATERIALS["svk"])
+        assert body.check_reference() == []
+        assert np.array_equal(mesh.element_sets["left"], half), fmt
