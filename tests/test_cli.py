@@ -81,7 +81,7 @@ BAD_CASES = {
     "negative-thickness": (GOOD.replace('generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 2, ny = 2, nz = 2',
                                         'generator = "plate", lx = 1.0, ly = 1.0, t = -0.1, nx = 2, ny = 2'),
                            "bodies[0].mesh"),
-    "unknown-element": (GOOD.replace('element = "hex8"', 'element = "hex20"'), "bodies[0].element"),
+    "unknown-element": (GOOD.replace('element = "hex8"', 'element = "hex64"'), "bodies[0].element"),
     "unknown-set": (GOOD.replace('set = "cube.zmin"', 'set = "cube.bottom"'), "has no node set 'bottom'"),
     "unknown-body": (GOOD.replace('set = "cube.zmin"', 'set = "ball.zmin"'), "no body named 'ball'"),
     "unknown-generator": (GOOD.replace('generator = "block"', 'generator = "brick"'), "generator"),

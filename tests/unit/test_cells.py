@@ -253,3 +253,28 @@ def test_read_from_gmsh_and_abaqus_files(tmp_path, cell, kind):
         body = SolidBody(cell, mesh.points, mesh.cells, MATERIALS["svk"])
         assert body.check_reference() == []
         assert np.array_equal(mesh.element_sets["left"], half), fmt
+
+
+def test_hex20_reduced_integration(tmp_path):
+    """options = { integration = "reduced" } (hex20 only, as C3D20R): 8 Gauss points; the tangent matches
+    differences, the homogeneous bar gives the closed form, and other cells are refused with one line."""
+    from covcontact.io.loader import load_problem
+    from covcontact.io.validate import InputError
+
+    X, cells = one_element("hex20", 5)
+    body = SolidBody("hex20", X, cells, MATERIALS["neo-hooke"], integration="reduced")
+    assert body.weights.size == 8
+    u = 0.1 * np.random.default_rng(6).uniform(-1.0, 1.0, X.shape)
+    K, _ = tangent(body, u)
+    assert np.abs(K - _fd(body, u)).max() <= 1e-6 * np.abs(K).max()
+    text = TENSION.replace("MESH", '{ generator = "block", lx = 2.0, ly = 2.0, lz = 2.0, nx = 2, ny = 2, nz = 2 }')
+    text = text.replace("[bodies.sets]", 'options = { integration = "reduced" }\n[bodies.sets]')
+    path = tmp_path / "p.toml"
+    path.write_text(text.replace("CELL", "hex20"))
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    assert res.summary["steps"][-1]["reactions"]["bar.x1"][0] == pytest.approx(43.05, rel=1e-8)
+    path.write_text(text.replace("CELL", "tet10"))
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert 'integration = "reduced" is for hex20' in str(err.value) and "\n" not in str(err.value)

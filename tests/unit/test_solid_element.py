@@ -108,7 +108,7 @@ def test_check_reference_finds_inverted_cells():
     with pytest.raises(ValueError, match="cells"):
         SolidBody("hex8", X, cells[:, :4], MATERIALS["svk"])
     with pytest.raises(ValueError, match="cell type"):
-        SolidBody("tet4", X, cells, MATERIALS["svk"])
+        SolidBody("pyramid5", X, cells, MATERIALS["svk"])
 
 
 def test_two_bodies_in_one_pattern():

@@ -113,7 +113,8 @@ class System:
                 solid = FbarBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
                                  **body.options)
             else:
-                solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material)
+                solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
+                                  **body.options)
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
             offset += body.mesh.n_nodes
         self.n_deformable = offset

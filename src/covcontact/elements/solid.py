@@ -276,14 +276,22 @@ class SolidBody(ElementBody):
         X: (nnode, 3) reference coordinates.
         cells: (nelem, nen) connectivity (local node ids).
         material: a :mod:`covcontact.materials` material.
-        rule: None (full integration), Gauss orders (n1, n2, n3) or (points, weights).
+        rule: None (full integration), Gauss orders (n1, n2, n3) or (points, weights); for tet4, tet10, wedge6 and
+            hex20 the number of points of one of their rules.
         chunk_bytes: size of the per-chunk element tangent buffer.
+        integration: "full", or "reduced" for hex20 (2 x 2 x 2 points, as C3D20R).
     """
 
     def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
-                 rule=None, chunk_bytes: int = 32 * 2**20) -> None:
+                 rule=None, chunk_bytes: int = 32 * 2**20, integration: str = "full") -> None:
         if cell_type not in SOLID_CELLS:
             raise ValueError(f"unknown solid cell type {cell_type!r}; known: {', '.join(SOLID_CELLS)}")
+        if integration == "reduced":
+            if cell_type != "hex20":
+                raise ValueError(f"reduced integration is for hex20 (C3D20R), not {cell_type}")
+            rule = 8
+        elif integration != "full":
+            raise ValueError(f"integration must be \"full\" or \"reduced\", got {integration!r}")
         super().__init__(cell_type, X, cells, material, chunk_bytes)
         self.points, self.weights = _rule(cell_type, rule)
         dN = other_cells.shapes(cell_type, self.points)[1] if cell_type in other_cells.CELLS else \

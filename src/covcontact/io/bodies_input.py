@@ -296,7 +296,14 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
             if mesh.cell_type == "hex27" and options.get("form", "spatial") != "spatial":
                 b.fail("F-bar hex27 has the spatial form only; leave out 'form'", "options")
         elif options:
-            b.fail("options are only known for formulation = \"solid-shell\" and \"fbar\"", "options")
+            unknown = sorted(set(options) - {"integration"})
+            if unknown:
+                b.fail(f"unknown option {unknown[0]!r} for formulation = \"solid\" (known: integration)", "options")
+            if options["integration"] not in ("full", "reduced"):
+                b.fail(f"integration must be \"full\" or \"reduced\", got {options['integration']!r}", "options")
+            if options["integration"] == "reduced" and mesh.cell_type != "hex20":
+                b.fail(f"integration = \"reduced\" is for hex20 elements (as C3D20R), not {mesh.cell_type}: the "
+                       f"others would have zero-energy modes", "options")
         bodies.append(Body(bname, mesh, material, formulation, options))
     if not bodies:
         top.fail("at least one [[bodies]] entry is needed")

@@ -199,7 +199,7 @@ def _make_body(body, cells: np.ndarray):
         from ..elements.fbar import FbarBody
 
         return FbarBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
-    return SolidBody(body.mesh.cell_type, body.mesh.points, cells, body.material)
+    return SolidBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
 
 
 class DistributedSystem(System):
