@@ -199,31 +199,52 @@ def test_mesh_file_run_and_vtu(tmp_path, cell):
     assert len(quads) == {"tet4": 48, "tet10": 48, "wedge6": 32, "hex20": 24}[cell]
 
 
-def test_tetrahedra_have_no_faces_yet(tmp_path):
-    """Contact or pressure on a tetrahedral body: one line; the block generator with element = "tet10" splits its
-    bricks."""
-    import meshio
+@pytest.mark.parametrize("cell", ["tet4", "tet10", "hex20"])
+def test_pressure_on_their_faces(tmp_path, cell):
+    """The generators' face sets carry over (tri3, tri6, quad8 faces), and a pressure on them gives the consistent
+    nodal forces: a tension p = 10 on the end x = 2 of the bar (on rollers) is carried by the support with the
+    force p A = 40 and leaves every node of the end at the same displacement (a homogeneous stress: the tri6 and
+    quad8 corner forces are zero or negative, which a lumped load would get wrong)."""
+    from covcontact.io.loader import load_problem
 
+    path = tmp_path / "p.toml"
+    text = TENSION.replace("CELL", cell).replace("MESH", '{ generator = "block", lx = 2.0, ly = 2.0, lz = 2.0, '
+                                                         'nx = 2, ny = 2, nz = 2 }')
+    text = text.replace('[[dirichlet]]\nname = "pull"\nset = "bar.x1"\ncomponents = "x"\nvalue = 0.1\n',
+                        '[[pressure]]\nset = "bar.xmax"\nvalue = -10.0\n')
+    path.write_text(text)
+    prob = load_problem(path)
+    mesh = prob.bodies[0].mesh
+    assert mesh.face_sets["xmax"].shape == {"tet4": (8, 3), "tet10": (8, 6), "hex20": (4, 8)}[cell]
+    res = prob.run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    assert res.summary["steps"][-1]["reactions"]["bar.x0"][0] == pytest.approx(-40.0, rel=1e-10)
+    ux = res.u.reshape(-1, 3)[mesh.node_sets["xmax"], 0]
+    assert ux.min() > 0 and ux.max() - ux.min() < 1e-9 * ux.max()
+
+
+def test_contact_facets_of_other_cells_are_refused(tmp_path):
+    """A tetrahedral body as a contact master: one line (contact facets are quad4 and quad9 for now); as the
+    node-to-surface slave of a hexahedral master it works."""
     from covcontact.io.loader import load_problem
     from covcontact.io.validate import InputError
 
-    X, cells, _ = _split("tet4")
-    meshio.write(tmp_path / "bar.vtu", meshio.Mesh(X, [("tetra", cells)]))
+    base = TENSION.replace("CELL", "tet10").replace("MESH", '{ generator = "block", lx = 2.0, ly = 2.0, lz = 2.0, '
+                                                            'nx = 2, ny = 2, nz = 2 }')
+    other = ('\n[[bodies]]\nname = "cap"\nelement = "hex8"\nmaterial = { model = "svk", E = 200.0, nu = 0.3 }\n'
+             'mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 1.0, nx = 2, ny = 2, nz = 1, '
+             'origin = [0.0, 0.0, 2.0] }\n')
     path = tmp_path / "p.toml"
-    path.write_text(TENSION.replace("CELL", "tet4").replace("MESH", '{ file = "bar.vtu" }') +
-                    '\n[[pressure]]\nset = "bar.x1"\nvalue = 1.0\n')
-    with pytest.raises((InputError, ValueError)) as err:
+    path.write_text(base.replace("[[dirichlet]]", other + "\n[[dirichlet]]", 1) +
+                    '\n[[contact]]\nslave = "cap.zmin"\nmaster = "bar.zmax"\npenalty = 1.0e4\n')
+    with pytest.raises(InputError) as err:
         load_problem(path)
+    assert "contact[0].master" in str(err.value) and "tri6 faces" in str(err.value)
     assert "\n" not in str(err.value)
-    # the generators' meshes split into tetrahedra: the same bar, no face sets
-    path.write_text(TENSION.replace("CELL", "tet10").replace("MESH", '{ generator = "block", lx = 2.0, ly = 2.0, '
-                                                                    'lz = 2.0, nx = 2, ny = 2, nz = 2 }'))
+    path.write_text(base.replace("[[dirichlet]]", other + "\n[[dirichlet]]", 1) +
+                    '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\nweighting = "area"\n')
     prob = load_problem(path)
-    assert prob.bodies[0].mesh.cell_type == "tet10" and prob.bodies[0].mesh.n_cells == 48
-    assert not prob.bodies[0].mesh.face_sets and "xmin" in prob.bodies[0].mesh.node_sets
-    res = prob.run(out=tmp_path / "gen")
-    assert res.exit_code == 0
-    assert res.summary["steps"][-1]["reactions"]["bar.x1"][0] == pytest.approx(43.05, rel=1e-8)
+    assert prob.contacts[0].slave == ("bar", "zmax")
 
 
 @pytest.mark.parametrize("cell, kind", [("tet10", "tetra10"), ("hex20", "hexahedron20"), ("wedge6", "wedge"),

@@ -13,8 +13,7 @@ import scipy.sparse as sp
 from numba import njit
 
 from ..elements.solid import SolidBody
-from ..fem.quadrature import default_rule
-from ..fem.shapes import shape_functions
+from ..fem.cells import any_face
 from ..loads import NodalForce, Pressure
 from .pattern import Pattern
 
@@ -75,10 +74,7 @@ def face_load_vector(X: np.ndarray, faces: np.ndarray, area_only: bool = False) 
     A dead pressure p gives nodal forces -p times this (positive pressure pushes into the body). With
     ``area_only`` the integral of N_a |rho_1 x rho_2| dxi (nodal areas, repeated in the 3 columns).
     """
-    nfn = faces.shape[1]
-    cell = "quad4" if nfn == 4 else "quad9"
-    pts, w = default_rule(cell)
-    N, dN, _ = shape_functions(cell, pts)
+    N, dN, w = any_face(faces.shape[1])
     xf = X[faces]  # (nf, nfn, 3)
     r1 = np.einsum("pa,fai->fpi", dN[:, :, 0], xf)
     r2 = np.einsum("pa,fai->fpi", dN[:, :, 1], xf)

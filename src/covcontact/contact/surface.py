@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit, prange
 
+from ..fem.cells import any_face
 from ..fem.quadrature import gauss_quad
 from ..fem.shapes import IDX, NODES, lagrange1d, shape_functions
 from .geometry import bilinear_coefficients
@@ -145,8 +146,8 @@ def tributary_area(x_nodes: np.ndarray, faces: np.ndarray, n_gauss: int | None =
 
     Args:
         x_nodes: (n, 3) positions.
-        faces: (nf, 4|9) global node ids.
-        n_gauss: Gauss points per direction (default 3 for quad4, 4 for quad9).
+        faces: (nf, 4|9) global node ids (or the 3, 6, 8 of tri3, tri6, quad8 faces: slave nodes of other cells).
+        n_gauss: Gauss points per direction (default 3 for quad4, 4 for quad9; the face rule of the others).
 
     Returns:
         (n,) areas; they sum to the surface area integrated with the same rule.
@@ -154,8 +155,11 @@ def tributary_area(x_nodes: np.ndarray, faces: np.ndarray, n_gauss: int | None =
     faces = np.asarray(faces, dtype=np.int64)
     x = np.asarray(x_nodes, dtype=np.float64)
     nen = faces.shape[1]
-    pts, w = gauss_quad(n_gauss or (3 if nen == 4 else 4))
-    N, dN, _ = shape_functions("quad4" if nen == 4 else "quad9", pts)
+    if nen in (4, 9):
+        pts, w = gauss_quad(n_gauss or (3 if nen == 4 else 4))
+        N, dN, _ = shape_functions("quad4" if nen == 4 else "quad9", pts)
+    else:
+        N, dN, w = any_face(nen)
     xf = x[faces]
     t = np.einsum("pad,fai->fpdi", dN, xf)
     jac = np.linalg.norm(np.cross(t[:, :, 0, :], t[:, :, 1, :]), axis=2)  # (nf, npts)

@@ -144,3 +144,72 @@ def rule(cell: str, npts: int | None = None) -> tuple[np.ndarray, np.ndarray]:
             raise ValueError("hex20 has the 27 point (full) and 8 point (reduced) rules")
         return gauss_tensor((3, 3, 3) if npts == 27 else (2, 2, 2))
     raise ValueError(f"unknown cell type {cell!r}; known: {', '.join(CELLS)}")
+
+
+# ----------------------------------------------------------------------------------------------- faces
+#: face types of the cells' boundaries: corners counter-clockwise seen from outside, then the edge mid-nodes
+FACE_CELLS = ("tri3", "tri6", "quad8")
+FACE_NNODES = {"tri3": 3, "tri6": 6, "quad8": 8}
+#: corner count of every face type (faces are matched by their corners)
+CORNERS = {"tri3": 3, "tri6": 3, "quad4": 4, "quad8": 4, "quad9": 4}
+
+
+def face_shapes(ftype: str, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """N (npts, nfn) and dN/dxi (npts, nfn, 2) of a tri3 (natural coordinates on the unit triangle), tri6 (mid-nodes
+    0-1, 1-2, 2-0) or quad8 (serendipity on [-1, 1]^2, mid-nodes 0-1, 1-2, 2-3, 3-0) face."""
+    p = np.atleast_2d(np.asarray(points, dtype=np.float64))
+    n = len(p)
+    if ftype in ("tri3", "tri6"):
+        L = np.stack([1.0 - p[:, 0] - p[:, 1], p[:, 0], p[:, 1]], axis=1)
+        dL = np.array([[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]])
+        if ftype == "tri3":
+            return L, np.broadcast_to(dL, (n, 3, 2)).copy()
+        a, b = np.array([0, 1, 2]), np.array([1, 2, 0])
+        N = np.hstack([L * (2.0 * L - 1.0), 4.0 * L[:, a] * L[:, b]])
+        dN = np.concatenate([(4.0 * L - 1.0)[:, :, None] * dL[None],
+                             4.0 * (L[:, a, None] * dL[None, b] + L[:, b, None] * dL[None, a])], axis=1)
+        return N, dN
+    if ftype == "quad8":
+        xa = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0, 1], [-1, 0]], dtype=float)
+        N = np.empty((n, 8))
+        dN = np.empty((n, 8, 2))
+        x, y = p[:, 0], p[:, 1]
+        for k, (u, v) in enumerate(xa):
+            if k < 4:
+                N[:, k] = 0.25 * (1 + u * x) * (1 + v * y) * (u * x + v * y - 1)
+                dN[:, k, 0] = 0.25 * u * (1 + v * y) * (2 * u * x + v * y)
+                dN[:, k, 1] = 0.25 * v * (1 + u * x) * (u * x + 2 * v * y)
+            elif u == 0:
+                N[:, k] = 0.5 * (1 - x * x) * (1 + v * y)
+                dN[:, k, 0] = -x * (1 + v * y)
+                dN[:, k, 1] = 0.5 * v * (1 - x * x)
+            else:
+                N[:, k] = 0.5 * (1 + u * x) * (1 - y * y)
+                dN[:, k, 0] = 0.5 * u * (1 - y * y)
+                dN[:, k, 1] = -y * (1 + u * x)
+        return N, dN
+    raise ValueError(f"unknown face type {ftype!r}; known: {', '.join(FACE_CELLS)}")
+
+
+def face_rule(ftype: str) -> tuple[np.ndarray, np.ndarray]:
+    """Face rules: tri3 and tri6 3 points (degree 2), quad8 3 x 3 Gauss."""
+    if ftype in ("tri3", "tri6"):
+        return _triangle_rule()
+    pts, w = gauss_1d(3)
+    return np.array([[a, b] for b in pts for a in pts]), np.array([u * v for v in w for u in w])
+
+
+def any_face(nfn: int, n_gauss: int | None = None):
+    """(N (npts, nfn), dN (npts, nfn, 2), weights) of the face type with ``nfn`` nodes (quad4, quad9 by their Gauss
+    rules of ``n_gauss`` points per direction, default full; tri3, tri6, quad8 by :func:`face_rule`)."""
+    from .quadrature import gauss_quad
+    from .shapes import shape_functions
+
+    if nfn in (4, 9):
+        pts, w = gauss_quad(n_gauss or (2 if nfn == 4 else 3))
+        N, dN, _ = shape_functions("quad4" if nfn == 4 else "quad9", pts)
+        return N, dN, w
+    ftype = {3: "tri3", 6: "tri6", 8: "quad8"}[nfn]
+    pts, w = face_rule(ftype)
+    N, dN = face_shapes(ftype, pts)
+    return N, dN, w

@@ -26,6 +26,18 @@ def _slave_faces(c, sets) -> None:
                f"of {bname!r} ({faces})", "slave")
 
 
+def _quad_facets(c, sets, ref: tuple, key: str) -> None:
+    """Contact facets are quad4 or quad9 (hexahedra's faces) for now: one line for the faces of other cells."""
+    owner = next((b.mesh for b in sets.bodies if b.name == ref[0]), None) or next(
+        (r.mesh for r in sets.rigid if r.name == ref[0] and r.mesh is not None), None)
+    faces = owner.face_sets.get(ref[1]) if owner is not None else None
+    if faces is not None and faces.shape[1] not in (4, 9):
+        kind = {3: "tri3", 6: "tri6", 8: "quad8"}[faces.shape[1]]
+        c.fail(f"'{ref[0]}.{ref[1]}' has {kind} faces ({owner.cell_type} cells); contact facets are quad4 and "
+               f"quad9 (hex8, hex27) for now: mesh the contact zone with hexahedra, or make this body the "
+               f"node-to-surface slave (its nodes) of a hexahedral master", key)
+
+
 def _self_surfaces(c, sets) -> tuple:
     """The face sets of a self-contact: one "BODY.FACESET" or a list of them (merged into one surface)."""
     val = c.get("self", "any")
@@ -42,6 +54,7 @@ def _self_surfaces(c, sets) -> tuple:
             c.fail(f"{ref!r} is a node set; self-contact needs the faces of the surface: give a face set of "
                    f"{bname!r} ({', '.join(sorted(owner.face_sets)) or 'none'})", "self")
         out.append(sets.body_set(c, "self", "face"))
+        _quad_facets(c, sets, out[-1], "self")
     if len(set(out)) != len(out):
         c.fail("a face set is listed twice", "self")
     return tuple(out)
@@ -75,6 +88,9 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
             else:
                 c.data["master"] = mref
                 master = sets.body_set(c, "master", "face")
+                _quad_facets(c, sets, master, "master")
+            if ctype == "sts" or c.has("two_pass") and c.data.get("two_pass") is True:
+                _quad_facets(c, sets, slave, "slave")
             if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
                 c.fail("slave and master are the same rigid body")
             if slave == master:

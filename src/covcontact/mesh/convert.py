@@ -3,15 +3,17 @@
 hex8 -> tet4: six tetrahedra per brick around its diagonal 0-6 (neighbouring bricks of a structured mesh then
 share their faces' diagonals); tet4 -> tet10: a mid-node on every edge, shared; hex8 -> wedge6: two wedges per
 brick, cut along the diagonal plane through edges 1-5 and 3-7; hex27 -> hex20: the face and body centres
-dropped. Node sets and element sets follow (an element set holds the new cells of its bricks); face sets do not
-(the new cells have no contact or pressure faces yet).
+dropped. Node sets and element sets follow (an element set holds the new cells of its bricks), and face sets
+(the boundary faces of the new cells whose corners lie on the old set's faces: triangles, tri6 or quad8); a wedge
+mesh has no face sets (its faces mix triangles and quadrilaterals).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .mesh import Mesh
+from .faces import faces_on_nodes
+from .mesh import FACE_TYPE, Mesh
 
 _TETS = np.array([[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]])
 _WEDGES = np.array([[0, 1, 3, 4, 5, 7], [1, 2, 3, 5, 6, 7]])
@@ -47,4 +49,10 @@ def convert(mesh: Mesh, cell: str) -> Mesh:
             out.add_node_set(name, k[k >= 0])
     for name, elems in mesh.element_sets.items():
         out.element_sets[name] = (per * np.asarray(elems)[:, None] + np.arange(per)).ravel()
+    if cell in FACE_TYPE:
+        for name, faces in mesh.face_sets.items():
+            corners = new[np.unique(faces[:, :4])]
+            f = faces_on_nodes(out, corners[corners >= 0], corners_only=True)
+            if len(f):
+                out.add_face_set(name, f)
     return out

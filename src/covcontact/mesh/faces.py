@@ -54,6 +54,35 @@ def _face_table(cell: str, face: str) -> np.ndarray:
 FACES = {c: np.stack([_face_table(c, f) for f in labels]) for c, labels in FACE_LABELS.items()}
 
 
+def _tet_faces(quadratic: bool) -> np.ndarray:
+    """The four faces of a tetrahedron, corners counter-clockwise seen from outside (the opposite vertex behind),
+    then (tet10) the mid-nodes of the face's edges in the tri6 order."""
+    from ..fem.cells import NODES as CELL_NODES
+
+    nat = CELL_NODES["tet10"]
+    mids = {frozenset(e): 4 + k for k, e in enumerate([(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)])}
+    rows = []
+    for opposite in (3, 2, 0, 1):
+        a, b, c = [v for v in range(4) if v != opposite]
+        if np.dot(np.cross(nat[b] - nat[a], nat[c] - nat[a]), nat[opposite] - nat[a]) > 0:
+            b, c = c, b
+        row = [a, b, c]
+        if quadratic:
+            row += [mids[frozenset((a, b))], mids[frozenset((b, c))], mids[frozenset((c, a))]]
+        rows.append(row)
+    return np.array(rows, dtype=np.int64)
+
+
+FACES["tet4"] = _tet_faces(False)
+FACES["tet10"] = _tet_faces(True)
+FACES["hex20"] = FACES["hex27"][:, :8].copy()  # the hex27's faces without their centres (hex20 = its first 20 nodes)
+
+
+def _corners(ftype_nodes: int) -> int:
+    """Corners of a face of ``ftype_nodes`` nodes: triangles 3, quadrilaterals 4."""
+    return 3 if ftype_nodes in (3, 6) else 4
+
+
 def boundary_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Faces used by exactly one element (for hex18 only the t = -1 and t = +1 faces).
 
@@ -64,18 +93,19 @@ def boundary_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     table = FACES[mesh.cell_type]
     nlf, nfn = table.shape
     allf = mesh.cells[:, table].reshape(-1, nfn)
-    corners = np.sort(allf[:, :4], axis=1)
+    corners = np.sort(allf[:, :_corners(nfn)], axis=1)
     _, inv, cnt = np.unique(corners, axis=0, return_inverse=True, return_counts=True)
     idx = np.nonzero(cnt[inv.ravel()] == 1)[0]
     return np.ascontiguousarray(allf[idx]), idx // nlf, idx % nlf
 
 
-def faces_on_nodes(mesh: Mesh, node_ids: np.ndarray) -> np.ndarray:
-    """Boundary faces (outward ordered) whose nodes all lie in ``node_ids``."""
+def faces_on_nodes(mesh: Mesh, node_ids: np.ndarray, corners_only: bool = False) -> np.ndarray:
+    """Boundary faces (outward ordered) whose nodes (or corners) all lie in ``node_ids``."""
     faces, _, _ = boundary_faces(mesh)
     mask = np.zeros(mesh.n_nodes, dtype=bool)
     mask[np.asarray(node_ids, dtype=np.int64)] = True
-    return np.ascontiguousarray(faces[np.all(mask[faces], axis=1)])
+    part = faces[:, :_corners(faces.shape[1])] if corners_only else faces
+    return np.ascontiguousarray(faces[np.all(mask[part], axis=1)])
 
 
 def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -85,10 +115,11 @@ def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.
         matched (nm, 4 | 9) boundary faces in the order of ``faces``, and found (nf,) bool.
     """
     bf, _, _ = boundary_faces(mesh)
-    query = np.sort(np.asarray(faces, dtype=np.int64)[:, :4], axis=1)
+    nc = _corners(bf.shape[1])
+    query = np.sort(np.asarray(faces, dtype=np.int64)[:, :nc], axis=1)
     if query.shape[0] == 0 or bf.shape[0] == 0:
         return np.empty((0, bf.shape[1]), dtype=np.int64), np.zeros(query.shape[0], dtype=bool)
-    keys = np.sort(bf[:, :4], axis=1)
+    keys = np.sort(bf[:, :nc], axis=1)
     both = np.concatenate([keys, query])
     _, inv = np.unique(both, axis=0, return_inverse=True)
     inv = inv.ravel()
@@ -100,7 +131,14 @@ def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.
 
 
 def face_normals(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Unnormalised normals rho_1 x rho_2 at the centre (0, 0) of each face, (nf, 3)."""
+    """Unnormalised normals rho_1 x rho_2 at the centre (0, 0) of each face, (nf, 3) (triangles and quad8: the
+    cross product of the corner diagonals or edges, the same direction)."""
+    if faces.shape[1] in (3, 6):
+        x = points[faces]
+        return np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    if faces.shape[1] == 8:
+        x = points[faces]
+        return np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 1])
     ftype = "quad4" if faces.shape[1] == 4 else "quad9"
     _, dN, _ = shape_functions(ftype, np.zeros((1, 2)))
     rho = np.einsum("fai,aj->fji", points[faces], dN[0])

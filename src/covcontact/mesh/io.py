@@ -38,9 +38,11 @@ if TYPE_CHECKING:
 _VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27", "tetra": "tet4", "tetra10": "tet10", "wedge": "wedge6",
            "hexahedron20": "hex20"}
 _TO_MESHIO = {v: k for k, v in _VOLUME.items()}
-#: cells with quadrilateral faces, whose face groups become face sets (contact and pressure surfaces)
+#: cells whose face groups become face sets (contact and pressure surfaces; tet4, tet10, hex20: pressure only)
+_FACED = ("hex8", "hex27", "tet4", "tet10", "hex20")
+#: cells whose Abaqus element surfaces (S1 .. S6) are read
 _QUAD_FACED = ("hex8", "hex27")
-_FACE_CELLS = ("quad", "quad8", "quad9")
+_FACE_CELLS = ("quad", "quad8", "quad9", "triangle", "triangle6")
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
 
@@ -204,7 +206,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
             nodes.append(data.ravel())
             if b in vol:
                 elems.append(first[vol.index(b)] + ids)
-            elif m.cells[b].type in _FACE_CELLS and len(data) and cell_type in _QUAD_FACED:
+            elif m.cells[b].type in _FACE_CELLS and len(data) and cell_type in _FACED:
                 faces.append(new[data[:, :4]])
         if elems:
             mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)

@@ -7,7 +7,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 #: volume cell type -> the type of its contact faces
-FACE_TYPE = {"hex8": "quad4", "hex18": "quad9", "hex27": "quad9"}
+FACE_TYPE = {"hex8": "quad4", "hex18": "quad9", "hex27": "quad9", "tet4": "tri3", "tet10": "tri6", "hex20": "quad8"}
+#: nodes per face of each face type
+FACE_NODES = {"quad4": 4, "quad9": 9, "tri3": 3, "tri6": 6, "quad8": 8}
 
 
 @dataclass
@@ -49,8 +51,8 @@ class Mesh:
     @property
     def face_type(self) -> str:
         if self.cell_type not in FACE_TYPE:
-            raise ValueError(f"{self.cell_type} meshes have no contact or pressure faces yet (quadrilateral faces "
-                             f"only: hex8, hex27); use node sets on them")
+            raise ValueError(f"{self.cell_type} meshes have no face sets yet (their faces mix triangles and "
+                             f"quadrilaterals); use node sets on them")
         return FACE_TYPE[self.cell_type]
 
     def node_set(self, name: str) -> np.ndarray:
@@ -72,7 +74,7 @@ class Mesh:
     def add_face_set(self, name: str, faces: np.ndarray) -> None:
         """Store outward-ordered faces (nface, 4 or 9) under ``name``."""
         f = np.ascontiguousarray(faces, dtype=np.int64)
-        nfn = 4 if self.face_type == "quad4" else 9
+        nfn = FACE_NODES[self.face_type]
         if f.ndim != 2 or f.shape[1] != nfn:
             raise ValueError(f"face set {name!r} needs shape (nface, {nfn}), got {f.shape}")
         self.face_sets[name] = f
