@@ -177,8 +177,8 @@ def test_mesh_file_run_and_vtu(tmp_path, cell):
     vtk = {"tet4": "tetra", "tet10": "tetra10", "wedge6": "wedge", "hex20": "hexahedron20"}[cell]
     meshio.write(tmp_path / "bar.vtu", meshio.Mesh(X, [(vtk, cells)]))
     reactions = {}
-    for name, element, mesh in ((cell, cell, '{ file = "bar.vtu" }'), ("hex8", "hex8", '{ generator = "block", '
-                                'lx = 2.0, ly = 2.0, lz = 2.0, nx = 2, ny = 2, nz = 2 }')):
+    generated = '{ generator = "block", lx = 2.0, ly = 2.0, lz = 2.0, nx = 2, ny = 2, nz = 2 }'
+    for name, element, mesh in ((cell, cell, '{ file = "bar.vtu" }'), ("hex8", "hex8", generated)):
         path = tmp_path / f"{name}.toml"
         path.write_text(TENSION.replace("CELL", element).replace("MESH", mesh))
         res = load_problem(path).run(out=tmp_path / name)

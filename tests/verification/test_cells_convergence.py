@@ -10,6 +10,8 @@ docs/verification.md, "Tetrahedra, wedges and 20-node bricks".
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 import scipy.sparse.linalg as sla
@@ -71,5 +73,5 @@ def test_converges_to_hex27(reference, cell, n_ok, tol):
             break
         errs.append(stiffness(n, cell) / reference - 1.0)
     assert all(e > -1e-4 for e in errs), errs
-    assert all(b < a for a, b in zip(errs, errs[1:])), errs
+    assert all(b < a for a, b in pairwise(errs)), errs
     assert errs[-1] < tol, errs
