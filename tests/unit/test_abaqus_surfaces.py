@@ -71,3 +71,40 @@ def test_bad_surfaces(tmp_path, surfaces, message):
     with pytest.raises(MeshError) as err:
         read_mesh(_write(tmp_path, surfaces))
     assert message in str(err.value)
+
+
+#: one C3D4 tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) and its faces S1 .. S4 (Abaqus numbering: S1 = 1-2-3,
+#: S2 = 1-4-2, S3 = 2-4-3, S4 = 3-4-1)
+TET_DECK = """*NODE
+1, 0, 0, 0
+2, 1, 0, 0
+3, 0, 1, 0
+4, 0, 0, 1
+*ELEMENT, TYPE=C3D4, ELSET=T
+1, 1, 2, 3, 4
+*SURFACE, NAME=BOTTOM
+T, S1
+*SURFACE, NAME=SIDE
+T, S2
+*SURFACE, NAME=SLANT
+T, S3
+*SURFACE, NAME=BACK
+T, S4
+"""
+
+
+def test_tetrahedron_surfaces(tmp_path):
+    """S1..S4 of a C3D4: face sets of outward tri3 faces at z = 0, y = 0, the slanted face and x = 0; S5 is an
+    error naming the faces a tetrahedron has."""
+    path = tmp_path / "tet.inp"
+    path.write_text(TET_DECK)
+    mesh = read_mesh(path)
+    normals = {name: face_normals(mesh.points, mesh.face_sets[name])[0] for name in ("BOTTOM", "SIDE", "SLANT", "BACK")}
+    for name, expected in (("BOTTOM", [0, 0, -1]), ("SIDE", [0, -1, 0]), ("SLANT", [1, 1, 1]), ("BACK", [-1, 0, 0])):
+        n = normals[name] / np.linalg.norm(normals[name])
+        np.testing.assert_allclose(n, np.asarray(expected) / np.linalg.norm(expected), atol=1e-12)
+        assert mesh.face_sets[name].shape == (1, 3)
+    path.write_text(TET_DECK.replace("T, S4", "T, S5"))
+    with pytest.raises(MeshError) as err:
+        read_mesh(path)
+    assert "faces S1..S4, not S5" in str(err.value)

@@ -18,8 +18,8 @@ from ..fem import cells as other_cells
 from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
 from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
-from ..materials.update import material_update
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
+from ..materials.update import material_update
 from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather, inverse3
 
 __all__ = ["BLOCKS_PER_THREAD", "SOLID_CELLS", "SolidBody", "SolidStress", "solid_chunk", "solid_gauss_fields"]

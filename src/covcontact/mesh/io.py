@@ -40,8 +40,6 @@ _VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27", "tetra": "tet4", "tetr
 _TO_MESHIO = {v: k for k, v in _VOLUME.items()}
 #: cells whose face groups become face sets (contact and pressure surfaces; tet4, tet10, hex20: pressure only)
 _FACED = ("hex8", "hex27", "tet4", "tet10", "hex20")
-#: cells whose Abaqus element surfaces (S1 .. S6) are read
-_QUAD_FACED = ("hex8", "hex27")
 _FACE_CELLS = ("quad", "quad8", "quad9", "triangle", "triangle6")
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
@@ -219,7 +217,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         kept = keep(np.concatenate(nodes))
         if name not in mesh.node_sets and kept.size:
             mesh.add_node_set(name, kept)
-    if p.suffix.lower() == ".inp" and cell_type in _QUAD_FACED:
+    if p.suffix.lower() == ".inp" and cell_type in _FACED:
         _abaqus_surfaces(p, m, mesh, vol, first, keep)
     return mesh
 
@@ -227,7 +225,9 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
 def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep) -> None:
     """The deck's *SURFACE definitions as face sets (element surfaces: their faces, matched outward) and node
     sets (node surfaces), each element surface also a node set of its nodes."""
-    from .abaqus import HEX_FACES, read_surfaces
+    from .abaqus import HEX_FACES, TET_FACES, read_surfaces
+
+    table = TET_FACES if mesh.cell_type in ("tet4", "tet10") else HEX_FACES
 
     try:
         elem, node = read_surfaces(p)
@@ -242,7 +242,10 @@ def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep)
             for k, b in enumerate(vol):
                 ids = np.asarray(parts[b], dtype=np.int64) if b < len(parts) and parts[b] is not None else []
                 if len(ids):
-                    faces.append(mesh.cells[first[k] + ids][:, list(HEX_FACES[face])])
+                    if face not in table:
+                        raise _fail(p, f"*SURFACE {name}: {mesh.cell_type} elements have the faces S1..S{len(table)}, "
+                                       f"not S{face}")
+                    faces.append(mesh.cells[first[k] + ids][:, list(table[face])])
         if not faces:
             raise _fail(p, f"*SURFACE {name}: its element sets hold no volume cells")
         f = np.concatenate(faces)
