@@ -242,7 +242,7 @@ def test_contact_facets_of_other_cells_are_refused(tmp_path):
     assert "contact[0].master" in str(err.value) and "tri6 faces" in str(err.value)
     assert "\n" not in str(err.value)
     path.write_text(base.replace("[[dirichlet]]", other + "\n[[dirichlet]]", 1) +
-                    '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\nweighting = "area"\n')
+                    '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\n')
     prob = load_problem(path)
     assert prob.contacts[0].slave == ("bar", "zmax")
 
@@ -299,3 +299,22 @@ def test_hex20_reduced_integration(tmp_path):
     with pytest.raises(InputError) as err:
         load_problem(path)
     assert 'integration = "reduced" is for hex20' in str(err.value) and "\n" not in str(err.value)
+
+
+def test_area_weighting_on_quadratic_faces_is_refused(tmp_path):
+    """Node-to-surface with area weighting on tri6 faces: one line (their corner nodes have zero tributary area);
+    with nodal weighting the pair is accepted."""
+    from covcontact.io.loader import load_problem
+    from covcontact.io.validate import InputError
+
+    base = TENSION.replace("CELL", "tet10").replace("MESH", '{ generator = "block", lx = 2.0, ly = 2.0, lz = 2.0, '
+                                                            'nx = 2, ny = 2, nz = 2 }')
+    floor = '\n[[rigid]]\nname = "floor"\nshape = "plane"\npoint = [0.0, 0.0, -0.01]\nnormal = [0.0, 0.0, 1.0]\n'
+    path = tmp_path / "p.toml"
+    path.write_text(base + floor + '\n[[contact]]\nslave = "bar.zmin"\nmaster = "floor"\npenalty = 1.0e4\n'
+                    'weighting = "area"\n')
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert "contact[0].slave: area weighting on tri6 faces" in str(err.value) and "\n" not in str(err.value)
+    path.write_text(base + floor + '\n[[contact]]\nslave = "bar.zmin"\nmaster = "floor"\npenalty = 1.0e4\n')
+    assert load_problem(path).contacts[0].weighting == "nodal"
