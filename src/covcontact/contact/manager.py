@@ -452,12 +452,15 @@ class ContactManager:
     def step_report(self, x: np.ndarray, lam: float, state: ContactState) -> dict:
         return report.step_report(self, x, lam, state)
 
-    def point_data(self, n_nodes: int, state: ContactState) -> dict:
-        return report.point_data(self, n_nodes, state)
+    def point_data(self, n_nodes: int, state: ContactState, fields: tuple | None = None) -> dict:
+        return report.point_data(self, n_nodes, state, fields)
 
-    def facet_fields(self, state: ContactState) -> list:
-        """(slave faces, mean contact pressure per facet) of every pass with a slave face set."""
-        return report.facet_pressure(self, state)
+    def facet_fields(self, state: ContactState, nodal_pressure: np.ndarray | None = None) -> list:
+        """(slave faces, mean contact pressure per facet) of every pass with a slave face set; ``nodal_pressure``
+        the pressure of :meth:`node_fields` when the caller has it."""
+        if nodal_pressure is None:
+            nodal_pressure = self.node_fields(state)[1]
+        return report.facet_pressure(self, state, nodal_pressure)
 
     def node_fields(self, state: ContactState):
         """(gap, pressure, status) over the extended node numbering (deformable nodes, then the nodes of rigid

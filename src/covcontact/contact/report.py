@@ -79,11 +79,10 @@ def node_fields(manager, n: int, state: ContactState) -> tuple[np.ndarray, np.nd
         if p.kind == "sts":
             pts = manager.points
             fin = np.isfinite(g)
-            pg, _ = pts.smooth(sl, area * fin, np.where(fin, g, 0.0), n)
+            pg, touched = pts.smooth(sl, area * fin, np.where(fin, g, 0.0), n)
             pp, has = pts.smooth(sl, area, np.where(act, fn, 0.0), n)
             on, _ = pts.smooth(sl, area, act.astype(float), n)
-            gsum, _ = pts.smooth(sl, area * fin, np.ones(len(sl)), n)
-            gap[gsum > 0] = pg[gsum > 0]
+            gap[touched] = pg[touched]
             pressure[has] = pp[has]
             status[has] = np.where(on[has] > 0.0, 1.0, 0.0)
             continue
@@ -106,10 +105,10 @@ def _point_rows(manager, state: ContactState) -> list[tuple]:
     return mine
 
 
-def facet_pressure(manager, state: ContactState) -> list[tuple[np.ndarray, np.ndarray]]:
+def facet_pressure(manager, state: ContactState, nodal: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
     """Per pass with a slave face set: (faces (nf, nen) extended ids, the mean contact pressure of each facet):
-    the area-weighted mean over its points (sts), the mean over its nodes of the nodal pressure (nts)."""
-    _, nodal, _ = node_fields(manager, manager.num.n_ext, state)
+    the area-weighted mean over its points (sts), the mean over its nodes of the nodal pressure ``nodal`` (the
+    pressure of :func:`node_fields` over the extended nodes) (nts)."""
     every = manager.gather(_point_rows(manager, state))
     out = []
     for k, p in enumerate(manager.passes):
@@ -126,9 +125,10 @@ def facet_pressure(manager, state: ContactState) -> list[tuple[np.ndarray, np.nd
     return out
 
 
-def point_data(manager, n_nodes: int, state: ContactState) -> dict:
-    """Gap, contact pressure and status per deformable node."""
-    gap, pressure, status = node_fields(manager, manager.num.n_ext, state)
+def point_data(manager, n_nodes: int, state: ContactState, fields: tuple | None = None) -> dict:
+    """Gap, contact pressure and status per deformable node (from :func:`node_fields` over the extended nodes,
+    ``fields``, when the caller has them)."""
+    gap, pressure, status = node_fields(manager, manager.num.n_ext, state) if fields is None else fields
     return {"gap": gap[:n_nodes], "contact_pressure": pressure[:n_nodes], "contact_status": status[:n_nodes]}
 
 

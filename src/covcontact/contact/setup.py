@@ -150,17 +150,14 @@ def _auto_penalty(num: Numbering, pair, slave, master) -> float:
                      f"named like its contact set")
 
 
-def _slaves(num: Numbering, pair, slave, X) -> tuple:
-    """(slave ids, area per slave, slave faces or None, own facet index or None) of one side of a pair:
-    nodes with their tributary areas (nts), or Gauss points with their weights (sts)."""
-    smesh, soff = num.mesh_of(slave[0])
-    faces = smesh.face_sets[slave[1]] + soff if slave[1] in smesh.face_sets else None
+def _slaves(num: Numbering, pair, faces: np.ndarray | None, nodes: np.ndarray | None, X) -> tuple:
+    """(slave ids, area per slave, each point's facet or None) of slave ``faces`` (extended ids, None for a node set)
+    and ``nodes``: the nodes with their tributary areas (nts), or the faces' Gauss points with their weights (sts)."""
     if pair.type == "sts":
         conn, N, weight, facet = gauss_points(X, faces, pair.order)
-        return num.points.add(conn, N), weight, faces, facet
-    slaves = smesh.node_sets[slave[1]] + soff
-    area = tributary_area(X, faces)[slaves] if faces is not None else np.ones(len(slaves))
-    return slaves, area, faces, None
+        return num.points.add(conn, N), weight, facet
+    area = tributary_area(X, faces)[nodes] if faces is not None else np.ones(len(nodes))
+    return nodes, area, None
 
 
 def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None, surfaces=None) -> Pass:
@@ -168,16 +165,13 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
     the (body, face set) list of a self-contact, merged into one surface that is both slave and master."""
     X = num.reference()
     if surfaces is not None:
-        faces = np.vstack([num.mesh_of(b)[0].face_sets[f] + num.mesh_of(b)[1] for b, f in surfaces])
-        if pair.type == "sts":
-            conn, N, area, own = gauss_points(X, faces, pair.order)
-            slaves = num.points.add(conn, N)
-        else:
-            slaves, own = np.unique(faces), None
-            area = tributary_area(X, faces)[slaves]
-        slave_faces = faces
+        slave_faces = np.vstack([num.mesh_of(b)[0].face_sets[f] + num.mesh_of(b)[1] for b, f in surfaces])
+        nodes = np.unique(slave_faces)
     else:
-        slaves, area, slave_faces, own = _slaves(num, pair, slave, X)
+        smesh, soff = num.mesh_of(slave[0])
+        slave_faces = smesh.face_sets[slave[1]] + soff if slave[1] in smesh.face_sets else None
+        nodes = smesh.node_sets[slave[1]] + soff if pair.type == "nts" else None
+    slaves, area, own = _slaves(num, pair, slave_faces, nodes, X)
     penalty = _auto_penalty(num, pair, slave, master) if pair.penalty == "auto" else pair.penalty
     if pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
         if slave_faces is None:

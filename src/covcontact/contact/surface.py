@@ -22,7 +22,6 @@ import numpy as np
 from numba import njit, prange
 
 from ..fem.cells import any_face
-from ..fem.quadrature import gauss_quad
 from ..fem.shapes import IDX, NODES, lagrange1d, shape_functions
 from .geometry import bilinear_coefficients
 
@@ -155,11 +154,7 @@ def tributary_area(x_nodes: np.ndarray, faces: np.ndarray, n_gauss: int | None =
     faces = np.asarray(faces, dtype=np.int64)
     x = np.asarray(x_nodes, dtype=np.float64)
     nen = faces.shape[1]
-    if nen in (4, 9):
-        pts, w = gauss_quad(n_gauss or (3 if nen == 4 else 4))
-        N, dN, _ = shape_functions("quad4" if nen == 4 else "quad9", pts)
-    else:
-        N, dN, w = any_face(nen)
+    N, dN, w = any_face(nen, n_gauss or (3 if nen == 4 else 4))
     xf = x[faces]
     t = np.einsum("pad,fai->fpdi", dN, xf)
     jac = np.linalg.norm(np.cross(t[:, :, 0, :], t[:, :, 1, :]), axis=2)  # (nf, npts)

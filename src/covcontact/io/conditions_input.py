@@ -15,12 +15,17 @@ class SetRefs:
     def __init__(self, bodies: list, rigid: list):
         self.bodies, self.rigid = bodies, rigid
 
-    def body_set(self, sec: Section, key: str, kind: str) -> tuple[str, str]:
-        ref = sec.get(key, "str")
-        bname, sname = split_ref(sec, key, ref)
+    def mesh(self, bname: str):
+        """The mesh of body ``bname`` (deformable or rigid meshed), or None."""
         owner = next((b.mesh for b in self.bodies if b.name == bname), None)
         if owner is None:
             owner = next((r.mesh for r in self.rigid if r.name == bname and r.mesh is not None), None)
+        return owner
+
+    def body_set(self, sec: Section, key: str, kind: str) -> tuple[str, str]:
+        ref = sec.get(key, "str")
+        bname, sname = split_ref(sec, key, ref)
+        owner = self.mesh(bname)
         if owner is None:
             names = [b.name for b in self.bodies] + [r.name for r in self.rigid if r.mesh is not None]
             sec.fail(f"{ref!r}: no body named {bname!r}{suggest(bname, names)} (bodies: {', '.join(names) or 'none'})",

@@ -18,8 +18,7 @@ def _slave_faces(c, sets) -> None:
     if not isinstance(ref, str):
         return  # body_set reports it
     bname, sname = split_ref(c, "slave", ref)
-    owner = next((b.mesh for b in sets.bodies if b.name == bname), None) or next(
-        (r.mesh for r in sets.rigid if r.name == bname and r.mesh is not None), None)
+    owner = sets.mesh(bname)
     if owner is not None and sname in owner.node_sets and sname not in owner.face_sets:
         faces = ", ".join(sorted(owner.face_sets)) or "none"
         c.fail(f"type = \"sts\" integrates over the slave's faces, but {ref!r} is a node set only: give a face set "
@@ -28,8 +27,7 @@ def _slave_faces(c, sets) -> None:
 
 def _quad_facets(c, sets, ref: tuple, key: str) -> None:
     """Contact facets are quad4 or quad9 (hexahedra's faces) for now: one line for the faces of other cells."""
-    owner = next((b.mesh for b in sets.bodies if b.name == ref[0]), None) or next(
-        (r.mesh for r in sets.rigid if r.name == ref[0] and r.mesh is not None), None)
+    owner = sets.mesh(ref[0])
     faces = owner.face_sets.get(ref[1]) if owner is not None else None
     if faces is not None and faces.shape[1] not in (4, 9):
         kind = {3: "tri3", 6: "tri6", 8: "quad8"}[faces.shape[1]]
@@ -48,8 +46,7 @@ def _self_surfaces(c, sets) -> tuple:
     for ref in refs:
         c.data["self"] = ref
         bname, sname = split_ref(c, "self", ref)
-        owner = next((b.mesh for b in sets.bodies if b.name == bname), None) or next(
-            (r.mesh for r in sets.rigid if r.name == bname and r.mesh is not None), None)
+        owner = sets.mesh(bname)
         if owner is not None and sname in owner.node_sets and sname not in owner.face_sets:
             c.fail(f"{ref!r} is a node set; self-contact needs the faces of the surface: give a face set of "
                    f"{bname!r} ({', '.join(sorted(owner.face_sets)) or 'none'})", "self")
@@ -147,8 +144,7 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                        "(weighting = \"area\" or leave weighting out)", "weighting")
             weighting = "area"
         if surfaces is None and (weighting == "area" or penalty == "auto"):
-            owner = next((b.mesh for b in sets.bodies if b.name == slave[0]), None) or next(
-                (r.mesh for r in rigid if r.name == slave[0] and r.mesh is not None), None)
+            owner = sets.mesh(slave[0])
             if owner is not None and slave[1] not in owner.face_sets:
                 faces = ", ".join(sorted(owner.face_sets)) or "none"
                 what = 'weighting = "area"' if weighting == "area" else 'penalty = "auto"'

@@ -162,16 +162,17 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
         cd.update(blk.solid.plastic_fields(est))
         cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
         blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
+    fields = model.contact.node_fields(state.contact)  # (gap, pressure, status) over the extended nodes
     if model.contact.passes:  # the slave surfaces with their facets' mean contact pressure
-        for faces, pressure in model.contact.facet_fields(state.contact):
+        for faces, pressure in model.contact.facet_fields(state.contact, fields[1]):
             keep = (faces < n).all(axis=1)
             if keep.any():
                 blocks.append(("quad4" if faces.shape[1] == 4 else "quad9", faces[keep],
                                {"contact_facet_pressure": pressure[keep]}))
     points = sysm.X[:n].copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
-    extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, model.contact.node_fields(state.contact))
-    pdata.update(model.contact.point_data(n, state.contact) if model.contact.passes else {})
+    extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, fields)
+    pdata.update(model.contact.point_data(n, state.contact, fields) if model.contact.passes else {})
     if extra_pts is not None and len(extra_pts):
         m = len(extra_pts)
         points = np.vstack([points, extra_pts])
