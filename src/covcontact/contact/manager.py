@@ -302,6 +302,8 @@ class ContactManager:
         if not self.reference:
             blocks.add(conn, R, K)
             return
+        if self.points.count and conn.max() >= self.points.offset:  # onto nodes first: a patch point of a rigid mesh
+            conn, R, K = self.points.expand(conn, R, K)
         for c, r, k in map_rigid_nodes(conn, R, K, self.owner, self.reference, self._poses, xe):
             blocks.add(c, r, k)
 
@@ -436,7 +438,7 @@ class ContactManager:
             nodes.append(self.points.nodes(p.slaves[act]))
             if p.surface is not None:
                 f = state.passes[k].facet[act]
-                nodes.append(p.surface.faces[f[f >= 0]].ravel())
+                nodes.append(self.points.nodes(p.surface.faces[f[f >= 0]].ravel()))
         nodes = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, int)
         nodes = nodes[nodes < self.N]
         return (3 * nodes[:, None] + np.arange(3)).ravel()

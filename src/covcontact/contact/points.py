@@ -14,46 +14,47 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..fem.quadrature import gauss_quad
-from ..fem.shapes import shape_functions
+from .facets import patch_gauss_points
 
 
 def default_order(nen: int) -> int:
-    """Gauss points per direction of a slave facet: 2 for quad4, 3 for quad9."""
-    return 2 if nen == 4 else 3
+    """Gauss points per direction of a slave facet (or of each quadrilateral of its patch): 2 for quad4 and tri3, 3
+    for quad9, tri6 and quad8."""
+    return 2 if nen in (3, 4) else 3
 
 
 def gauss_points(X: np.ndarray, faces: np.ndarray, order: int | None = None):
-    """The Gauss points of ``faces`` (nf, 4|9) at reference positions X.
+    """The Gauss points of ``faces`` (nf, nen) at reference positions X: ``order`` per direction on each facet (quad4,
+    quad9) or on each quadrilateral of its patch (tri3, tri6, quad8: :mod:`.facets`).
 
     Returns (conn (ng, nen) the facet nodes of each point, N (ng, nen) their shape values, weight (ng,) the
     reference area w_g J_g, facet (ng,) the index of the point's facet in ``faces``).
     """
     faces = np.asarray(faces, dtype=np.int64)
-    nen = faces.shape[1]
-    pts, w = gauss_quad(order or default_order(nen))
-    N, dN, _ = shape_functions("quad4" if nen == 4 else "quad9", pts)
-    t = np.einsum("pad,fai->fpdi", dN, X[faces])
-    jac = np.linalg.norm(np.cross(t[:, :, 0], t[:, :, 1]), axis=2)
-    return (np.repeat(faces, len(w), axis=0), np.tile(N, (len(faces), 1)), (jac * w).ravel(),
-            np.repeat(np.arange(len(faces)), len(w)))
+    N, weight = patch_gauss_points(X, faces, order or default_order(faces.shape[1]))
+    per = N.shape[0]
+    return (np.repeat(faces, per, axis=0), np.tile(N, (len(faces), 1)), weight.ravel(),
+            np.repeat(np.arange(len(faces)), per))
 
 
 class VirtualPoints:
-    """Every segment-to-surface point of a problem: ids ``offset + j`` (offset: the extended node count)."""
+    """Every point of a problem that is a fixed combination of nodes, ids ``offset + j`` (offset: the extended node
+    count): the segment-to-surface slave points, and the master points of the patches of tri3, tri6 and quad8 facets
+    (:mod:`.facets`, flagged ``master``)."""
 
     def __init__(self, offset: int):
         self.offset = offset
         self.conn = np.zeros((0, 9), dtype=np.int64)
         self.N = np.zeros((0, 9))
         self.nen = np.zeros(0, dtype=np.int64)
+        self.master = np.zeros(0, dtype=np.bool_)
 
     @property
     def count(self) -> int:
         return len(self.nen)
 
-    def add(self, conn: np.ndarray, N: np.ndarray) -> np.ndarray:
-        """Register points (conn, N); returns their ids."""
+    def add(self, conn: np.ndarray, N: np.ndarray, master: bool = False) -> np.ndarray:
+        """Register points (conn, N) (master: patch points of master facets); returns their ids."""
         m, nen = conn.shape
         c = np.zeros((m, 9), dtype=np.int64)
         c[:, :nen] = conn
@@ -64,6 +65,7 @@ class VirtualPoints:
         self.conn = np.vstack([self.conn, c])
         self.N = np.vstack([self.N, n])
         self.nen = np.concatenate([self.nen, np.full(m, nen)])
+        self.master = np.concatenate([self.master, np.full(m, master)])
         return ids
 
     def positions(self, xe: np.ndarray) -> np.ndarray:
@@ -75,7 +77,7 @@ class VirtualPoints:
         ids = np.asarray(ids, dtype=np.int64)
         node = ids < self.offset
         j = ids[~node] - self.offset
-        rows = [ids[node]] + [self.conn[j[self.nen[j] == k], :k].ravel() for k in (4, 9)]
+        rows = [ids[node]] + [self.conn[j[self.nen[j] == k], :k].ravel() for k in np.unique(self.nen[j])]
         return np.unique(np.concatenate(rows))
 
     def smooth(self, ids: np.ndarray, weight: np.ndarray, values: np.ndarray, n: int) -> tuple[np.ndarray,
@@ -92,8 +94,14 @@ class VirtualPoints:
 
     def expand(self, conn: np.ndarray, R: np.ndarray, K: np.ndarray | None):
         """An element block whose node lists hold points, with each point's rows and columns distributed to
-        its facet's nodes (x_g = sum_a N_a x_a). Columns of points must hold points in every row of the block
-        (one pass's slaves)."""
+        its facet's nodes (x_g = sum_a N_a x_a). Columns of slave points must hold points in every row of the block
+        (one pass's slaves). A block with master patch points is expanded row by row onto the distinct nodes of
+        each row (a patch quadrilateral's nodes are combinations of its face's few nodes)."""
+        conn = np.asarray(conn, dtype=np.int64)
+        virtual = conn >= self.offset
+        if virtual.any() and self.master[conn[virtual] - self.offset].any():
+            return _compact(conn, np.ascontiguousarray(R), None if K is None else np.ascontiguousarray(K),
+                            self.offset, self.conn, self.N, self.nen)
         cols = np.flatnonzero(conn[0] >= self.offset)
         for j in cols[::-1]:
             conn, R, K = self._expand_column(conn, R, K, int(j))
@@ -148,3 +156,77 @@ def _expand_matrices(K, j, Nv):
                     for k in range(3):
                         out[e, 3 * q + i, 3 * r + k] = w * K[e, 3 * oq + i, 3 * orr + k]
     return out
+
+
+@njit(cache=True)
+def _parents(conn, offset, vconn, vN, vnen):
+    """Per row e and column q the nodes (pidx, into the row's distinct nodes ``uniq``) and weights (pw) the column
+    stands for; returns (uniq (m, width) padded with the row's first node, pidx, pw, pn)."""
+    m, nc = conn.shape
+    uniq = np.empty((m, 9 * nc), dtype=np.int64)
+    count = np.zeros(m, dtype=np.int64)
+    pidx = np.zeros((m, nc, 9), dtype=np.int64)
+    pw = np.zeros((m, nc, 9))
+    pn = np.zeros((m, nc), dtype=np.int64)
+    for e in range(m):
+        for q in range(nc):
+            node = conn[e, q]
+            n_par = 1 if node < offset else vnen[node - offset]
+            for a in range(n_par):
+                if node < offset:
+                    par, w = node, 1.0
+                else:
+                    par, w = vconn[node - offset, a], vN[node - offset, a]
+                    if w == 0.0:
+                        continue
+                u = -1
+                for k in range(count[e]):
+                    if uniq[e, k] == par:
+                        u = k
+                        break
+                if u < 0:
+                    u = count[e]
+                    uniq[e, u] = par
+                    count[e] += 1
+                pidx[e, q, pn[e, q]] = u
+                pw[e, q, pn[e, q]] = w
+                pn[e, q] += 1
+    width = 1
+    for e in range(m):
+        width = max(width, count[e])
+    out = np.empty((m, width), dtype=np.int64)
+    for e in range(m):
+        for k in range(width):
+            out[e, k] = uniq[e, k] if k < count[e] else uniq[e, 0]
+    return out, pidx, pw, pn
+
+
+@njit(cache=True, parallel=True)
+def _compact_blocks(R, K, pidx, pw, pn, width, want_K):
+    m, nc = pn.shape
+    Ro = np.zeros((m, 3 * width))
+    Ko = np.zeros((m, 3 * width, 3 * width)) if want_K else np.zeros((1, 1, 1))
+    for e in prange(m):
+        for q in range(nc):
+            for a in range(pn[e, q]):
+                u = pidx[e, q, a]
+                wq = pw[e, q, a]
+                for i in range(3):
+                    Ro[e, 3 * u + i] += wq * R[e, 3 * q + i]
+                if not want_K:
+                    continue
+                for r in range(nc):
+                    for b in range(pn[e, r]):
+                        v = pidx[e, r, b]
+                        w = wq * pw[e, r, b]
+                        for i in range(3):
+                            for k in range(3):
+                                Ko[e, 3 * u + i, 3 * v + k] += w * K[e, 3 * q + i, 3 * r + k]
+    return Ro, Ko
+
+
+def _compact(conn, R, K, offset, vconn, vN, vnen):
+    """The block with every row expanded onto its distinct nodes: R_a = sum_v w_va R_v, K_ab = sum_vw w_va w_wb K_vw."""
+    out, pidx, pw, pn = _parents(conn, offset, vconn, vN, vnen)
+    Ro, Ko = _compact_blocks(R, np.zeros((1, 1, 1)) if K is None else K, pidx, pw, pn, out.shape[1], K is not None)
+    return out, Ro, (Ko if K is not None else None)

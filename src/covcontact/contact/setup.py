@@ -14,6 +14,7 @@ import numpy as np
 
 from .analytic import Cylinder, Plane, Sphere
 from .element import CASES
+from .facets import quad_patches
 from .points import VirtualPoints, gauss_points
 from .selfcontact import excluded_facets
 from .surface import MeshSurface, facet_sizes, tributary_area
@@ -204,10 +205,12 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         else:
             faces = mmesh.face_sets[master[1]] + moff
             h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)
-            p = Pass(name, slaves, eps, area, surface=MeshSurface(faces, n_nodes=num.n_ext), **kw)
+            quads, _ = quad_patches(faces, num.points)  # tri3, tri6, quad8 facets as quadrilaterals
+            p = Pass(name, slaves, eps, area, surface=MeshSurface(quads, n_nodes=num.n_ext + num.points.count), **kw)
     if pair.law == "tied":
-        xs = num.points.positions(X)[slaves - num.n_ext] if pair.type == "sts" else X[slaves]
-        p.tie_facet, p.tie_N = tie(X, p.surface, xs, pair.tie_tolerance)
+        Xe = np.vstack([X, num.points.positions(X)])
+        xs = Xe[slaves] if pair.type == "sts" else X[slaves]
+        p.tie_facet, p.tie_N = tie(Xe, p.surface, xs, pair.tie_tolerance)
         if not (p.tie_facet >= 0).any():
             raise ValueError(f"contact {pair.name}: no slave point lies within the tie tolerance of the master "
                              f"surface; the surfaces do not meet: check the geometry or raise tie_tolerance")

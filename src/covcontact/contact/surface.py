@@ -233,8 +233,12 @@ def _sizes_kernel(x, faces, out):
 
 
 def facet_sizes(x_nodes: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Characteristic size per facet: the longer of its two corner diagonals."""
+    """Characteristic size per facet: the longer of its two corner diagonals (quadrilaterals), its longest edge
+    (triangles: tri3, tri6)."""
     faces = np.ascontiguousarray(faces, dtype=np.int64)
+    if faces.shape[1] in (3, 6):
+        c = np.asarray(x_nodes)[faces[:, :3]]
+        return np.linalg.norm(c - np.roll(c, -1, axis=1), axis=2).max(axis=1)
     out = np.empty(faces.shape[0])
     if faces.shape[0]:
         _sizes_kernel(np.ascontiguousarray(x_nodes, dtype=np.float64), faces, out)

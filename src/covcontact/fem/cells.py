@@ -150,6 +150,8 @@ def rule(cell: str, npts: int | None = None) -> tuple[np.ndarray, np.ndarray]:
 #: face types of the cells' boundaries: corners counter-clockwise seen from outside, then the edge mid-nodes
 FACE_CELLS = ("tri3", "tri6", "quad8")
 FACE_NNODES = {"tri3": 3, "tri6": 6, "quad8": 8}
+#: the face type with this many nodes
+FACE_BY_NODES = {3: "tri3", 4: "quad4", 6: "tri6", 8: "quad8", 9: "quad9"}
 #: corner count of every face type (faces are matched by their corners)
 CORNERS = {"tri3": 3, "tri6": 3, "quad4": 4, "quad8": 4, "quad9": 4}
 

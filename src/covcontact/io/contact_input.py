@@ -26,14 +26,14 @@ def _slave_faces(c, sets) -> None:
 
 
 def _quad_facets(c, sets, ref: tuple, key: str) -> None:
-    """Contact facets are quad4 or quad9 (hexahedra's faces) for now: one line for the faces of other cells."""
+    """Self-contact surfaces are quad4 or quad9 (hexahedra's faces) for now: one line for the faces of other cells."""
     owner = sets.mesh(ref[0])
     faces = owner.face_sets.get(ref[1]) if owner is not None else None
     if faces is not None and faces.shape[1] not in (4, 9):
         kind = {3: "tri3", 6: "tri6", 8: "quad8"}[faces.shape[1]]
-        c.fail(f"'{ref[0]}.{ref[1]}' has {kind} faces ({owner.cell_type} cells); contact facets are quad4 and "
-               f"quad9 (hex8, hex27) for now: mesh the contact zone with hexahedra, or make this body the "
-               f"node-to-surface slave (its nodes) of a hexahedral master", key)
+        c.fail(f"'{ref[0]}.{ref[1]}' has {kind} faces ({owner.cell_type} cells); self-contact surfaces are quad4 "
+               f"and quad9 (hex8, hex27) for now: mesh the folding zone with hexahedra, or give the two sides as a "
+               f"slave and master pair", key)
 
 
 def _self_surfaces(c, sets) -> tuple:
@@ -85,9 +85,6 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
             else:
                 c.data["master"] = mref
                 master = sets.body_set(c, "master", "face")
-                _quad_facets(c, sets, master, "master")
-            if ctype == "sts" or c.has("two_pass") and c.data.get("two_pass") is True:
-                _quad_facets(c, sets, slave, "slave")
             if slave[0] == master[0] and slave[0] in {r.name for r in rigid}:
                 c.fail("slave and master are the same rigid body")
             if slave == master:

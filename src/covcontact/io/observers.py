@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 
+from ..fem.cells import FACE_BY_NODES
 from ..observer import Observer
 from . import checkpoint
 from .output import ResultWriter, _jsonable
@@ -167,7 +168,7 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
         for faces, pressure in model.contact.facet_fields(state.contact, fields[1]):
             keep = (faces < n).all(axis=1)
             if keep.any():
-                blocks.append(("quad4" if faces.shape[1] == 4 else "quad9", faces[keep],
+                blocks.append((FACE_BY_NODES[faces.shape[1]], faces[keep],
                                {"contact_facet_pressure": pressure[keep]}))
     points = sysm.X[:n].copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}

@@ -17,7 +17,8 @@ _HEX18_SPLIT = np.array([
     [7, 8, 6, 3, 16, 17, 15, 12],
 ])
 _VTK_NAME = {"hex8": "hexahedron", "hex27": "hexahedron27", "quad4": "quad", "quad9": "quad9", "tet4": "tetra",
-             "tet10": "tetra10", "wedge6": "wedge", "hex20": "hexahedron20"}
+             "tet10": "tetra10", "wedge6": "wedge", "hex20": "hexahedron20", "tri3": "triangle", "tri6": "triangle6",
+             "quad8": "quad8"}
 
 
 def atomic_write_text(path: Path, text: str) -> None:
