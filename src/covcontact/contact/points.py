@@ -83,9 +83,12 @@ class VirtualPoints:
     def smooth(self, ids: np.ndarray, weight: np.ndarray, values: np.ndarray, n: int) -> tuple[np.ndarray,
                                                                                               np.ndarray]:
         """Point values as a nodal field: the lumped L2 projection sum_g N_a w_g v_g / sum_g N_a w_g over
-        nodes 0..n-1; returns (field, mask of the nodes that carry points)."""
+        nodes 0..n-1; returns (field, mask of the nodes that carry points). On tri6 and quad8 facets, whose corner
+        shape functions integrate to zero or less, the weights are N_a^2 w_g (a positive weighted mean; a constant
+        field stays exact)."""
         j = np.asarray(ids, dtype=np.int64) - self.offset
-        wN = self.N[j] * weight[:, None]
+        Nj = self.N[j]
+        wN = np.where(np.isin(self.nen[j], (6, 8))[:, None], Nj * Nj, Nj) * weight[:, None]
         conn = self.conn[j].ravel()
         den = np.bincount(conn, wN.ravel(), minlength=n)[:n]
         num = np.bincount(conn, (wN * values[:, None]).ravel(), minlength=n)[:n]
