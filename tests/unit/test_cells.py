@@ -223,9 +223,9 @@ def test_pressure_on_their_faces(tmp_path, cell):
     assert ux.min() > 0 and ux.max() - ux.min() < 1e-9 * ux.max()
 
 
-def test_contact_facets_of_other_cells_are_refused(tmp_path):
-    """A tetrahedral body as a contact master: one line (contact facets are quad4 and quad9 for now); as the
-    node-to-surface slave of a hexahedral master it works."""
+def test_tetrahedral_contact_surfaces_are_read(tmp_path):
+    """A tetrahedral body as a contact master (tri6 facets) or slave loads; as a self-contact surface it is one line
+    (self-contact surfaces are quad4 and quad9 for now)."""
     from covcontact.io.loader import load_problem
     from covcontact.io.validate import InputError
 
@@ -235,16 +235,17 @@ def test_contact_facets_of_other_cells_are_refused(tmp_path):
              'mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 1.0, nx = 2, ny = 2, nz = 1, '
              'origin = [0.0, 0.0, 2.0] }\n')
     path = tmp_path / "p.toml"
-    path.write_text(base.replace("[[dirichlet]]", other + "\n[[dirichlet]]", 1) +
-                    '\n[[contact]]\nslave = "cap.zmin"\nmaster = "bar.zmax"\npenalty = 1.0e4\n')
+    two = base.replace("[[dirichlet]]", other + "\n[[dirichlet]]", 1)
+    path.write_text(two + '\n[[contact]]\nslave = "cap.zmin"\nmaster = "bar.zmax"\npenalty = 1.0e4\n')
+    prob = load_problem(path)
+    assert prob.contacts[0].master == ("bar", "zmax")
+    path.write_text(two + '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\ntype = "sts"\n')
+    assert load_problem(path).contacts[0].slave == ("bar", "zmax")
+    path.write_text(two + '\n[[contact]]\nself = "bar.zmax"\npenalty = 1.0e4\n')
     with pytest.raises(InputError) as err:
         load_problem(path)
-    assert "contact[0].master" in str(err.value) and "tri6 faces" in str(err.value)
+    assert "contact[0].self" in str(err.value) and "tri6 faces" in str(err.value)
     assert "\n" not in str(err.value)
-    path.write_text(base.replace("[[dirichlet]]", other + "\n[[dirichlet]]", 1) +
-                    '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\n')
-    prob = load_problem(path)
-    assert prob.contacts[0].slave == ("bar", "zmax")
 
 
 @pytest.mark.parametrize("cell, kind", [("tet10", "tetra10"), ("hex20", "hexahedron20"), ("wedge6", "wedge"),

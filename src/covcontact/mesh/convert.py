@@ -1,7 +1,8 @@
 """Hexahedral meshes turned into the other cells (tet4, tet10, wedge6, hex20), for the mesh generators and tests.
 
 hex8 -> tet4: six tetrahedra per brick around its diagonal 0-6 (neighbouring bricks of a structured mesh then
-share their faces' diagonals); tet4 -> tet10: a mid-node on every edge, shared; hex8 -> wedge6: two wedges per
+share their faces' diagonals); tet4 -> tet10: a mid-node on every edge, shared, and in every node set that holds
+both ends of its edge; hex8 -> wedge6: two wedges per
 brick, cut along the diagonal plane through edges 1-5 and 3-7; hex27 -> hex20: the face and body centres
 dropped. Node sets and element sets follow (an element set holds the new cells of its bricks), and face sets
 (the boundary faces of the new cells whose corners lie on the old set's faces: triangles, tri6 or quad8); a wedge
@@ -34,6 +35,7 @@ def convert(mesh: Mesh, cell: str) -> Mesh:
         cells, per = h[:, _WEDGES].reshape(-1, 6), 2
     else:
         cells, per = h[:, _TETS].reshape(-1, 4), 6
+    uniq = np.zeros((0, 2), dtype=np.int64)
     if cell == "tet10":
         key = np.sort(cells[:, _TET10_EDGES].reshape(-1, 2), axis=1)
         uniq, inv = np.unique(key, axis=0, return_inverse=True)
@@ -44,7 +46,10 @@ def convert(mesh: Mesh, cell: str) -> Mesh:
     new[used] = np.arange(used.size)
     out = Mesh(X[used], cell, new[cells])
     for name, nodes in mesh.node_sets.items():
-        k = new[nodes]
+        inside = np.zeros(len(mesh.points), dtype=bool)
+        inside[nodes] = True
+        mids = len(mesh.points) + np.flatnonzero(inside[uniq[:, 0]] & inside[uniq[:, 1]])  # edges within the set
+        k = new[np.concatenate([nodes, mids])]
         if np.any(k >= 0):
             out.add_node_set(name, k[k >= 0])
     for name, elems in mesh.element_sets.items():
