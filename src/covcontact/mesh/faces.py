@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..fem import cells as other_cells
 from ..fem.quadrature import default_rule
 from ..fem.shapes import NODES, shape_functions
 from .mesh import Mesh
@@ -150,13 +151,21 @@ def jacobian_determinants(mesh: Mesh, points: np.ndarray | None = None) -> np.nd
 
     The default points are the full Gauss rule of the cell type.
     """
-    pts = default_rule(mesh.cell_type)[0] if points is None else np.atleast_2d(points)
-    _, dN, _ = shape_functions(mesh.cell_type, pts)
+    if mesh.cell_type in other_cells.CELLS:
+        pts = other_cells.rule(mesh.cell_type)[0] if points is None else np.atleast_2d(points)
+        dN = other_cells.shapes(mesh.cell_type, pts)[1]
+    else:
+        pts = default_rule(mesh.cell_type)[0] if points is None else np.atleast_2d(points)
+        _, dN, _ = shape_functions(mesh.cell_type, pts)
     J = np.einsum("eai,paj->epij", mesh.points[mesh.cells], dN)
     return np.asarray(np.linalg.det(J))
 
 
+#: natural coordinates of the centre of each cell type (hexahedra: the origin)
+_CENTRE = {"tet4": (0.25, 0.25, 0.25), "tet10": (0.25, 0.25, 0.25), "wedge6": (1.0 / 3.0, 1.0 / 3.0, 0.0)}
+
+
 def check_orientation(mesh: Mesh) -> list[int]:
     """Elements whose Jacobian at the element centre is not positive (inverted node order)."""
-    det = jacobian_determinants(mesh, np.zeros((1, 3)))[:, 0]
+    det = jacobian_determinants(mesh, np.array([_CENTRE.get(mesh.cell_type, (0.0, 0.0, 0.0))]))[:, 0]
     return [int(e) for e in np.nonzero(~(det > 0.0))[0]]
