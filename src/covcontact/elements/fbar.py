@@ -47,6 +47,7 @@ from __future__ import annotations
 import numpy as np
 from numba import get_num_threads, njit, prange
 
+from ..fem import cells as other_cells
 from ..fem.quadrature import gauss_tensor
 from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
@@ -55,8 +56,10 @@ from ..materials.update import material_update
 from .base import ElementBody, add_cauchy_pk2, block_range, f_times_d, gather, inverse3
 from .solid import _jacobian, _kinematics
 
-__all__ = ["FBAR_FORMS", "FbarBody", "fbar_chunk", "fbar_gauss_fields"]
+__all__ = ["FBAR_CELLS", "FBAR_FORMS", "FbarBody", "fbar_chunk", "fbar_gauss_fields"]
 
+#: the cell types with an F-bar form
+FBAR_CELLS = ("hex8", "hex27", "hex20", "tet10")
 #: weak forms by name -> kernel code
 FBAR_FORMS = {"variational": 0, "spatial": 1}
 
@@ -438,24 +441,38 @@ class FbarBody(ElementBody):
 
     def __init__(self, cell_type: str, X: np.ndarray, cells: np.ndarray, material: Material,
                  form: str = "spatial", chunk_bytes: int = 32 * 2**20) -> None:
-        if cell_type not in ("hex8", "hex27"):
-            raise ValueError(f"F-bar elements are hex8 or hex27, got cell type {cell_type!r}")
+        if cell_type not in FBAR_CELLS:
+            raise ValueError(f"F-bar elements are {', '.join(FBAR_CELLS)}, got cell type {cell_type!r}")
         if form not in FBAR_FORMS:
             raise ValueError(f"unknown F-bar form {form!r}; known: {', '.join(FBAR_FORMS)}")
         super().__init__(cell_type, X, cells, material, chunk_bytes)
         self.form = form
-        n = 2 if cell_type == "hex8" else 3
-        self.points, self.weights = gauss_tensor((n, n, n))
-        #: 0: the centre's volume change (hex8, the paper's element); 1: J projected onto the linear functions
-        #: (1, xi, eta, zeta) of the element (hex27, the F-bar analogue of Q2/P1: a constant volume change per
-        #: element would leave the quadratic conformal modes, whose dilatation is linear, without stiffness)
+        if cell_type in other_cells.CELLS:
+            self.points, self.weights = other_cells.rule(cell_type)
+            self.dNdxi = np.ascontiguousarray(other_cells.shapes(cell_type, self.points)[1])
+        else:
+            n = 2 if cell_type == "hex8" else 3
+            self.points, self.weights = gauss_tensor((n, n, n))
+            self.dNdxi = np.ascontiguousarray(shape_functions(cell_type, self.points)[1])
+        #: 0: the centre's volume change (hex8, the paper's element); 1: J projected (L2 over the element) onto
+        #: the linear functions (1, xi, eta, zeta) (hex27 and hex20, the F-bar analogue of Q2/P1 and of C3D20H's
+        #: linear pressure: a constant volume change per element would leave the quadratic conformal modes,
+        #: whose dilatation is linear, without stiffness), or onto the constants (tet10, the mean dilatation:
+        #: the analogue of the stable P2/P0 pair; its four points would make a linear projection the identity)
         self.volume = 0 if cell_type == "hex8" else 1
-        self.Pv = (np.zeros((self.weights.size, 0)) if self.volume == 0 else
-                   np.ascontiguousarray(np.column_stack([np.ones(self.weights.size), self.points])))
+        if self.volume == 0:
+            self.Pv = np.zeros((self.weights.size, 0))
+        elif cell_type == "tet10":
+            self.Pv = np.ones((self.weights.size, 1))
+        else:
+            self.Pv = np.ascontiguousarray(np.column_stack([np.ones(self.weights.size), self.points]))
         if self.volume != 0 and form != "spatial":
-            raise ValueError("F-bar hex27 has the spatial form only (form = \"spatial\")")
-        self.dNdxi = np.ascontiguousarray(shape_functions(cell_type, self.points)[1])
-        self.dNc = np.ascontiguousarray(shape_functions(cell_type, np.zeros((1, 3)))[1][0])
+            raise ValueError(f"F-bar {cell_type} has the spatial form only (form = \"spatial\")")
+        if cell_type in other_cells.CELLS:  # the centre: the reference tetrahedron's centroid, the cube's origin
+            centre = np.full((1, 3), 0.25 if cell_type == "tet10" else 0.0)
+            self.dNc = np.ascontiguousarray(other_cells.shapes(cell_type, centre)[1][0])
+        else:
+            self.dNc = np.ascontiguousarray(shape_functions(cell_type, np.zeros((1, 3)))[1][0])
 
     @property
     def n_hist(self) -> int:

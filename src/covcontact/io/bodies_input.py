@@ -286,15 +286,18 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
             except ValueError as exc:
                 b.fail(str(exc), "options")
         elif formulation == "fbar":
-            if mesh.cell_type not in ("hex8", "hex27"):
-                b.fail(f"formulation = \"fbar\" needs hex8 or hex27 elements, got {mesh.cell_type}", "formulation")
+            from ..elements.fbar import FBAR_CELLS
+
+            if mesh.cell_type not in FBAR_CELLS:
+                b.fail(f"formulation = \"fbar\" needs {', '.join(FBAR_CELLS)} elements, got {mesh.cell_type}",
+                       "formulation")
             unknown = sorted(set(options) - {"form"})
             if unknown:
                 b.fail(f"unknown option {unknown[0]!r} for formulation = \"fbar\" (known: form)", "options")
             if options.get("form", "spatial") not in ("spatial", "variational"):
                 b.fail(f"form must be \"spatial\" or \"variational\", got {options['form']!r}", "options")
-            if mesh.cell_type == "hex27" and options.get("form", "spatial") != "spatial":
-                b.fail("F-bar hex27 has the spatial form only; leave out 'form'", "options")
+            if mesh.cell_type != "hex8" and options.get("form", "spatial") != "spatial":
+                b.fail(f"F-bar {mesh.cell_type} has the spatial form only; leave out 'form'", "options")
         elif options:
             unknown = sorted(set(options) - {"integration"})
             if unknown:
