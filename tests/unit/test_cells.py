@@ -224,8 +224,8 @@ def test_pressure_on_their_faces(tmp_path, cell):
 
 
 def test_tetrahedral_contact_surfaces_are_read(tmp_path):
-    """A tetrahedral body as a contact master (tri6 facets) or slave loads; as a self-contact surface it is one line
-    (self-contact surfaces are quad4 and quad9 for now)."""
+    """A tetrahedral body as a contact master (tri6 facets), slave or self-contact surface loads; area weighting on
+    its tri6 faces is one line."""
     from covcontact.io.loader import load_problem
     from covcontact.io.validate import InputError
 
@@ -242,10 +242,12 @@ def test_tetrahedral_contact_surfaces_are_read(tmp_path):
     path.write_text(two + '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\ntype = "sts"\n')
     assert load_problem(path).contacts[0].slave == ("bar", "zmax")
     path.write_text(two + '\n[[contact]]\nself = "bar.zmax"\npenalty = 1.0e4\n')
-    with pytest.raises(InputError) as err:
+    assert load_problem(path).contacts[0].self_surfaces == (("bar", "zmax"),)
+    path.write_text(two + '\n[[contact]]\nslave = "bar.zmax"\nmaster = "cap.zmin"\npenalty = 1.0e4\n'
+                    'weighting = "area"\n')
+    with pytest.raises(InputError) as err:  # tri6 corners have no tributary area
         load_problem(path)
-    assert "contact[0].self" in str(err.value) and "tri6 faces" in str(err.value)
-    assert "\n" not in str(err.value)
+    assert "contact[0]" in str(err.value) and "tri6" in str(err.value) and "\n" not in str(err.value)
 
 
 @pytest.mark.parametrize("cell, kind", [("tet10", "tetra10"), ("hex20", "hexahedron20"), ("wedge6", "wedge"),

@@ -207,3 +207,28 @@ def test_run_reports_triangle_facets(tmp_path):
     field, has = pts.smooth(ids, w, np.full(len(ids), 3.5), res.model.contact.num.n_ext)
     np.testing.assert_allclose(field[has], 3.5, rtol=1e-12)
     assert has.sum() == len(np.unique(res.model.contact.passes[0].slave_faces))
+
+
+@pytest.mark.parametrize("cell, extra", [("tet4", ""), ("tet10", 'type = "sts"\nfriction = 0.3')],
+                         ids=["tri3-nts", "tri6-sts-coulomb"])
+def test_self_contact_on_triangles(tmp_path, cell, extra):
+    """Two tetrahedral bodies' face sets merged into one self-contact surface act as the two-pass pair between them
+    (same iterations, displacements to round-off): a facet excluded for a slave takes all its patch quadrilaterals
+    with it. The exact tangent matches central differences."""
+    pair = 'slave = "punch.zmin"\nmaster = "base.zmax"'
+    text = TWO_BLOCKS.replace("BASE", cell).replace("PUNCH", cell).replace("EXTRA", extra + "\nweighting = \"area\""
+                                                                           if cell == "tet4" else extra)
+    runs = {}
+    for name, repl in (("self", 'self = ["punch.zmin", "base.zmax"]'), ("pair", pair + "\ntwo_pass = true")):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text.replace(pair, repl))
+        runs[name] = load_problem(path)
+    a = runs["self"].run(out=tmp_path / "self")
+    b = runs["pair"].run(out=tmp_path / "pair")
+    assert a.exit_code == b.exit_code == 0
+    assert [s["iterations"] for s in a.summary["steps"]] == [s["iterations"] for s in b.summary["steps"]]
+    np.testing.assert_allclose(a.u, b.u, rtol=0, atol=1e-9 * np.abs(b.u).max())
+    assert a.summary["steps"][-1]["pairs"]["contact1"]["active_contacts"] > 16
+    rep = check_tangent(runs["self"], step=3, columns=60)
+    assert rep["converged"] and rep["zones"]["contact"] > 0
+    assert rep["relative_error"] <= 1e-6, rep["relative_error"]

@@ -180,7 +180,7 @@ class ContactManager:
         t0 = time.perf_counter()
         if p.self_contact:  # every facet near the slave is a candidate: no walks into its own neighbourhood
             fn = facet_normals(xe, p.surface.faces)
-            own = slave_normals(xe, p.surface, p.slaves, p.slave_facet, fn)
+            own = slave_normals(xe, p.surface, p.slaves, p.own_patch, fn)
             ptr, fac = drop_excluded(np.ascontiguousarray(cand[0], np.int64), np.ascontiguousarray(cand[1], np.int64),
                                      p.exclude, own, fn, np.where(g0.facet >= 0, HOLD_COS, 0.0))
             res = project_slaves(xe, p.surface, xe[p.slaves], ptr, fac, g0.facet, g0.xi, max_hops=0,

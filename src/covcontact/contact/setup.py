@@ -14,7 +14,7 @@ import numpy as np
 
 from .analytic import Cylinder, Plane, Sphere
 from .element import CASES
-from .facets import quad_patches
+from .facets import patch_count, quad_patches
 from .points import VirtualPoints, gauss_points
 from .selfcontact import excluded_facets
 from .surface import MeshSurface, facet_sizes, tributary_area
@@ -55,6 +55,7 @@ class Pass:
     tie_N: np.ndarray | None = None        # law "tied": (ns, nen) master shape values at the tie point
     exclude: np.ndarray | None = None      # self-contact: (ns, k) facets each slave never touches, -1 padded
     slave_facet: np.ndarray | None = None  # sts: (ns,) each point's facet in slave_faces
+    own_patch: np.ndarray | None = None    # sts self-contact: (ns,) each point's patch quadrilateral in surface
 
     @property
     def ns(self) -> int:
@@ -71,7 +72,7 @@ class Pass:
     def subset(self, keep: np.ndarray) -> Pass:
         """The pass over slaves ``keep`` only (a rank's share of a distributed run)."""
         cut = {name: getattr(self, name)[keep] for name in ("slaves", "eps", "area", "eps_t", "tie_facet", "tie_N",
-                                                            "exclude", "slave_facet") if getattr(self, name) is not None}
+                                                            "exclude", "slave_facet", "own_patch") if getattr(self, name) is not None}
         return dataclasses.replace(self, global_index=keep, **cut)
 
 
@@ -191,11 +192,18 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
           "slave_body": slave[0] if surfaces is None else "", "master_body": master[0] if surfaces is None else "",
           "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own}
     if surfaces is not None:
-        surface = MeshSurface(slave_faces, n_nodes=num.n_ext)
+        quads, _ = quad_patches(slave_faces, num.points)  # tri3, tri6, quad8 facets as quadrilaterals
+        surface = MeshSurface(quads, n_nodes=num.n_ext + num.points.count)
         h = float(np.mean(facet_sizes(X, slave_faces))) / np.sqrt(2.0)
         exclude = excluded_facets(slave_faces, num.n_ext, slave_nodes=None if own is not None else slaves,
                                   slave_facets=own)
+        nsub = patch_count(slave_faces.shape[1])  # a facet excluded: all its patch quadrilaterals
+        exclude = np.where(exclude[:, :, None] >= 0, exclude[:, :, None] * nsub + np.arange(nsub),
+                           -1).reshape(len(exclude), -1)
         p = Pass(name, slaves, eps, area, surface=surface, exclude=exclude, **kw)
+        if own is not None:  # each point's own patch quadrilateral (its normal is the point's own)
+            per = len(own) // max(len(slave_faces), 1)
+            p.own_patch = own * nsub + np.arange(len(own)) % per // (per // nsub)
     else:
         mmesh, moff = num.mesh_of(master[0])
         if mmesh is None:

@@ -25,17 +25,6 @@ def _slave_faces(c, sets) -> None:
                f"of {bname!r} ({faces})", "slave")
 
 
-def _quad_facets(c, sets, ref: tuple, key: str) -> None:
-    """Self-contact surfaces are quad4 or quad9 (hexahedra's faces) for now: one line for the faces of other cells."""
-    owner = sets.mesh(ref[0])
-    faces = owner.face_sets.get(ref[1]) if owner is not None else None
-    if faces is not None and faces.shape[1] not in (4, 9):
-        kind = {3: "tri3", 6: "tri6", 8: "quad8"}[faces.shape[1]]
-        c.fail(f"'{ref[0]}.{ref[1]}' has {kind} faces ({owner.cell_type} cells); self-contact surfaces are quad4 "
-               f"and quad9 (hex8, hex27) for now: mesh the folding zone with hexahedra, or give the two sides as a "
-               f"slave and master pair", key)
-
-
 def _self_surfaces(c, sets) -> tuple:
     """The face sets of a self-contact: one "BODY.FACESET" or a list of them (merged into one surface)."""
     val = c.get("self", "any")
@@ -51,7 +40,6 @@ def _self_surfaces(c, sets) -> tuple:
             c.fail(f"{ref!r} is a node set; self-contact needs the faces of the surface: give a face set of "
                    f"{bname!r} ({', '.join(sorted(owner.face_sets)) or 'none'})", "self")
         out.append(sets.body_set(c, "self", "face"))
-        _quad_facets(c, sets, out[-1], "self")
     if len(set(out)) != len(out):
         c.fail("a face set is listed twice", "self")
     return tuple(out)
