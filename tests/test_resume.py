@@ -116,6 +116,22 @@ def self_friction(tmp: Path) -> Path:
     return path
 
 
+def two_materials(tmp: Path) -> Path:
+    """The two blocks with the base in two materials by element set: an elastic lower layer and a J2 upper layer
+    that yields under the punch (the composite body's history)."""
+    text = (EXAMPLES / "contact" / "two_blocks.toml").read_text()
+    base = 'mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 4, ny = 4, nz = 2, origin = [-1.0, -1.0, -0.5] }\n'
+    assert base in text
+    text = text.replace(base, base + 'materials = { top = { model = "j2", E = 1000.0, nu = 0.3, yield_stress = 5.0, '
+                        'hardening = { law = "linear", modulus = 100.0 } } }\n'
+                        '[bodies.cells]\ntop = { box = [[-2.0, -2.0, -0.25], [2.0, 2.0, 0.1]] }\n', 1)
+    text = text.replace("value = [0.0, 0.0, -0.02]", "value = [0.0, 0.0, -0.04]").replace("[steps]\ncount = 2",
+                                                                                         _steps(12))
+    path = tmp / "two_materials.toml"
+    path.write_text(text)
+    return path
+
+
 def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
@@ -160,9 +176,9 @@ def _has_gamg() -> bool:
 
 
 @pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks,
-                                  sts_friction, self_friction],
+                                  sts_friction, self_friction, two_materials],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction"])
+                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")

@@ -19,13 +19,15 @@ TANGENT_CASES = ("a", "b", "c", "d", "exact")
 
 @dataclass
 class Body:
-    """A deformable body: a mesh, its element formulation and its material."""
+    """A deformable body: a mesh, its element formulation and its material (or a material per element set,
+    ``materials``, bonded through the shared nodes; the cells in no set take ``material``)."""
 
     name: str
     mesh: Mesh
     material: Any
     formulation: str = "solid"
     options: dict = field(default_factory=dict)
+    materials: dict = field(default_factory=dict)  # element set -> material (the other cells take ``material``)
 
 
 @dataclass

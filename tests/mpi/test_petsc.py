@@ -104,8 +104,16 @@ def test_serial_petsc_matches_default(tmp_path):
     (TWO_BLOCKS, "petsc-gamg", 1e-8),   # CG + GAMG with rigid-body modes
     ("sts", "petsc", 1e-7),             # segment-to-surface with friction: points split by their facet's owner
     ("self", "petsc", 1e-7),            # self-contact of both blocks' faces merged, with friction
-], ids=["deformable-pair", "friction", "gamg", "sts-friction", "self-contact"])
+    ("materials", "petsc", 1e-7),       # the base in two materials by element set, one of them plastic
+], ids=["deformable-pair", "friction", "gamg", "sts-friction", "self-contact", "two-materials"])
 def test_two_ranks_match_serial(tmp_path, path, solver, tol):
+    if path == "materials":  # the resume test's set-up (tests/test_resume.py, two_materials)
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location("resume_setups", ROOT / "tests" / "test_resume.py")
+        setups = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(setups)
+        path = setups.two_materials(tmp_path)
     if path in ("sts", "self"):
         text = TWO_BLOCKS.read_text()
         pair = 'slave = "punch.zmin"\nmaster = "base.zmax"\n'

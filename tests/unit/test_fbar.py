@@ -340,7 +340,7 @@ def test_reference_checks_and_arguments():
     body = FbarBody("hex8", X, cells, mat)
     assert body.form == "spatial" and not body.symmetric_tangent
     assert FbarBody("hex8", X, cells, mat, form="variational").symmetric_tangent
-    with pytest.raises(ValueError, match="hex8 or hex27"):
+    with pytest.raises(ValueError, match="F-bar elements are hex8, hex27, hex20, tet10"):
         FbarBody("hex18", X, cells, mat)
     X27, cells27 = two_elements(seed=5, cell="hex27")
     with pytest.raises(ValueError, match="spatial form only"):

@@ -87,6 +87,41 @@ def face_load_vector(X: np.ndarray, faces: np.ndarray, area_only: bool = False) 
     return out
 
 
+def _element_body(body, material, cells: np.ndarray):
+    """The element body of ``body``'s formulation over ``cells`` with ``material``."""
+    if body.formulation == "solid-shell":
+        from ..elements.solidshell import SolidShellBody
+
+        return SolidShellBody(body.mesh.cell_type, body.mesh.points, cells, material, **body.options)
+    if body.formulation == "fbar":
+        from ..elements.fbar import FbarBody
+
+        return FbarBody(body.mesh.cell_type, body.mesh.points, cells, material, **body.options)
+    return SolidBody(body.mesh.cell_type, body.mesh.points, cells, material, **body.options)
+
+
+def make_solid(body, elements: np.ndarray | None = None):
+    """The element body of a ``covcontact.problem.Body`` over its cells ``elements`` (default all): one material,
+    or a :class:`covcontact.elements.composite.CompositeBody` of one part per material of ``body.materials``."""
+    cells = body.mesh.cells if elements is None else body.mesh.cells[elements]
+    if not body.materials:
+        return _element_body(body, body.material, cells)
+    owner = np.full(body.mesh.n_cells, -1)
+    for k, name in enumerate(body.materials):
+        owner[body.mesh.element_sets[name]] = k
+    owner = owner if elements is None else owner[elements]
+    parts = []
+    for k, material in enumerate([body.material, *body.materials.values()]):
+        idx = np.flatnonzero(owner == k - 1)
+        if idx.size:
+            parts.append((idx, _element_body(body, material, cells[idx])))
+    if len(parts) <= 1:  # one material over these cells (in their order)
+        return parts[0][1] if parts else _element_body(body, body.material, cells)
+    from ..elements.composite import CompositeBody
+
+    return CompositeBody(cells, parts)
+
+
 class System:
     """Global arrays of deformable bodies, their loads and Dirichlet conditions, and the reference nodes of
     the rigid bodies with free components: ``System(bodies, rigid, loads, dirichlet)`` (``covcontact.problem``
@@ -98,19 +133,7 @@ class System:
         self.blocks: list[BodyBlock] = []
         offset = 0
         for body in bodies:
-            if body.formulation == "solid-shell":
-                from ..elements.solidshell import SolidShellBody
-
-                solid = SolidShellBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
-                                       **body.options)
-            elif body.formulation == "fbar":
-                from ..elements.fbar import FbarBody
-
-                solid = FbarBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
-                                 **body.options)
-            else:
-                solid = SolidBody(body.mesh.cell_type, body.mesh.points, body.mesh.cells, body.material,
-                                  **body.options)
+            solid = make_solid(body)
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
             offset += body.mesh.n_nodes
         self.n_deformable = offset

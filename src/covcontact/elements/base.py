@@ -326,16 +326,21 @@ class ElementBody:
     def stress(self, u: np.ndarray, state: dict | None = None) -> SolidStress:
         """Element-averaged Cauchy stress, S and Green-Lagrange strain; nodal averaged Cauchy stress at
         displacement u and element history ``state`` (default: the reference state)."""
-        f = self._fields(u, 2, 18, state)
-        cauchy = np.ascontiguousarray(f[:, :6])
-        count = np.bincount(self.cells.ravel(), minlength=self.n_nodes).astype(np.float64)
-        nodal = np.empty((self.n_nodes, 6))
-        for I in range(6):
-            nodal[:, I] = np.bincount(self.cells.ravel(), weights=np.repeat(cauchy[:, I], self.nen),
-                                      minlength=self.n_nodes)
-        nodal /= np.maximum(count, 1.0)[:, None]
-        s = cauchy
-        vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)
-                     + 3.0 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
-        return SolidStress(cauchy=cauchy, pk2=np.ascontiguousarray(f[:, 6:12]),
-                           green_lagrange=np.ascontiguousarray(f[:, 12:]), cauchy_nodal=nodal, von_mises=vm)
+        return stress_from_fields(self._fields(u, 2, 18, state), self.cells, self.n_nodes)
+
+
+def stress_from_fields(f: np.ndarray, cells: np.ndarray, n_nodes: int) -> SolidStress:
+    """The stresses of the element fields ``f`` (nelem, 18: Cauchy, S, Green-Lagrange, Voigt): the Cauchy stress
+    averaged at the nodes of ``cells`` and the von Mises stress."""
+    nen = cells.shape[1]
+    cauchy = np.ascontiguousarray(f[:, :6])
+    count = np.bincount(cells.ravel(), minlength=n_nodes).astype(np.float64)
+    nodal = np.empty((n_nodes, 6))
+    for I in range(6):
+        nodal[:, I] = np.bincount(cells.ravel(), weights=np.repeat(cauchy[:, I], nen), minlength=n_nodes)
+    nodal /= np.maximum(count, 1.0)[:, None]
+    s = cauchy
+    vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)
+                 + 3.0 * (s[:, 3] ** 2 + s[:, 4] ** 2 + s[:, 5] ** 2))
+    return SolidStress(cauchy=cauchy, pk2=np.ascontiguousarray(f[:, 6:12]),
+                       green_lagrange=np.ascontiguousarray(f[:, 12:]), cauchy_nodal=nodal, von_mises=vm)

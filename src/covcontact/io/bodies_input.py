@@ -145,6 +145,41 @@ def read_material(sec: Section):
         sec.fail(str(exc))
 
 
+def user_cells(sec: Section | None, mesh) -> None:
+    """Element sets defined in the input: ``cells = { NAME = { box = [[x0, y0, z0], [x1, y1, z1]] } }`` (the cells
+    whose centroid lies inside the box, bounds included) or ``{ elements = [i, j, ...] }`` (cell numbers, from 0)."""
+    if sec is None:
+        return
+    for name in list(sec.data):
+        if name in mesh.element_sets:
+            sec.fail(f"an element set {name!r} exists already (from the mesh)", name)
+        d = sec.get(name, "table")
+        given = [k for k in ("box", "elements") if d.has(k)]
+        if len(given) != 1:
+            d.fail("give exactly one of 'box' or 'elements'")
+        if given[0] == "elements":
+            raw = d.get("elements", "any")
+            if not isinstance(raw, list) or not raw or not all(isinstance(v, int) and not isinstance(v, bool)
+                                                               for v in raw):
+                d.fail("must be a non-empty array of cell numbers", "elements")
+            ids = np.unique(np.asarray(raw, dtype=np.int64))
+            if ids.min() < 0 or ids.max() >= mesh.n_cells:
+                d.fail(f"cell numbers must lie in [0, {mesh.n_cells - 1}]", "elements")
+        else:
+            box = d.get("box", "any")
+            if not (isinstance(box, list) and len(box) == 2 and all(
+                    isinstance(q, list) and len(q) == 3 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                                for v in q) for q in box)):
+                d.fail("must be [[x0, y0, z0], [x1, y1, z1]]", "box")
+            lo, hi = np.asarray(box, dtype=float)
+            c = mesh.points[mesh.cells].mean(axis=1)
+            ids = np.flatnonzero(np.all((c >= lo) & (c <= hi), axis=1))
+            if ids.size == 0:
+                d.fail("no cell centroid lies inside this box", "box")
+        d.done()
+        mesh.element_sets[name] = ids
+
+
 def user_sets(sec: Section | None, mesh) -> None:
     """Node sets defined in the input: ``sets = { NAME = { box = [[x0, y0, z0], [x1, y1, z1]] } }`` (the nodes
     inside an axis-aligned box, bounds included), ``{ closest = [x, y, z] }`` or ``{ closest = [[...], ...] }``
@@ -262,6 +297,29 @@ def user_faces(sec: Section | None, mesh) -> None:
         mesh.add_node_set(name, chosen.ravel())
 
 
+def _materials_by_set(sec: Section, mesh, default) -> dict:
+    """``materials = { SET = {...}, ... }``: a material per element set of the body (the cells in no set take
+    ``material``). One line for an unknown set, a cell in two sets, or cells left without a material."""
+    out = {}
+    owner = np.full(mesh.n_cells, -1)
+    for k, name in enumerate(list(sec.data)):
+        if name not in mesh.element_sets:
+            sec.fail(f"no element set {name!r}{suggest(name, mesh.element_sets)} in the body's mesh (known: "
+                     f"{', '.join(sorted(mesh.element_sets)) or 'none'})", name)
+        cells = np.asarray(mesh.element_sets[name], dtype=np.int64)
+        twice = cells[owner[cells] >= 0]
+        if twice.size:
+            other = list(out)[int(owner[twice[0]])]
+            sec.fail(f"element set {name!r} shares {twice.size} cells with {other!r}: give every cell one "
+                     f"material", name)
+        owner[cells] = k
+        out[name] = read_material(sec.get(name, "table"))
+    if default is None and np.any(owner < 0):
+        sec.fail(f"{int(np.count_nonzero(owner < 0))} of {mesh.n_cells} cells lie in none of these element sets: "
+                 f"give a 'material' for them or add their set")
+    return out
+
+
 def read_bodies(top: Section, base: Path) -> list[Body]:
     """Every ``[[bodies]]`` entry (at least one); ``base``: the folder mesh files are relative to."""
     bodies: list[Body] = []
@@ -273,10 +331,13 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
         formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell", "fbar"))
         options = b.get("options", "table", None)
         options = options.rest() if options is not None else {}
-        material = read_material(b.get("material", "table"))
+        material = read_material(b.get("material", "table")) if b.has("material") or not b.has("materials") else None
+        by_set = b.get("materials", "table", None)
         mesh = build_mesh(b.get("mesh", "table"), base, element)
+        user_cells(b.get("cells", "table", None), mesh)
         user_sets(b.get("sets", "table", None), mesh)
         user_faces(b.get("faces", "table", None), mesh)
+        materials = _materials_by_set(by_set, mesh, material) if by_set is not None else {}
         b.done()
         if formulation == "solid-shell":
             from ..elements.solidshell import check_options
@@ -307,7 +368,9 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
             if options["integration"] == "reduced" and mesh.cell_type != "hex20":
                 b.fail(f"integration = \"reduced\" is for hex20 elements (as C3D20R), not {mesh.cell_type}: the "
                        f"others would have zero-energy modes", "options")
-        bodies.append(Body(bname, mesh, material, formulation, options))
+        if materials and material is None:  # every cell in a set: the first set's material stands for the body
+            material = next(iter(materials.values()))
+        bodies.append(Body(bname, mesh, material, formulation, options, materials))
     if not bodies:
         top.fail("at least one [[bodies]] entry is needed")
     return bodies

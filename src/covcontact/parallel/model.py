@@ -17,9 +17,8 @@ import scipy.sparse as sp
 from numba import njit
 
 from ..assembly.pattern import Pattern
-from ..assembly.system import BodyBlock, InvertedElementError, System
+from ..assembly.system import BodyBlock, InvertedElementError, System, make_solid
 from ..elements.base import SolidStress
-from ..elements.solid import SolidBody
 from ..solvers.model import Model
 from ..solvers.stages import StagePlan
 from ..solvers.state import State
@@ -190,18 +189,6 @@ class PartBody:
         return out
 
 
-def _make_body(body, cells: np.ndarray):
-    if body.formulation == "solid-shell":
-        from ..elements.solidshell import SolidShellBody
-
-        return SolidShellBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
-    if body.formulation == "fbar":
-        from ..elements.fbar import FbarBody
-
-        return FbarBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
-    return SolidBody(body.mesh.cell_type, body.mesh.points, cells, body.material, **body.options)
-
-
 class DistributedSystem(System):
     """The System of one rank: global numbering, loads and Dirichlet data; local elements only.
 
@@ -235,7 +222,7 @@ class DistributedSystem(System):
         local_cells = []
         for off, body, p in zip(offsets, bodies, parts):
             elements = np.flatnonzero(p == rank)
-            local = _make_body(body, body.mesh.cells[elements])
+            local = make_solid(body, elements)
             self.blocks.append(BodyBlock(body.name, off, body.mesh.n_nodes,
                                          PartBody(local, elements, body.mesh.n_cells, comm)))
             local_cells.append(body.mesh.cells[elements] + off)
