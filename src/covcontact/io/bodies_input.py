@@ -238,9 +238,9 @@ def user_faces(sec: Section | None, mesh) -> None:
     same name (its nodes), as the generators' sets are."""
     if sec is None:
         return
-    from ..mesh.faces import boundary_faces, face_normals
+    from ..mesh.faces import all_boundary_faces, face_normals
 
-    faces, elem, _ = boundary_faces(mesh)
+    every = all_boundary_faces(mesh)
     X = mesh.points
     for name in list(sec.data):
         if name in mesh.face_sets or name in mesh.node_sets:
@@ -261,7 +261,7 @@ def user_faces(sec: Section | None, mesh) -> None:
                 d.fail("needs 'normal', the direction the angle is measured from", "angle")
             if not any(d.has(k) for k in FACE_FILTERS):
                 d.fail("give 'box', 'normal' (with 'angle'), 'cells', any of them together, or 'union'")
-            keep = np.ones(len(faces), dtype=bool)
+            box = direction = cname = None
             if d.has("box"):
                 box = d.get("box", "any")
                 ok = isinstance(box, list) and len(box) == 2 and all(isinstance(q, list) and len(q) == 3 and all(
@@ -270,9 +270,7 @@ def user_faces(sec: Section | None, mesh) -> None:
                 if not ok:
                     d.fail("must be two points [[x0, y0, z0], [x1, y1, z1]]", "box")
                 P = np.asarray(box, dtype=float)
-                lo, hi = P.min(axis=0), P.max(axis=0)
-                inside = np.all((X >= lo) & (X <= hi), axis=1)
-                keep &= np.all(inside[faces], axis=1)
+                inside = np.all((X >= P.min(axis=0)) & (X <= P.max(axis=0)), axis=1)
             if d.has("normal"):
                 direction = np.asarray(d.get("normal", "vector"))
                 if not np.linalg.norm(direction) > 0.0:
@@ -280,17 +278,30 @@ def user_faces(sec: Section | None, mesh) -> None:
                 angle = d.get("angle", "float", 10.0, positive=True)
                 if angle > 180.0:
                     d.fail(f"must lie in (0, 180] degrees, got {angle:g}", "angle")
-                n = face_normals(X, faces)
-                cosine = n @ direction / np.maximum(np.linalg.norm(n, axis=1) * np.linalg.norm(direction), 1e-300)
-                keep &= cosine >= np.cos(np.radians(angle)) - 1e-12
             if d.has("cells"):
                 cname = d.get("cells", "str")
                 if cname not in mesh.element_sets:
                     d.fail(f"no element set {cname!r}{suggest(cname, mesh.element_sets)} (known: "
                            f"{', '.join(sorted(mesh.element_sets)) or 'none'})", "cells")
-                keep &= np.isin(elem, mesh.element_sets[cname])
             d.done()
-            chosen = faces[keep]
+            picked = []
+            for faces, elem, _ in every:  # one face type, or a wedge mesh's triangles and quadrilaterals
+                keep = np.ones(len(faces), dtype=bool)
+                if box is not None:
+                    keep &= np.all(inside[faces], axis=1)
+                if direction is not None:
+                    n = face_normals(X, faces)
+                    cosine = n @ direction / np.maximum(np.linalg.norm(n, axis=1) * np.linalg.norm(direction),
+                                                        1e-300)
+                    keep &= cosine >= np.cos(np.radians(angle)) - 1e-12
+                if cname is not None:
+                    keep &= np.isin(elem, mesh.element_sets[cname])
+                if keep.any():
+                    picked.append(faces[keep])
+            if len(picked) > 1:
+                sec.fail(f"these filters pick {len(picked[0])} triangles and {len(picked[1])} quadrilaterals of the "
+                         f"wedges; a face set holds faces of one type: narrow the filters (normal, box)", name)
+            chosen = picked[0] if picked else np.zeros((0, 3), dtype=np.int64)
         if len(chosen) == 0:
             sec.fail("no boundary face passes these filters", name)
         mesh.add_face_set(name, chosen)

@@ -14,6 +14,8 @@ from pathlib import Path
 HEX_FACES = {1: (0, 1, 2, 3), 2: (4, 7, 6, 5), 3: (0, 4, 5, 1), 4: (1, 5, 6, 2), 5: (2, 6, 7, 3), 6: (3, 7, 4, 0)}
 #: the corners of the faces S1 .. S4 of a tetrahedron (C3D4, C3D10), in the Abaqus face numbering
 TET_FACES = {1: (0, 1, 2), 2: (0, 3, 1), 3: (1, 3, 2), 4: (2, 3, 0)}
+#: the corners of the faces S1 .. S5 of a wedge (C3D6): the triangles 1-2-3 and 4-6-5, the quadrilaterals
+WEDGE_FACES = {1: (0, 1, 2), 2: (3, 5, 4), 3: (0, 3, 4, 1), 4: (1, 4, 5, 2), 5: (2, 5, 3, 0)}
 
 
 def _options(line: str) -> dict[str, str]:

@@ -5,8 +5,9 @@ share their faces' diagonals); tet4 -> tet10: a mid-node on every edge, shared, 
 both ends of its edge; hex8 -> wedge6: two wedges per
 brick, cut along the diagonal plane through edges 1-5 and 3-7; hex27 -> hex20: the face and body centres
 dropped. Node sets and element sets follow (an element set holds the new cells of its bricks), and face sets
-(the boundary faces of the new cells whose corners lie on the old set's faces: triangles, tri6 or quad8); a wedge
-mesh has no face sets (its faces mix triangles and quadrilaterals).
+(the boundary faces of the new cells whose corners lie on the old set's faces: triangles, tri6 or quad8; on wedges
+the triangles or the quadrilaterals, whichever the set holds: a block's zmin and zmax are triangles, its sides
+quadrilaterals).
 """
 
 from __future__ import annotations
@@ -54,10 +55,13 @@ def convert(mesh: Mesh, cell: str) -> Mesh:
             out.add_node_set(name, k[k >= 0])
     for name, elems in mesh.element_sets.items():
         out.element_sets[name] = (per * np.asarray(elems)[:, None] + np.arange(per)).ravel()
-    if cell in FACE_TYPE:
+    if cell in FACE_TYPE or cell == "wedge6":
         for name, faces in mesh.face_sets.items():
             corners = new[np.unique(faces[:, :4])]
-            f = faces_on_nodes(out, corners[corners >= 0], corners_only=True)
+            try:
+                f = faces_on_nodes(out, corners[corners >= 0], corners_only=True)
+            except ValueError:  # wedges: triangles and quadrilaterals on these nodes (no face set of one type)
+                continue
             if len(f):
                 out.add_face_set(name, f)
     return out

@@ -74,9 +74,23 @@ def _tet_faces(quadratic: bool) -> np.ndarray:
     return np.array(rows, dtype=np.int64)
 
 
+def _outward(nat: np.ndarray, rows: list[list[int]]) -> np.ndarray:
+    """Face corner rows of a cell with natural node coordinates ``nat``, each turned so that its normal
+    (first three corners' cross product) points away from the cell's centroid."""
+    centre = nat.mean(axis=0)
+    out = []
+    for row in rows:
+        a, b, c = nat[row[0]], nat[row[1]], nat[row[2]]
+        out.append(row if np.dot(np.cross(b - a, c - a), a - centre) > 0 else [row[0]] + row[1:][::-1])
+    return np.array(out, dtype=np.int64)
+
+
 FACES["tet4"] = _tet_faces(False)
 FACES["tet10"] = _tet_faces(True)
 FACES["hex20"] = FACES["hex27"][:, :8].copy()  # the hex27's faces without their centres (hex20 = its first 20 nodes)
+#: wedge6 faces by type: the triangles 0-1-2 and 3-4-5, the quadrilaterals through the edges 0-3, 1-4, 2-5
+WEDGE_FACES = {"tri3": _outward(other_cells.NODES["wedge6"], [[0, 1, 2], [3, 4, 5]]),
+               "quad4": _outward(other_cells.NODES["wedge6"], [[0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]])}
 
 
 def _corners(ftype_nodes: int) -> int:
@@ -84,14 +98,21 @@ def _corners(ftype_nodes: int) -> int:
     return 3 if ftype_nodes in (3, 6) else 4
 
 
-def boundary_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Faces used by exactly one element (for hex18 only the t = -1 and t = +1 faces).
+def _tables(mesh: Mesh) -> list[np.ndarray]:
+    """The face tables of the mesh's cell type (wedges: the triangles', then the quadrilaterals')."""
+    return list(WEDGE_FACES.values()) if mesh.cell_type == "wedge6" else [FACES[mesh.cell_type]]
+
+
+def boundary_faces(mesh: Mesh, nfn: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Faces used by exactly one element (for hex18 only the t = -1 and t = +1 faces); of a wedge mesh those of
+    ``nfn`` nodes (3: triangles, 4: quadrilaterals; default the triangles).
 
     Returns:
-        faces (nf, 4 | 9) outward ordered, elem (nf,) owning element, local_face (nf,) row of
-        ``FACES[mesh.cell_type]``.
+        faces (nf, nfn) outward ordered, elem (nf,) owning element, local_face (nf,) row of the cell type's face
+        table (``FACES[mesh.cell_type]``, ``WEDGE_FACES``).
     """
-    table = FACES[mesh.cell_type]
+    tables = _tables(mesh)
+    table = next((t for t in tables if t.shape[1] == nfn), tables[0]) if nfn is not None else tables[0]
     nlf, nfn = table.shape
     allf = mesh.cells[:, table].reshape(-1, nfn)
     corners = np.sort(allf[:, :_corners(nfn)], axis=1)
@@ -100,22 +121,36 @@ def boundary_faces(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.ascontiguousarray(allf[idx]), idx // nlf, idx % nlf
 
 
+def all_boundary_faces(mesh: Mesh) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """:func:`boundary_faces` of every face type of the mesh (one, or two for wedges)."""
+    return [boundary_faces(mesh, t.shape[1]) for t in _tables(mesh)]
+
+
 def faces_on_nodes(mesh: Mesh, node_ids: np.ndarray, corners_only: bool = False) -> np.ndarray:
-    """Boundary faces (outward ordered) whose nodes (or corners) all lie in ``node_ids``."""
-    faces, _, _ = boundary_faces(mesh)
+    """Boundary faces (outward ordered) whose nodes (or corners) all lie in ``node_ids``. On a wedge mesh the faces
+    of one type: a ValueError if both types have such faces (a face set holds one type)."""
     mask = np.zeros(mesh.n_nodes, dtype=bool)
     mask[np.asarray(node_ids, dtype=np.int64)] = True
-    part = faces[:, :_corners(faces.shape[1])] if corners_only else faces
-    return np.ascontiguousarray(faces[np.all(mask[part], axis=1)])
+    found = []
+    for faces, _, _ in all_boundary_faces(mesh):
+        part = faces[:, :_corners(faces.shape[1])] if corners_only else faces
+        found.append(np.ascontiguousarray(faces[np.all(mask[part], axis=1)]))
+    hit = [f for f in found if len(f)]
+    if len(hit) > 1:
+        raise ValueError(f"these nodes carry {len(hit[0])} triangular and {len(hit[1])} quadrilateral faces; a face "
+                         f"set holds faces of one type")
+    return hit[0] if hit else found[0]
 
 
 def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Outward-ordered boundary faces with the same corners as ``faces`` (any order, >= 4 nodes).
+    """Outward-ordered boundary faces with the same corners as ``faces`` (any order; on a wedge mesh triangles
+    are matched with 3 corners given, quadrilaterals with 4 or more).
 
     Returns:
-        matched (nm, 4 | 9) boundary faces in the order of ``faces``, and found (nf,) bool.
+        matched (nm, nfn) boundary faces in the order of ``faces``, and found (nf,) bool.
     """
-    bf, _, _ = boundary_faces(mesh)
+    given = np.asarray(faces).shape[1] if np.ndim(faces) == 2 else 4
+    bf, _, _ = boundary_faces(mesh, 3 if given == 3 else 4) if mesh.cell_type == "wedge6" else boundary_faces(mesh)
     nc = _corners(bf.shape[1])
     query = np.sort(np.asarray(faces, dtype=np.int64)[:, :nc], axis=1)
     if query.shape[0] == 0 or bf.shape[0] == 0:

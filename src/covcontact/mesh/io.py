@@ -39,7 +39,7 @@ _VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27", "tetra": "tet4", "tetr
            "hexahedron20": "hex20"}
 _TO_MESHIO = {v: k for k, v in _VOLUME.items()}
 #: cells whose face groups become face sets (contact and pressure surfaces; tet4, tet10, hex20: pressure only)
-_FACED = ("hex8", "hex27", "tet4", "tet10", "hex20")
+_FACED = ("hex8", "hex27", "tet4", "tet10", "hex20", "wedge6")
 _FACE_CELLS = ("quad", "quad8", "quad9", "triangle", "triangle6")
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
@@ -208,8 +208,8 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
                 faces.append(new[data[:, :4]])
         if elems:
             mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)
-        if faces:
-            f = np.concatenate(faces)
+        if faces and len({f.shape[1] for f in faces}) == 1:  # (a group of wedge triangles and quadrilaterals: no
+            f = np.concatenate(faces)                          # face set, a face set holds one type)
             mesh.face_groups[name] = f[np.all(f >= 0, axis=1)]
             matched, _ = match_boundary_faces(mesh, f[np.all(f >= 0, axis=1)])
             if matched.shape[0]:
@@ -225,9 +225,10 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
 def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep) -> None:
     """The deck's *SURFACE definitions as face sets (element surfaces: their faces, matched outward) and node
     sets (node surfaces), each element surface also a node set of its nodes."""
-    from .abaqus import HEX_FACES, TET_FACES, read_surfaces
+    from .abaqus import HEX_FACES, TET_FACES, WEDGE_FACES, read_surfaces
 
-    table = TET_FACES if mesh.cell_type in ("tet4", "tet10") else HEX_FACES
+    table = (TET_FACES if mesh.cell_type in ("tet4", "tet10") else WEDGE_FACES if mesh.cell_type == "wedge6"
+             else HEX_FACES)
 
     try:
         elem, node = read_surfaces(p)
@@ -248,6 +249,9 @@ def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep)
                     faces.append(mesh.cells[first[k] + ids][:, list(table[face])])
         if not faces:
             raise _fail(p, f"*SURFACE {name}: its element sets hold no volume cells")
+        if len({f.shape[1] for f in faces}) > 1:
+            raise _fail(p, f"*SURFACE {name}: mixes triangular (S1, S2) and quadrilateral (S3..S5) wedge faces; "
+                           f"a surface holds faces of one type: split it in two")
         f = np.concatenate(faces)
         matched, found = match_boundary_faces(mesh, f)
         if not found.all():

@@ -8,6 +8,8 @@ import numpy as np
 
 #: volume cell type -> the type of its contact faces
 FACE_TYPE = {"hex8": "quad4", "hex18": "quad9", "hex27": "quad9", "tet4": "tri3", "tet10": "tri6", "hex20": "quad8"}
+#: the face types of wedges (a face set holds one of them)
+WEDGE_FACE_TYPES = ("tri3", "quad4")
 #: nodes per face of each face type
 FACE_NODES = {"quad4": 4, "quad9": 9, "tri3": 3, "tri6": 6, "quad8": 8}
 
@@ -51,9 +53,14 @@ class Mesh:
     @property
     def face_type(self) -> str:
         if self.cell_type not in FACE_TYPE:
-            raise ValueError(f"{self.cell_type} meshes have no face sets yet (their faces mix triangles and "
-                             f"quadrilaterals); use node sets on them")
+            raise ValueError(f"{self.cell_type} cells have faces of two types (triangles and quadrilaterals): each "
+                             f"face set is of one of them")
         return FACE_TYPE[self.cell_type]
+
+    @property
+    def face_types(self) -> tuple[str, ...]:
+        """The face types a face set of this mesh may have: one, or for wedges tri3 and quad4 (a set of one)."""
+        return WEDGE_FACE_TYPES if self.cell_type == "wedge6" else (self.face_type,)
 
     def node_set(self, name: str) -> np.ndarray:
         """Node indices of set ``name``; a KeyError lists the known names."""
@@ -74,9 +81,9 @@ class Mesh:
     def add_face_set(self, name: str, faces: np.ndarray) -> None:
         """Store outward-ordered faces (nface, 4 or 9) under ``name``."""
         f = np.ascontiguousarray(faces, dtype=np.int64)
-        nfn = FACE_NODES[self.face_type]
-        if f.ndim != 2 or f.shape[1] != nfn:
-            raise ValueError(f"face set {name!r} needs shape (nface, {nfn}), got {f.shape}")
+        nfn = [FACE_NODES[t] for t in self.face_types]
+        if f.ndim != 2 or f.shape[1] not in nfn:
+            raise ValueError(f"face set {name!r} needs shape (nface, {' or '.join(map(str, nfn))}), got {f.shape}")
         self.face_sets[name] = f
 
 
