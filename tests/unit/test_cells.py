@@ -321,3 +321,37 @@ def test_area_weighting_on_quadratic_faces_is_refused(tmp_path):
     assert "contact[0].slave: area weighting on tri6 faces" in str(err.value) and "\n" not in str(err.value)
     path.write_text(base + floor + '\n[[contact]]\nslave = "bar.zmin"\nmaster = "floor"\npenalty = 1.0e4\n')
     assert load_problem(path).contacts[0].weighting == "nodal"
+
+
+def _file_body(tmp_path, cells, points, element):
+    import meshio
+
+    meshio.write(tmp_path / "m.msh", meshio.Mesh(points, cells), file_format="gmsh22", binary=False)
+    path = tmp_path / "p.toml"
+    path.write_text(f'[problem]\nname = "f"\n[[bodies]]\nname = "b"\nelement = "{element}"\n'
+                    'material = { model = "svk", E = 1.0, nu = 0.3 }\nmesh = { file = "m.msh" }\n'
+                    '[steps]\ncount = 1\n')
+    return path
+
+
+def test_inverted_cells_and_unsupported_cell_types_are_one_line(tmp_path):
+    """A file whose tet10 cell 0 is mirrored (node order) is an input error naming that cell; a file with pyramids
+    beside hexahedra names the type and the supported ones (instead of dropping the pyramids)."""
+    from covcontact.io.loader import load_problem
+    from covcontact.io.validate import InputError
+
+    m = convert(block(1.0, 1.0, 1.0, 1, 1, 1, "hex8"), "tet10")
+    cells = m.cells.copy()
+    cells[0] = m.cells[0][[0, 2, 1, 3, 6, 5, 4, 7, 9, 8]]  # corners 1 and 2 swapped, mid-nodes to match
+    with pytest.raises(InputError) as err:
+        load_problem(_file_body(tmp_path, [("tetra10", cells)], m.points, "tet10"))
+    msg = str(err.value)
+    assert "bodies[0].mesh" in msg and "1 of 6 tet10 cells are inverted or degenerate" in msg and "cells 0 " in msg
+    h = block(1.0, 1.0, 1.0, 1, 1, 1, "hex8")
+    pts = np.vstack([h.points, [[0.5, 0.5, 1.5]]])
+    pyramid = np.array([[4, 5, 6, 7, 8]])
+    with pytest.raises(InputError) as err:
+        load_problem(_file_body(tmp_path, [("hexahedron", h.cells), ("pyramid", pyramid)], pts, "hex8"))
+    msg = str(err.value)
+    assert "holds pyramid cells, which covcontact does not have" in msg and "hexahedron" in msg
+    assert "\n" not in msg

@@ -308,6 +308,25 @@ def user_faces(sec: Section | None, mesh) -> None:
         mesh.add_node_set(name, chosen.ravel())
 
 
+def _check_cells(sec: Section, mesh, formulation: str) -> None:
+    """Inverted or degenerate cells (det J <= 0 at an integration point) are one line naming them (solid-shells
+    check their own points later)."""
+    from ..mesh import Mesh
+    from ..mesh.faces import jacobian_determinants
+
+    if formulation == "solid-shell" or mesh.n_cells == 0:
+        return
+    chunk = 20000  # (cells, points, 3, 3) Jacobians a chunk at a time
+    bad = np.concatenate([np.flatnonzero(~np.all(jacobian_determinants(
+        Mesh(mesh.points, mesh.cell_type, mesh.cells[k: k + chunk])) > 0.0, axis=1)) + k
+        for k in range(0, mesh.n_cells, chunk)])
+    if bad.size:
+        cells = ", ".join(map(str, bad[:5])) + (f" and {bad.size - 5} more" if bad.size > 5 else "")
+        sec.fail(f"{bad.size} of {mesh.n_cells} {mesh.cell_type} cells are inverted or degenerate (det J <= 0 at an "
+                 f"integration point): cells {cells} (numbered from 0); check the file's node order (VTK's) or the "
+                 f"geometry", "mesh")
+
+
 def _materials_by_set(sec: Section, mesh, default) -> dict:
     """``materials = { SET = {...}, ... }``: a material per element set of the body (the cells in no set take
     ``material``). One line for an unknown set, a cell in two sets, or cells left without a material."""
@@ -345,6 +364,7 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
         material = read_material(b.get("material", "table")) if b.has("material") or not b.has("materials") else None
         by_set = b.get("materials", "table", None)
         mesh = build_mesh(b.get("mesh", "table"), base, element)
+        _check_cells(b, mesh, formulation)
         user_cells(b.get("cells", "table", None), mesh)
         user_sets(b.get("sets", "table", None), mesh)
         user_faces(b.get("faces", "table", None), mesh)

@@ -170,6 +170,12 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         why = lines[0] if lines else f"{type(exc).__name__}: {exc}"
         raise _fail(p, f"cannot read mesh ({why})") from exc
     found = sorted({_VOLUME[b.type] for b in m.cells if b.type in _VOLUME})
+    from meshio._mesh import topological_dimension
+
+    other = sorted({b.type for b in m.cells if topological_dimension.get(b.type) == 3 and b.type not in _VOLUME})
+    if other:
+        raise _fail(p, f"holds {', '.join(other)} cells, which covcontact does not have; its volume cells are "
+                       f"{', '.join(_VOLUME)}: mesh without them (Gmsh: no pyramids or wedges of other orders)")
     if cell_type is not None and cell_type not in _TO_MESHIO:
         raise _fail(p, f"cell_type must be one of {', '.join(_TO_MESHIO)}, got {cell_type!r}")
     if not found:
