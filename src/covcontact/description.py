@@ -132,6 +132,39 @@ class Steps:
         return None if self.is_automatic else len(self.factors)
 
 
+#: time integration methods of a dynamic stage
+DYNAMIC_METHODS = ("generalized-alpha", "hht", "newmark")
+
+
+@dataclass
+class Dynamics:
+    """A dynamic stage (``procedure = "dynamic"``): time steps ``dt`` up to ``t_end`` (the stage's load factor is
+    t / t_end), the integrator ``method`` with the spectral radius ``rho_inf`` at infinite frequency (1: no
+    numerical damping; generalized-alpha in [0, 1], HHT in [0.5, 1]; Newmark is the trapezoidal rule), and the
+    ``mass`` matrix, "consistent" or "lumped" (docs/theory.md, section 20)."""
+
+    dt: float
+    t_end: float
+    method: str = "generalized-alpha"
+    rho_inf: float = 1.0
+    mass: str = "consistent"
+
+    def steps(self) -> Steps:
+        """The stage's load factors: t / t_end at every time step (the last one may be shorter)."""
+        n = int(np.ceil(self.t_end / self.dt * (1.0 - 1e-12)))
+        return Steps(tuple(min((k + 1) * self.dt / self.t_end, 1.0) for k in range(n)))
+
+
+@dataclass
+class InitialVelocity:
+    """The velocity ``value`` of the nodes of ``set`` of ``body`` (the whole body when ``set`` is empty) at the
+    start of the first dynamic stage."""
+
+    body: str
+    set: str
+    value: tuple[float, float, float]
+
+
 @dataclass
 class Stage:
     """A later stage of the analysis: it continues from the end state of the stage before.
@@ -147,6 +180,7 @@ class Stage:
     motions: new motions of named rigid bodies and of Dirichlet conditions with a motion, continuing from
         the pose the earlier stages left (``covcontact.motion.StagedMotion``).
     contacts: pair name -> True (switched on) or False (switched off) at the start of the stage.
+    dynamics: the time stepping of a dynamic stage (None: quasi-static load stepping).
     """
 
     name: str
@@ -156,6 +190,7 @@ class Stage:
     remove: tuple[str, ...] = ()
     motions: dict = field(default_factory=dict)
     contacts: dict = field(default_factory=dict)
+    dynamics: Dynamics | None = None  # a dynamic stage (None: quasi-static)
 
 
 @dataclass

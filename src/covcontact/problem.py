@@ -14,6 +14,8 @@ from .description import (
     TANGENT_CASES,
     Body,
     ContactPair,
+    Dynamics,
+    InitialVelocity,
     OutputOptions,
     RigidBody,
     SolverOptions,
@@ -24,8 +26,9 @@ from .loads import Dirichlet, NodalForce, Pressure, Traction
 from .mesh import Mesh
 from .motion import RigidMotion
 
-__all__ = ["COMPONENTS", "TANGENT_CASES", "Body", "ContactPair", "Dirichlet", "Mesh", "NodalForce", "OutputOptions",
-           "Pressure", "Problem", "RigidBody", "RigidMotion", "SolverOptions", "Stage", "Steps", "Traction"]
+__all__ = ["COMPONENTS", "TANGENT_CASES", "Body", "ContactPair", "Dirichlet", "Dynamics", "InitialVelocity", "Mesh",
+           "NodalForce", "OutputOptions", "Pressure", "Problem", "RigidBody", "RigidMotion", "SolverOptions", "Stage",
+           "Steps", "Traction"]
 
 @dataclass
 class Problem:
@@ -47,6 +50,12 @@ class Problem:
     stages: list[Stage] = field(default_factory=list)  # the stages after the first (this object's own)
     stage_name: str = "stage1"                           # the name of the first stage
     units: str = ""  # as stated by the user, e.g. "mm, N, MPa" (length first): labels of the pictures
+    dynamics: Dynamics | None = None  # the first stage dynamic (None: quasi-static)
+    initial_velocity: list[InitialVelocity] = field(default_factory=list)
+
+    def stage_dynamics(self, index: int) -> Dynamics | None:
+        """The time stepping of stage ``index`` (0: the first), None for a quasi-static stage."""
+        return self.dynamics if index == 0 else self.stages[index - 1].dynamics
 
     def stage_list(self) -> list[tuple[str, Steps]]:
         """(name, steps) of every stage, the first included."""

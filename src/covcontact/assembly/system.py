@@ -151,6 +151,28 @@ class System:
         self._build_loads()
         self._build_dirichlet()
 
+    def mass(self, lumped: bool = False, massless: np.ndarray | None = None):
+        """The dof mass matrix (n_dofs, n_dofs) of the deformable bodies, consistent or HRZ-lumped
+        (``covcontact.elements.mass``), lumped with the ``massless`` nodes' mass redistributed when given; zero rows at
+        reference nodes. A material without density is a ValueError."""
+        from ..elements.mass import assemble_mass, dof_matrix, element_masses
+
+        parts = []
+        for blk, body in zip(self.blocks, self.bodies.values()):
+            owner = np.full(body.mesh.n_cells, -1)
+            for k, name in enumerate(body.materials):
+                owner[body.mesh.element_sets[name]] = k
+            for k, material in enumerate([body.material, *body.materials.values()]):
+                idx = np.flatnonzero(owner == k - 1)
+                if not idx.size:
+                    continue
+                rho = getattr(material, "density", None)
+                if rho is None:
+                    raise ValueError(f"body {body.name!r}: its material has no density (needed for the mass)")
+                cells = body.mesh.cells[idx]
+                parts.append((cells + blk.offset, element_masses(body.mesh.cell_type, body.mesh.points, cells, rho)))
+        return dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless))
+
     @staticmethod
     def _reference_nodes(rigid, offset: int) -> list:
         """The reference-node pairs (A: translation, B: rotation vector) of rigid bodies with free components,

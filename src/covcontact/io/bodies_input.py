@@ -119,6 +119,7 @@ def read_material(sec: Section):
     model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke", "j2"))
     E = sec.get("E", "float", positive=True)
     nu = sec.get("nu", "float")
+    density = sec.get("density", "float", None, positive=True)
     if not -1.0 < nu < 0.5:
         sec.fail(f"must lie in (-1, 0.5), got {nu}", "nu")
     if model == "j2":
@@ -135,12 +136,12 @@ def read_material(sec: Section):
         sec.done()
         try:
             return J2Plasticity(E=E, nu=nu, yield_stress=yield_stress, hardening=hardening,
-                                kinematic_modulus=kinematic, hill48=hill)
+                                kinematic_modulus=kinematic, hill48=hill, density=density)
         except ValueError as exc:
             sec.fail(str(exc))
     sec.done()
     try:
-        return material_from_name(model, E=E, nu=nu)
+        return material_from_name(model, E=E, nu=nu, density=density)
     except ValueError as exc:
         sec.fail(str(exc))
 

@@ -16,6 +16,7 @@ from ..problem import Problem
 from .bodies_input import read_bodies
 from .conditions_input import SetRefs, read_dirichlet, read_loads
 from .contact_input import read_contacts
+from .dynamics_input import check_densities, read_dynamics, read_initial_velocities
 from .fields import read_steps
 from .options_input import read_output, read_solver
 from .rigid_input import read_rigid
@@ -38,7 +39,7 @@ def load_problem(path: str | Path) -> Problem:
 
 
 _TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "contact", "steps",
-              "stages", "solver", "output")
+              "stages", "initial_velocity", "solver", "output")
 
 
 def problem_from_dict(raw: dict, path: Path) -> Problem:
@@ -52,6 +53,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     description = meta.get("description", "str", "")
     meta_stage = meta.get("stage", "str", "stage1")
     units = meta.get("units", "str", "")
+    dynamics = read_dynamics(meta)
     meta.done()
 
     bodies = read_bodies(top, base)
@@ -65,7 +67,10 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
         if r.free and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
             top.fail(f"rigid body {r.name!r} has free components but no contact pair: nothing would restrain "
                      f"it; add a [[contact]] with it or drop 'free'", f"rigid[{i}].free")
-    steps = read_steps(top.get("steps", "table", None))
+    if dynamics is not None and top.has("steps"):
+        top.fail("a dynamic first stage takes its steps from dt and t_end in [problem]: remove [steps]", "steps")
+    steps = dynamics.steps() if dynamics is not None else read_steps(top.get("steps", "table", None))
+    velocities = read_initial_velocities(top, sets)
 
     named = named_conditions(top, dirichlet, forces, pressures, tractions)
     for r in rigid:  # rigid bodies with free components: their force is a load later stages may change
@@ -76,10 +81,17 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     for st in top.get("stages", "array", []):
         stages.append(stage(st, named, dirichlet, rigid, contacts, stages, stage_name))
 
+    if dynamics is not None or any(st.dynamics is not None for st in stages):
+        check_densities(top, bodies)
+        if any(r.free for r in rigid):
+            top.fail("rigid bodies with free components have no mass yet: a dynamic stage cannot move them; "
+                     "prescribe their motion", "rigid")
+    elif velocities:
+        top.fail("initial velocities need a dynamic stage (procedure = \"dynamic\")", "initial_velocity")
     solver = read_solver(top)
     output = read_output(top)
     top.done()
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
-                   units=units)
+                   units=units, dynamics=dynamics, initial_velocity=velocities)

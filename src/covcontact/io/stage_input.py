@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .dynamics_input import read_dynamics
 from .fields import COMPONENT_NAMES, dirichlet_values, names, read_motion, read_steps
 from .validate import Section, suggest
 
@@ -31,7 +32,10 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
     name = st.get("name", "str")
     if name == first or any(x.name == name for x in earlier):
         st.fail(f"duplicate stage name {name!r}", "name")
-    steps = read_steps(st.get("steps", "table", None))
+    dynamics = read_dynamics(st)
+    if dynamics is not None and st.has("steps"):
+        st.fail("a dynamic stage takes its steps from dt and t_end: remove 'steps'", "steps")
+    steps = dynamics.steps() if dynamics is not None else read_steps(st.get("steps", "table", None))
     released_before = {n: x.name for x in earlier for n in x.release}
 
     def check_name(sec: Section, key: str, value: str, kinds: tuple[str, ...], what: str) -> tuple[str, object]:
@@ -139,4 +143,4 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
             switch[n] = csec.get(n, "bool")
         csec.done()
     st.done()
-    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch)
+    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch, dynamics)

@@ -59,15 +59,23 @@ class LameConstants:
         return lame(self.E, self.nu)[1]
 
 
+def check_density(density) -> None:
+    """A mass density is None (a static analysis needs none) or finite and > 0."""
+    if density is not None and not (math.isfinite(float(density)) and float(density) > 0.0):
+        raise ValueError(f"density must be finite and > 0, got density={density}")
+
+
 @dataclass(frozen=True)
 class _Isotropic(LameConstants):
     E: float
     nu: float
     kind: int = field(init=False, default=-1)
     name: str = field(init=False, default="")
+    density: float | None = None  # mass per unit reference volume (dynamics)
 
     def __post_init__(self) -> None:
         _check(float(self.E), float(self.nu))
+        check_density(self.density)
 
     @property
     def params(self) -> np.ndarray:
@@ -108,13 +116,15 @@ def material_from_name(name: str, **params: float) -> Material:
     key = name.strip().lower().replace("_", "-").replace(" ", "-")
     if key not in _NAMES:
         raise ValueError(f"unknown material {name!r}; known: {', '.join(sorted(_NAMES))}")
-    unknown = set(params) - {"E", "nu"}
+    unknown = set(params) - {"E", "nu", "density"}
     if unknown:
-        raise ValueError(f"unknown material parameter(s) {sorted(unknown)}; expected E and nu")
+        raise ValueError(f"unknown material parameter(s) {sorted(unknown)}; expected E and nu (and density)")
     for p in ("E", "nu"):
         if p not in params:
             raise ValueError(f"material {name!r} needs parameter {p}")
-    return _NAMES[key](E=float(params["E"]), nu=float(params["nu"]))
+    density = params.get("density")
+    return _NAMES[key](E=float(params["E"]), nu=float(params["nu"]),
+                       density=None if density is None else float(density))
 
 
 # ----------------------------------------------------------------------------------------------

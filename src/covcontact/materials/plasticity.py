@@ -236,6 +236,7 @@ class J2Plasticity(LameConstants):
         hardening: LinearHardening / SwiftHardening / VoceHardening or a dict {"law": ..., ...}.
         kinematic_modulus: H_kin of linear (Prager) kinematic hardening, d beta = 2/3 H_kin d E_p.
         hill48: None (von Mises), Hill48, a dict {"r0", "r45", "r90"} or a tuple (r0, r45, r90).
+        density: mass per unit reference volume (dynamics), or None.
     """
 
     E: float
@@ -246,8 +247,12 @@ class J2Plasticity(LameConstants):
     hill48: Any = None
     kind: int = field(init=False, default=J2)
     name: str = field(init=False, default="j2")
+    density: float | None = None  # mass per unit reference volume (dynamics)
 
     def __post_init__(self) -> None:
+        from .hyperelastic import check_density
+
+        check_density(self.density)
         E, nu = float(self.E), float(self.nu)
         if not (math.isfinite(E) and E > 0.0):
             raise ValueError(f"Young's modulus E must be finite and > 0, got E={self.E}")

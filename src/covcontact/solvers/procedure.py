@@ -177,10 +177,12 @@ class QuasiStatic:
         self.augmented = any(c.method == "augmented" for c in model.problem.contacts)
         self.work = None
 
-    def start(self, state: State) -> None:
+    def start(self, state: State, u: np.ndarray | None = None) -> State:
         """Start, or resume, the stage at the committed ``state`` (its plastic work is the reference of the
-        next step's dissipation)."""
+        next step's dissipation); returns the state the stage starts from (a quasi-static stage starts at rest:
+        without the kinematics of a dynamic stage before it)."""
         self.work = self.model.plastic_work(state)
+        return state.but(dynamics={}) if state.dynamics else state
 
     def next_step(self, state: State) -> tuple[int, float] | None:
         """(step number, load factor) of the next increment after ``state``; None when the stage is done."""

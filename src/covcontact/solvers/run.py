@@ -223,8 +223,17 @@ class Run:
             control = increment_control(spec, stage_steps(self.problem)[si])
             if self.control_state.get("stage") == si:  # resumed inside this stage
                 control.restore(self.control_state)
-            self.procedure = QuasiStatic(model, self.newton, spec, t_stage, len(plan) > 1, control)
-            self.procedure.start(self.state)
+            dyn = self.problem.stage_dynamics(si)
+            if dyn is None:
+                self.procedure = QuasiStatic(model, self.newton, spec, t_stage, len(plan) > 1, control)
+            else:
+                from .dynamics import Dynamic
+
+                t_start = sum(self.problem.stage_dynamics(k).t_end if self.problem.stage_dynamics(k) is not None
+                              else plan.stages[k].lam_end for k in range(si))
+                self.procedure = Dynamic(model, self.newton, spec, t_stage, len(plan) > 1, control, dyn,
+                                         self.problem, t_start)
+            self.state = self.procedure.start(self.state, self.u)
             self.emit("stage_entered", self.procedure, entering)
             while (nxt := self.procedure.next_step(self.state)) is not None:
                 self.emit("increment_started", *nxt)

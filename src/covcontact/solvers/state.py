@@ -27,10 +27,15 @@ class State:
     step: int = 0
     lam: float = 0.0
     forces: dict[str, np.ndarray] = field(default_factory=dict)
+    #: a dynamic stage's kinematic state at the end of the step: ``u``, ``v``, ``a`` (n_dofs,) each and ``r``, the
+    #: static residual there (the generalized-alpha mid-point uses it); ``time`` (the stage's time) and the energy
+    #: account (``covcontact.solvers.dynamics``); empty in a quasi-static stage
+    dynamics: dict[str, np.ndarray] = field(default_factory=dict)
 
     def copy(self) -> State:
         return State([{k: v.copy() for k, v in e.items()} for e in self.elements], self.contact.copy(),
-                     self.stage, self.step, self.lam, {k: v.copy() for k, v in self.forces.items()})
+                     self.stage, self.step, self.lam, {k: v.copy() for k, v in self.forces.items()},
+                     {k: v.copy() for k, v in self.dynamics.items()})
 
     def but(self, **changes) -> State:
         """This state with some fields replaced (the arrays of the others shared, not copied)."""
@@ -44,6 +49,7 @@ class State:
         out["step.step"] = np.array(self.step)
         out["step.lam"] = np.array(self.lam)
         out.update({f"forces.{k}": v for k, v in self.forces.items()})
+        out.update({f"dynamics.{k}": v for k, v in self.dynamics.items()})
         return out
 
     @classmethod
@@ -61,5 +67,6 @@ class State:
             if p.gap.shape != q.gap.shape:
                 raise ValueError("the contact state does not match the problem's slave sets")
         forces = {k[len("forces."):]: np.array(data[k]) for k in data if k.startswith("forces.")}
+        dynamics = {k[len("dynamics."):]: np.array(data[k]) for k in data if k.startswith("dynamics.")}
         return cls(elements, contact, int(data["step.stage"]), int(data["step.step"]), float(data["step.lam"]),
-                   forces)
+                   forces, dynamics)

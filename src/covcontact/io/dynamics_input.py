@@ -1,0 +1,81 @@
+"""Dynamic stages and initial velocities (docs/input.md, "Dynamics"): ``procedure = "dynamic"`` with ``dt``,
+``t_end``, ``method``, ``rho_inf``, ``mass`` in ``[problem]`` (the first stage) or a ``[[stages]]`` entry, and
+``[[initial_velocity]]``."""
+
+from __future__ import annotations
+
+from ..description import DYNAMIC_METHODS, Dynamics, InitialVelocity
+from .validate import Section
+
+#: the keys of a dynamic stage besides ``procedure``
+DYNAMIC_KEYS = ("dt", "t_end", "method", "rho_inf", "mass")
+
+
+def read_dynamics(sec: Section) -> Dynamics | None:
+    """The time stepping of a stage from its table (``[problem]`` or a ``[[stages]]`` entry); None for a quasi-static
+    one. Dynamic keys without ``procedure = "dynamic"`` are one line."""
+    procedure = sec.get("procedure", "str", "static", choices=("static", "dynamic"))
+    if procedure == "static":
+        given = [k for k in DYNAMIC_KEYS if sec.has(k)]
+        if given:
+            sec.fail(f"{given[0]!r} belongs to a dynamic stage: add procedure = \"dynamic\"", given[0])
+        return None
+    dt = sec.get("dt", "float", positive=True)
+    t_end = sec.get("t_end", "float", positive=True)
+    if dt > t_end:
+        sec.fail(f"the time step {dt:g} exceeds the stage's duration t_end = {t_end:g}", "dt")
+    method = sec.get("method", "str", "generalized-alpha", choices=DYNAMIC_METHODS)
+    rho = sec.get("rho_inf", "float", 1.0)
+    if method == "newmark" and sec.has("rho_inf"):
+        sec.fail("the Newmark trapezoidal rule has no numerical damping (rho_inf = 1); use method = "
+                 "\"generalized-alpha\" or \"hht\" to damp high frequencies", "rho_inf")
+    lo = 0.5 if method == "hht" else 0.0
+    if not lo <= rho <= 1.0:
+        sec.fail(f"must lie in [{lo:g}, 1] for method = \"{method}\", got {rho:g}", "rho_inf")
+    mass = sec.get("mass", "str", "consistent", choices=("consistent", "lumped", "redistributed"))
+    return Dynamics(dt=dt, t_end=t_end, method=method, rho_inf=rho, mass=mass)
+
+
+def read_initial_velocities(top: Section, sets) -> list[InitialVelocity]:
+    """Every ``[[initial_velocity]]``: ``set = "BODY.SET"`` (a node set) or ``body = "BODY"`` (all its nodes), and
+    ``value = [vx, vy, vz]``."""
+    out = []
+    for sec in top.get("initial_velocity", "array", []):
+        value = sec.get("value", "vector")
+        if sec.has("set") == sec.has("body"):
+            sec.fail("give either set = \"BODY.SET\" (a node set) or body = \"BODY\" (all its nodes)")
+        if sec.has("body"):
+            name = sec.get("body", "str")
+            if name not in {b.name for b in sets.bodies}:
+                known = ", ".join(b.name for b in sets.bodies)
+                sec.fail(f"no deformable body {name!r} (known: {known})", "body")
+            out.append(InitialVelocity(name, "", value))
+        else:
+            body, nset = sets.body_set(sec, "set", "node")
+            sets.deformable(sec, "set", body)
+            out.append(InitialVelocity(body, nset, value))
+        sec.done()
+    return out
+
+
+def check_densities(top: Section, bodies) -> None:
+    """A problem with a dynamic stage needs the mass density of every material: one line naming the first one
+    without."""
+    for i, body in enumerate(bodies):
+        if getattr(body.material, "density", None) is None and (not body.materials or _uses_default(body)):
+            top.fail("missing: a dynamic stage needs the mass density of every material (e.g. density = 7.85e-9 "
+                     "in t/mm^3 with mm, N, MPa)", f"bodies[{i}].material.density")
+        for name, mat in body.materials.items():
+            if getattr(mat, "density", None) is None:
+                top.fail("missing: a dynamic stage needs the mass density of every material",
+                         f"bodies[{i}].materials.{name}.density")
+
+
+def _uses_default(body) -> bool:
+    """Whether some cell of ``body`` takes its ``material`` (lies in none of the sets of ``materials``)."""
+    import numpy as np
+
+    covered = np.zeros(body.mesh.n_cells, dtype=bool)
+    for name in body.materials:
+        covered[body.mesh.element_sets[name]] = True
+    return not covered.all()

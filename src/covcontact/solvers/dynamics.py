@@ -1,0 +1,257 @@
+"""Implicit dynamics: the generalized-alpha family of time integrators for a dynamic stage (docs/theory.md, section
+20).
+
+Chung and Hulbert (1993, J. Appl. Mech. 60, 371-375): the equation of motion is held at the generalized mid-point,
+
+    M a_(n+1-am) + r(u, t)_(n+1-af) = 0,   x_(n+1-a) = (1 - a) x_(n+1) + a x_n,
+
+with r = f_int + f_contact - f_ext the static residual (its value at step n kept from that step, so every
+nonlinear term is evaluated at converged configurations only) and Newmark's updates
+
+    a_(n+1) = (u_(n+1) - u_n - dt v_n) / (beta dt^2) - (1 / (2 beta) - 1) a_n,
+    v_(n+1) = v_n + dt ((1 - gamma) a_n + gamma a_(n+1)).
+
+The dynamic residual of u_(n+1) is R = M ((1 - am) a_(n+1) + am a_n) + (1 - af) r(u_(n+1)) + af r_n and its
+tangent (1 - af) K + (1 - am) / (beta dt^2) M. Parameters from the spectral radius rho at infinite frequency:
+
+- ``"generalized-alpha"``: am = (2 rho - 1) / (rho + 1), af = rho / (rho + 1), gamma = 1/2 - am + af,
+  beta = (1 - am + af)^2 / 4 (second order, unconditionally stable, high-frequency damping optimal for rho);
+- ``"hht"`` (Hilber, Hughes and Taylor 1977): am = 0, af = (1 - rho) / (1 + rho), gamma = 1/2 + af,
+  beta = (1 + af)^2 / 4, rho in [1/2, 1];
+- ``"newmark"``: the trapezoidal rule, am = af = 0, gamma = 1/2, beta = 1/4 (no damping, energy conserving for
+  linear problems).
+
+A :class:`DynamicModel` wraps the quasi-static model: Newton iterates on it unchanged (its cutbacks halve the time
+step). The kinematic state (u, v, a at the end of the step, the static residual r there) is part of the committed
+state (``State.dynamics``), so a checkpoint resumes the run bit for bit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as sla
+
+from .procedure import Increment, QuasiStatic
+from .state import State
+
+
+@dataclass(frozen=True)
+class Integrator:
+    """Parameters of the generalized-alpha method (am, af, beta, gamma)."""
+
+    alpha_m: float
+    alpha_f: float
+    beta: float
+    gamma: float
+
+    @classmethod
+    def of(cls, method: str, rho_inf: float = 1.0) -> Integrator:
+        rho = float(rho_inf)
+        if method == "newmark":
+            return cls(0.0, 0.0, 0.25, 0.5)
+        if method == "hht":
+            if not 0.5 <= rho <= 1.0:
+                raise ValueError(f"HHT needs rho_inf in [0.5, 1], got {rho}")
+            af = (1.0 - rho) / (1.0 + rho)
+            return cls(0.0, af, 0.25 * (1.0 + af) ** 2, 0.5 + af)
+        if method == "generalized-alpha":
+            if not 0.0 <= rho <= 1.0:
+                raise ValueError(f"generalized-alpha needs rho_inf in [0, 1], got {rho}")
+            am, af = (2.0 * rho - 1.0) / (rho + 1.0), rho / (rho + 1.0)
+            return cls(am, af, 0.25 * (1.0 - am + af) ** 2, 0.5 - am + af)
+        raise ValueError(f"unknown time integration method {method!r}")
+
+    def acceleration(self, u, u_n, v_n, a_n, dt: float) -> np.ndarray:
+        return (u - u_n - dt * v_n) / (self.beta * dt * dt) - (0.5 / self.beta - 1.0) * a_n
+
+    def velocity(self, a, v_n, a_n, dt: float) -> np.ndarray:
+        return v_n + dt * ((1.0 - self.gamma) * a_n + self.gamma * a)
+
+    def mass_factor(self, dt: float) -> float:
+        """d(M a_(n+1-am)) / du = this times M."""
+        return (1.0 - self.alpha_m) / (self.beta * dt * dt)
+
+
+def add_into(K: sp.csr_matrix, M: sp.csr_matrix, c: float, cache: dict) -> sp.csr_matrix:
+    """K + c M in K's own sparsity pattern (M's entries lie in it: the mass couples the nodes of an element, which
+    the tangent couples already); K is changed in place. ``cache`` keeps the positions for K's pattern."""
+    key = (K.shape, K.nnz, id(K.indices), id(K.indptr))
+    pos = cache.get("pos") if cache.get("key") == key else None
+    if pos is None:
+        if not K.has_sorted_indices:
+            K.sort_indices()
+        n = K.shape[1]
+        k_keys = np.repeat(np.arange(K.shape[0], dtype=np.int64), np.diff(K.indptr)) * n + K.indices
+        C = M.tocoo()
+        m_keys = C.row.astype(np.int64) * n + C.col
+        pos = np.searchsorted(k_keys, m_keys)
+        if np.any(pos >= k_keys.size) or np.any(k_keys[np.minimum(pos, k_keys.size - 1)] != m_keys):
+            raise ValueError("the mass matrix couples dofs the tangent's pattern does not hold")
+        cache.update(key=key, pos=pos, data=C.data)
+    np.add.at(K.data, pos, c * cache["data"])
+    return K
+
+
+class DynamicModel:
+    """The quasi-static ``model`` seen by Newton in a dynamic stage: ``evaluate`` returns the dynamic residual and
+    tangent and a trial state with the step's kinematics; everything else is the model's. ``T`` is the stage's
+    duration (load factor lam = t / T)."""
+
+    def __init__(self, model, M: sp.csr_matrix, integrator: Integrator, T: float):
+        self.model, self.M, self.integ, self.T = model, M, integrator, float(T)
+        self._cache: dict = {}
+
+    def __getattr__(self, name):
+        return getattr(self.model, name)
+
+    def kinematics(self, u: np.ndarray, lam: float, committed: State) -> tuple[np.ndarray, np.ndarray, float]:
+        """(a, v, dt) at the end of a step from ``committed`` to load factor ``lam`` with displacement ``u``."""
+        d = committed.dynamics
+        dt = (lam - committed.lam) * self.T
+        if not dt > 0.0:
+            raise ValueError(f"a dynamic step needs a positive time step, got {dt}")
+        a = self.integ.acceleration(u, d["u"], d["v"], d["a"], dt)
+        return a, self.integ.velocity(a, d["v"], d["a"], dt), dt
+
+    def evaluate(self, u: np.ndarray, lam: float, committed: State, guess: State | None = None,
+                 want_K: bool = True, timing: dict | None = None):
+        R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=timing)
+        g, d = self.integ, committed.dynamics
+        a, v, dt = self.kinematics(u, lam, committed)
+        Rd = self.M @ ((1.0 - g.alpha_m) * a + g.alpha_m * d["a"]) + (1.0 - g.alpha_f) * R + g.alpha_f * d["r"]
+        if K is not None:
+            K.data *= 1.0 - g.alpha_f
+            K = add_into(K, self.M, g.mass_factor(dt), self._cache)
+        # the work of the applied forces over the step (trapezoidal rule)
+        f = applied_forces(self.model, Rd, lam)
+        work = float(d["work"]) + 0.5 * float((d["f"] + f) @ (u - d["u"]))
+        dyn = dict(d)
+        dyn.update(u=u.copy(), v=v, a=a, r=R, rd=Rd, f=f, work=np.array(work), time=np.array(float(d["time"]) + dt))
+        return Rd, K, trial.but(dynamics=dyn)
+
+
+def applied_forces(model, Rd: np.ndarray, lam: float) -> np.ndarray:
+    """The forces on the bodies from outside: the external loads and, on constrained dofs, the supports' (the
+    dynamic residual there)."""
+    f = model.external(lam).copy()
+    c = ~model.free
+    f[c] += Rd[c]
+    return f
+
+
+def contact_nodes(model) -> np.ndarray:
+    """Mask over the system's nodes of the deformable nodes on a contact surface: every slave node (the facet nodes of
+    segment-to-surface points) and every node of a mesh master surface (patch points resolved to their nodes)."""
+    mask = np.zeros(model.system.n_nodes, dtype=bool)
+    contact = model.contact
+    for p in contact.passes:
+        nodes = [contact.points.nodes(p.slaves)]
+        if p.surface is not None:
+            nodes.append(contact.points.nodes(p.surface.faces.ravel()))
+        ids = np.concatenate(nodes)
+        mask[ids[ids < model.system.n_nodes]] = True
+    return mask
+
+
+def initial_velocity(model, problem) -> np.ndarray:
+    """The dofs' velocities of ``problem.initial_velocity`` (later entries win where sets overlap)."""
+    v = np.zeros(model.n_dofs).reshape(-1, 3)
+    for iv in problem.initial_velocity:
+        off = model.system.offset(iv.body)
+        mesh = problem.body(iv.body).mesh
+        nodes = mesh.node_sets[iv.set] if iv.set else np.arange(mesh.n_nodes)
+        v[nodes + off] = iv.value
+    return v.ravel()
+
+
+class Dynamic(QuasiStatic):
+    """Time stepping of a dynamic stage (``dyn``, a ``covcontact.description.Dynamics``) with the generalized-alpha
+    family; the increments are the stage's time steps (``t / t_end`` as load factor) and Newton's cutbacks halve
+    them. ``t_start``: the stage's start time (``time`` in the records)."""
+
+    name = "dynamic"
+
+    def __init__(self, model, newton, spec, t_stage: float, staged: bool, control, dyn, problem, t_start: float):
+        super().__init__(model, newton, spec, t_stage, staged, control)
+        self.dyn, self.problem, self.t_start = dyn, problem, float(t_start)
+        self.integrator = Integrator.of(dyn.method, dyn.rho_inf)
+        self.M = model.system.mass(lumped=dyn.mass == "lumped",
+                                   massless=contact_nodes(model) if dyn.mass == "redistributed" else None)
+        self.dynamic_model = DynamicModel(model, self.M, self.integrator, dyn.t_end)
+
+    def start(self, state: State, u: np.ndarray | None = None) -> State:
+        """The stage's start: a state that has no kinematics yet (the first dynamic stage, or one after a static
+        stage) gets them: u, the initial velocities (first dynamic stage) or rest, the acceleration of
+        equilibrium M a_0 = -r(u_0) on the free dofs, and the energy account's start."""
+        super().start(state)
+        if "v" in state.dynamics or u is None:
+            return state
+        model = self.model
+        R, _, _ = model.evaluate(u, state.lam, state, want_K=False)
+        free = model.free
+        first = not any(self.problem.stage_dynamics(i) is not None for i in range(state.stage))
+        v = initial_velocity(model, self.problem) if first else np.zeros(model.n_dofs)
+        v[~free] = 0.0  # (a prescribed dof moves with its prescription)
+        a = np.zeros(model.n_dofs)
+        inert = free & (self.M.diagonal() > 0.0)  # (the redistributed mass leaves contact nodes without inertia)
+        if np.any(R[inert]):
+            a[inert] = sla.spsolve(self.M[inert][:, inert].tocsc(), -R[inert])
+        Rd = R + self.M @ a  # the supports' forces at rest or with the initial velocities' inertia
+        dyn = {"u": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
+               "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam)}
+        dyn["e0"] = np.array(self._energies(u, state.but(dynamics=dyn))["mechanical"])
+        return state.but(dynamics=dyn)
+
+    def advance(self, u: np.ndarray, state: State, step: int, lam: float) -> Increment:
+        newton = self.newton
+        newton.model = self.dynamic_model
+        try:
+            return super().advance(u, state, step, lam)
+        finally:
+            newton.model = self.model
+
+    def _energies(self, u: np.ndarray, state: State) -> dict:
+        """Kinetic, strain and contact (penalty) energy of ``state`` and their sum."""
+        d = state.dynamics
+        kinetic = 0.5 * float(d["v"] @ (self.M @ d["v"]))
+        strain = self.model.system.energy(u, state.elements)
+        contact = 0.0
+        for k, p in enumerate(state.contact.passes):
+            act = self.model.contact.active_mask(k, state.contact)
+            g = np.where(act, p.gap, 0.0)
+            contact += 0.5 * float(np.sum(np.linalg.norm(p.force[act], axis=1) * np.abs(g[act])))
+        return {"kinetic": kinetic, "strain": strain, "contact": contact, "mechanical": kinetic + strain + contact}
+
+    def _report(self, inc: Increment, u: np.ndarray, stats0: dict, time0: dict) -> dict:
+        entry = super()._report(inc, u, stats0, time0)
+        if not inc.success:
+            return entry
+        state = inc.state
+        d = state.dynamics
+        e = self._energies(u, state)
+        dissipation = float(entry.get("plastic_work", 0.0))
+        balance = e["mechanical"] + dissipation - float(d["e0"]) - float(d["work"])
+        scale = max(e["mechanical"], float(d["e0"]), abs(float(d["work"])), 1e-300)
+        entry["time"] = float(d["time"])
+        entry["energy"] = {"kinetic": e["kinetic"], "strain": e["strain"], "contact": e["contact"],
+                           "external_work": float(d["work"]), "dissipation": dissipation,
+                           "balance_error": balance / scale}
+        entry["reactions"] = self._reactions(d["rd"])
+        return entry
+
+    def _reactions(self, Rd: np.ndarray) -> dict:
+        """The supports' resultant forces (inertia included) of every Dirichlet condition in force."""
+        out = {}
+        held = {c.name for c in self.model.loading.spec.conditions}
+        for i, bc in enumerate(self.problem.dirichlet):
+            if (bc.name or f"#{i}") not in held:
+                continue
+            nodes = self.model.system.global_nodes(bc.body, bc.set)
+            total = Rd.reshape(-1, 3)[nodes].sum(axis=0)
+            comp = np.zeros(3, dtype=bool)
+            comp[list(bc.components)] = True
+            out[f"{bc.body}.{bc.set}"] = np.where(comp, total, 0.0).tolist()
+        return out
