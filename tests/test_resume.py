@@ -132,6 +132,54 @@ def two_materials(tmp: Path) -> Path:
     return path
 
 
+def dynamic(tmp: Path) -> Path:
+    """A static preload, then a dynamic stage: the bar of the impact test pushed against a block by its end, then
+    let go (the kinematic state u, v, a and the energy account are part of the committed state)."""
+    text = """
+[problem]
+name = "dynamic-resume"
+[[bodies]]
+name = "bar"
+material = { model = "svk", E = 1.0, nu = 0.0, density = 1.0 }
+mesh = { generator = "block", lx = 1.0, ly = 0.1, lz = 0.1, nx = 20, ny = 1, nz = 1 }
+[[rigid]]
+name = "wall"
+shape = "plane"
+point = [1.0, 0.0, 0.0]
+normal = [-1.0, 0.0, 0.0]
+[[contact]]
+slave = "bar.xmax"
+master = "wall"
+penalty = 1.0e4
+weighting = "area"
+[[dirichlet]]
+name = "push"
+set = "bar.xmin"
+components = "x"
+value = 0.002
+[[dirichlet]]
+set = "bar.ymin"
+components = "y"
+[[dirichlet]]
+set = "bar.zmin"
+components = "z"
+[steps]
+count = 2
+[[stages]]
+name = "let-go"
+release = ["push"]
+procedure = "dynamic"
+dt = 0.05
+t_end = 1.2
+method = "generalized-alpha"
+rho_inf = 0.8
+mass = "redistributed"
+"""
+    path = tmp / "dynamic.toml"
+    path.write_text(text)
+    return path
+
+
 def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
@@ -176,9 +224,9 @@ def _has_gamg() -> bool:
 
 
 @pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks,
-                                  sts_friction, self_friction, two_materials],
+                                  sts_friction, self_friction, two_materials, dynamic],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials"])
+                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials", "dynamic"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")

@@ -25,8 +25,9 @@ def read_dynamics(sec: Section) -> Dynamics | None:
     if dt > t_end:
         sec.fail(f"the time step {dt:g} exceeds the stage's duration t_end = {t_end:g}", "dt")
     method = sec.get("method", "str", "generalized-alpha", choices=DYNAMIC_METHODS)
+    given = sec.has("rho_inf")
     rho = sec.get("rho_inf", "float", 1.0)
-    if method == "newmark" and sec.has("rho_inf"):
+    if method == "newmark" and given:
         sec.fail("the Newmark trapezoidal rule has no numerical damping (rho_inf = 1); use method = "
                  "\"generalized-alpha\" or \"hht\" to damp high frequencies", "rho_inf")
     lo = 0.5 if method == "hht" else 0.0

@@ -37,7 +37,7 @@ def auto_amg(problem) -> bool:
     if any(b.formulation != "solid" or not 0.0 <= float(getattr(b.material, "nu", 1.0)) <= AUTO_AMG_NU
            or b.mesh.cell_type not in FACES for b in problem.bodies):
         return False
-    if any(c.friction for c in problem.contacts) or any(rb.free for rb in problem.rigid):
+    if any(c.friction for c in problem.contacts) or any(rb.free for rb in problem.rigid) or _dynamic(problem):
         return False
     on_boundary = sum(np.unique(boundary_faces(b.mesh)[0]).size for b in problem.bodies)
     return on_boundary <= AUTO_AMG_BOUNDARY * n_nodes
@@ -133,6 +133,12 @@ def auto_line(linear: str, ranks: int, one_core_hint: bool = False, started: boo
             f"factorise instead{hint})")
 
 
+def _dynamic(problem) -> bool:
+    """Whether ``problem`` has a dynamic stage (serial only for now)."""
+    return getattr(problem, "dynamics", None) is not None or any(
+        getattr(st, "dynamics", None) is not None for st in problem.stages)
+
+
 def check_distributable(problem, linear: str, ranks: int) -> None:
     """Raise InputError where ``ranks`` MPI ranks cannot run ``problem`` with the solver ``linear``."""
     where = problem.source or problem.name
@@ -142,6 +148,9 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if distributes(linear) and any(rb.free for rb in problem.rigid):
         raise InputError(f"{where}: rigid bodies with free components (reference nodes) are not available with "
                          f"the distributed solver {linear!r} yet; use a serial solver")
+    if distributes(linear) and _dynamic(problem):
+        raise InputError(f"{where}: dynamic stages are not available with the distributed solver {linear!r} yet; "
+                         f"use a serial solver (--solver default, or pardiso)")
 
 
 
