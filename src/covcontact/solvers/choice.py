@@ -150,7 +150,7 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
                          f"the distributed solver {linear!r} yet; use a serial solver")
     if distributes(linear) and _dynamic(problem):
         raise InputError(f"{where}: dynamic stages are not available with the distributed solver {linear!r} yet; "
-                         f"use a serial solver (--solver default, or pardiso)")
+                         f"use a serial solver (--solver pardiso or superlu)")
 
 
 
