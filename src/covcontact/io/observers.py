@@ -130,7 +130,8 @@ class Results(Observer):
     def increment_converged(self, run, inc) -> None:
         k, proc = inc.step, run.procedure
         if k % self.every == 0 or inc.ends_stage or inc.output:  # stage ends (so the run's end), output_at
-            self._write(run, inc.lam, k, proc.t_stage + inc.lam)
+            dyn = run.state.dynamics  # a dynamic stage's files carry its time
+            self._write(run, inc.lam, k, float(dyn["time"]) if dyn else proc.t_stage + inc.lam)
 
     def _write(self, run, lam: float, step: int, time_value: float) -> None:
         t0 = time.perf_counter()
@@ -172,6 +173,9 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
                                {"contact_facet_pressure": pressure[keep]}))
     points = sysm.X[:n].copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}
+    if state.dynamics:  # a dynamic stage: velocities and accelerations
+        pdata["velocity"] = state.dynamics["v"].reshape(-1, 3)[:n].copy()
+        pdata["acceleration"] = state.dynamics["a"].reshape(-1, 3)[:n].copy()
     extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, fields)
     pdata.update(model.contact.point_data(n, state.contact, fields) if model.contact.passes else {})
     if extra_pts is not None and len(extra_pts):

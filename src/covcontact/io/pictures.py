@@ -214,7 +214,9 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
     step = int(last.stem.split("_")[1])
     ends = _stage_ends(out_dir)
     length = _length_unit(out_dir)
-    if ends:  # a staged run: the pvd time is not a load factor
+    if _dynamic(out_dir):  # the pvd time of a dynamic step is the time
+        final = f"final state: step {step}" + (f", time {lam:.4g}" if lam is not None else "")
+    elif ends:  # a staged run: the pvd time is not a load factor
         final = f"final state: step {step}, end of stage {ends[-1][0]!r}"
     else:
         final = f"final state: step {step}" + (f", load factor {lam:.3g}" if lam is not None else "")
@@ -228,7 +230,58 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
             path = out_dir / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png"
             _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view, length, plastic)
             written.append(path)
-    return written
+    energy = energy_plot(out_dir)
+    return written + ([energy] if energy is not None else [])
+
+
+def energy_plot(out_dir: Path) -> Path | None:
+    """``energy.png``: the energies of a run with dynamic steps (summary.json ``energy`` against ``time``): kinetic,
+    strain, contact, their sum, the applied forces' work and the dissipation; None without dynamic steps."""
+    import json
+
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    try:
+        steps = [s for s in json.loads((out_dir / "summary.json").read_text()).get("steps", [])
+                 if s.get("converged") and "energy" in s]
+    except (OSError, ValueError):
+        return None
+    if not steps:
+        return None
+    t = np.array([s["time"] for s in steps])
+    e = {k: np.array([s["energy"][k] for s in steps]) for k in steps[0]["energy"]}
+    fig, ax = plt.subplots(figsize=(6.4, 3.6), dpi=110)
+    for key, style in (("kinetic", "-"), ("strain", "-"), ("contact", "-"), ("external_work", "--"),
+                       ("dissipation", ":")):
+        if np.any(e[key]):
+            ax.plot(t, e[key], style, label=key.replace("_", " "))
+    ax.plot(t, e["kinetic"] + e["strain"] + e["contact"], "k-", lw=1.5, label="kinetic + strain + contact")
+    ax.set_xlabel("time")
+    ax.set_ylabel("energy")
+    worst = float(np.max(np.abs(e["balance_error"])))
+    ax.set_title(f"energies (largest balance error {worst:.2g})", fontsize=10)
+    ax.legend(fontsize=8, loc="best")
+    ax.grid(alpha=0.3)
+    path = out_dir / "energy.png"
+    tmp = path.with_name(".energy.tmp.png")
+    fig.savefig(tmp, bbox_inches="tight")
+    plt.close(fig)
+    tmp.replace(path)
+    return path
+
+
+def _dynamic(out_dir: Path) -> bool:
+    """Whether the run's last step was a dynamic one (its summary record has energies)."""
+    import json
+
+    try:
+        steps = json.loads((out_dir / "summary.json").read_text()).get("steps", [])
+    except (OSError, ValueError):
+        return False
+    return bool(steps) and "energy" in steps[-1]
 
 
 def _length_unit(out_dir: Path) -> str:
