@@ -51,6 +51,7 @@ class Problem:
     stage_name: str = "stage1"                           # the name of the first stage
     units: str = ""  # as stated by the user, e.g. "mm, N, MPa" (length first): labels of the pictures
     dynamics: Dynamics | None = None  # the first stage dynamic (None: quasi-static)
+    gravity: tuple[float, float, float] | None = None  # a body force rho g on every body, in full from the start
     initial_velocity: list[InitialVelocity] = field(default_factory=list)
 
     def stage_dynamics(self, index: int) -> Dynamics | None:

@@ -59,16 +59,16 @@ def read_initial_velocities(top: Section, sets) -> list[InitialVelocity]:
     return out
 
 
-def check_densities(top: Section, bodies) -> None:
-    """A problem with a dynamic stage needs the mass density of every material: one line naming the first one
-    without."""
+def check_densities(top: Section, bodies, why: str = "a dynamic stage") -> None:
+    """A problem with a dynamic stage (or gravity, ``why``) needs the mass density of every material: one line
+    naming the first one without."""
     for i, body in enumerate(bodies):
         if getattr(body.material, "density", None) is None and (not body.materials or _uses_default(body)):
-            top.fail("missing: a dynamic stage needs the mass density of every material (e.g. density = 7.85e-9 "
-                     "in t/mm^3 with mm, N, MPa)", f"bodies[{i}].material.density")
+            top.fail(f"missing: {why} needs the mass density of every material (e.g. density = 7.85e-9 "
+                     f"in t/mm^3 with mm, N, MPa)", f"bodies[{i}].material.density")
         for name, mat in body.materials.items():
             if getattr(mat, "density", None) is None:
-                top.fail("missing: a dynamic stage needs the mass density of every material",
+                top.fail(f"missing: {why} needs the mass density of every material",
                          f"bodies[{i}].materials.{name}.density")
 
 

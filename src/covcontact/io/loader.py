@@ -54,6 +54,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     meta_stage = meta.get("stage", "str", "stage1")
     units = meta.get("units", "str", "")
     dynamics = read_dynamics(meta)
+    gravity = meta.get("gravity", "vector", None)
     meta.done()
 
     bodies = read_bodies(top, base)
@@ -81,8 +82,9 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     for st in top.get("stages", "array", []):
         stages.append(stage(st, named, dirichlet, rigid, contacts, stages, stage_name))
 
-    if dynamics is not None or any(st.dynamics is not None for st in stages):
-        check_densities(top, bodies)
+    if dynamics is not None or any(st.dynamics is not None for st in stages) or gravity is not None:
+        check_densities(top, bodies, "gravity" if dynamics is None and not any(st.dynamics for st in stages)
+                        else "a dynamic stage")
         if any(r.free for r in rigid):
             top.fail("rigid bodies with free components have no mass yet: a dynamic stage cannot move them; "
                      "prescribe their motion", "rigid")
@@ -94,4 +96,4 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
-                   units=units, dynamics=dynamics, initial_velocity=velocities)
+                   units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity)

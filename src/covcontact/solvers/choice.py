@@ -37,7 +37,8 @@ def auto_amg(problem) -> bool:
     if any(b.formulation != "solid" or not 0.0 <= float(getattr(b.material, "nu", 1.0)) <= AUTO_AMG_NU
            or b.mesh.cell_type not in FACES for b in problem.bodies):
         return False
-    if any(c.friction for c in problem.contacts) or any(rb.free for rb in problem.rigid) or _dynamic(problem):
+    if any(c.friction for c in problem.contacts) or any(rb.free for rb in problem.rigid) or _dynamic(problem) \
+            or getattr(problem, "gravity", None) is not None:
         return False
     on_boundary = sum(np.unique(boundary_faces(b.mesh)[0]).size for b in problem.bodies)
     return on_boundary <= AUTO_AMG_BOUNDARY * n_nodes
@@ -148,6 +149,9 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if distributes(linear) and any(rb.free for rb in problem.rigid):
         raise InputError(f"{where}: rigid bodies with free components (reference nodes) are not available with "
                          f"the distributed solver {linear!r} yet; use a serial solver")
+    if distributes(linear) and getattr(problem, "gravity", None) is not None:
+        raise InputError(f"{where}: gravity is not available with the distributed solver {linear!r} yet; use a "
+                         f"serial solver (--solver pardiso or superlu)")
     if distributes(linear) and _dynamic(problem):
         raise InputError(f"{where}: dynamic stages are not available with the distributed solver {linear!r} yet; "
                          f"use a serial solver (--solver pardiso or superlu)")

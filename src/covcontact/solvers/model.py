@@ -97,8 +97,20 @@ class Model:
         return self.loading.prescribed(lam)
 
     def external(self, lam: float) -> np.ndarray:
-        """External forces at load factor lam of the current stage."""
-        return self.loading.external(lam)
+        """External forces at load factor lam of the current stage (and the weight, in full at every lam)."""
+        f = self.loading.external(lam)
+        return f + self.weight if self.weight is not None else f
+
+    @property
+    def weight(self) -> np.ndarray | None:
+        """The bodies' weight under ``problem.gravity``: int rho N_a g dV0 = M (g at every node), None without
+        gravity."""
+        g = getattr(self.problem, "gravity", None)
+        if g is None:
+            return None
+        if getattr(self, "_weight", None) is None:
+            self._weight = self.system.mass() @ np.tile(np.asarray(g, dtype=float), self.system.n_nodes)
+        return self._weight
 
     def eliminate(self, K):
         return self.system.eliminate(K)

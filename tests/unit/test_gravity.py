@@ -1,0 +1,62 @@
+"""Gravity (``[problem] gravity``): the weight int rho N_a g dV0 on every body, in full from the start of the run
+(docs/input.md, "Dynamics")."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from covcontact.io.loader import load_problem
+from covcontact.io.validate import InputError
+
+COLUMN = """
+[problem]
+name = "column"
+gravity = [0.0, 0.0, -9.81]
+EXTRA
+[[bodies]]
+name = "col"
+element = "CELL"
+material = { model = "svk", E = 1.0e5, nu = 0.3, density = 2.0 }
+mesh = { generator = "block", lx = 1.0, ly = 0.5, lz = 2.0, nx = 2, ny = 1, nz = 4 }
+SUPPORT
+"""
+
+
+@pytest.mark.parametrize("cell", ["hex8", "tet10", "hex27"])
+def test_static_weight_is_carried_by_the_support(tmp_path, cell):
+    """A column on its base: the base's reaction is the weight rho V g, exactly, in the first step already."""
+    path = tmp_path / "c.toml"
+    path.write_text(COLUMN.replace("EXTRA", "").replace("CELL", cell)
+                    .replace("SUPPORT", '[[dirichlet]]\nset = "col.zmin"\n[steps]\ncount = 2'))
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    for s in res.summary["steps"]:
+        np.testing.assert_allclose(s["reactions"]["col.zmin"], [0.0, 0.0, 2.0 * 1.0 * 9.81], atol=1e-9)
+
+
+def test_free_fall(tmp_path):
+    """An unsupported column falls: every node at -g t^2 / 2 (the trapezoidal rule is exact for a constant
+    acceleration), its kinetic energy the work of its weight."""
+    path = tmp_path / "f.toml"
+    path.write_text(COLUMN.replace("EXTRA", 'procedure = "dynamic"\ndt = 0.05\nt_end = 0.5\nmethod = "newmark"')
+                    .replace("CELL", "hex8").replace("SUPPORT", ""))
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    s = res.summary["steps"][-1]
+    u = res.u.reshape(-1, 3)
+    np.testing.assert_allclose(u[:, 2], -0.5 * 9.81 * 0.5 ** 2, rtol=1e-10)
+    np.testing.assert_allclose(u[:, :2], 0.0, atol=1e-12)
+    m = 2.0 * 1.0
+    assert s["energy"]["kinetic"] == pytest.approx(0.5 * m * (9.81 * 0.5) ** 2, rel=1e-10)
+    assert s["energy"]["external_work"] == pytest.approx(s["energy"]["kinetic"], rel=1e-10)
+    assert abs(s["energy"]["balance_error"]) < 1e-10
+
+
+def test_gravity_needs_densities(tmp_path):
+    path = tmp_path / "c.toml"
+    path.write_text(COLUMN.replace("EXTRA", "").replace("CELL", "hex8").replace(", density = 2.0", "")
+                    .replace("SUPPORT", '[[dirichlet]]\nset = "col.zmin"'))
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert "bodies[0].material.density" in str(err.value) and "gravity needs the mass density" in str(err.value)
