@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import math
 import statistics
 import sys
 import tempfile
@@ -24,44 +23,19 @@ from _report import emit
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
-from hertz_setup import E, NU, R, hertz_mesh, hertz_problem  # noqa: E402
+from hertz_setup import hertz_mesh, hertz_problem, impact_problem, impact_reference  # noqa: E402
 
-from covcontact.materials import SaintVenantKirchhoff  # noqa: E402
-from covcontact.problem import (  # noqa: E402
-    Body,
-    ContactPair,
-    Dirichlet,
-    Dynamics,
-    InitialVelocity,
-    OutputOptions,
-    Problem,
-    RigidBody,
-)
-
-V, RHO = 3e-4, 1.0
-E_STAR = E / (1.0 - NU ** 2)
-M_HALF = RHO * 2.0 / 3.0 * math.pi * R ** 3
-T_C = 2.868 * (M_HALF ** 2 / (R * E_STAR ** 2 * V)) ** 0.2
-DEPTH = (15.0 * M_HALF * V * V / (16.0 * E_STAR * math.sqrt(R))) ** 0.4  # Hertz's largest indentation
+V = 3e-4
+DEPTH = impact_reference(V)[2]  # Hertz's largest indentation
 
 
-def impact(n: int, reuse: bool) -> Problem:
-    mesh = hertz_mesh(n=n, nr=n // 2)
-    dyn = Dynamics(dt=1.2 * T_C / 100, t_end=1.2 * T_C, method="newmark", mass="redistributed")
-    prob = Problem(
-        name="hertz-impact",
-        bodies=[Body("ball", mesh, SaintVenantKirchhoff(E=E, nu=NU, density=RHO))],
-        dirichlet=[Dirichlet("ball", "symx", (0,), (0.0,)), Dirichlet("ball", "symy", (1,), (0.0,))],
-        rigid=[RigidBody("floor", shape="plane", params={"point": (0.0, 0.0, 0.0), "normal": (0.0, 0.0, 1.0)})],
-        contacts=[ContactPair("floor", ("ball", "curved"), ("floor", ""), penalty=1e4, weighting="area")],
-        steps=dyn.steps(), output=OutputOptions(vtu=False), dynamics=dyn,
-        initial_velocity=[InitialVelocity("ball", "", (0.0, 0.0, -V))],
-    )
+def impact(n: int, reuse: bool):
+    prob = impact_problem(hertz_mesh(n=n, nr=n // 2), V)
     prob.solver = dataclasses.replace(prob.solver, reuse_factorization=reuse)
     return prob
 
 
-def static(n: int) -> Problem:
+def static(n: int):
     prob = hertz_problem(hertz_mesh(n=n, nr=n // 2), "svk", steps=10, d_max=DEPTH, vtu=False)
     prob.solver = dataclasses.replace(prob.solver, reuse_factorization=False)
     return prob

@@ -10,41 +10,15 @@ from covcontact.contact.selfcontact import drop_excluded, excluded_facets
 from covcontact.io.loader import load_problem
 from covcontact.mesh.generators import block
 from covcontact.tangent_check import check_tangent
+from two_blocks import two_blocks
 
-TWO_BLOCKS = """
-[problem]
-name = "two-blocks-self"
-[[bodies]]
-name = "base"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 4, ny = 4, nz = 1, origin = [-1.0, -1.0, -0.5] }
-[[bodies]]
-name = "punch"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
-[[contact]]
-PAIR
-penalty = 2.0e4
-weighting = "area"
-tangent = "exact"
-EXTRA
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.03, 0.01, -0.01]
-[steps]
-count = 3
-"""
 MERGED = 'self = ["punch.zmin", "base.zmax"]'
 PAIR = 'slave = "punch.zmin"\nmaster = "base.zmax"\ntwo_pass = true'
 
 
 def _problem(tmp_path, pair: str, extra: str = "", name: str = "p"):
     path = tmp_path / f"{name}.toml"
-    path.write_text(TWO_BLOCKS.replace("PAIR", pair).replace("EXTRA", extra))
+    path.write_text(two_blocks(extra='weighting = "area"\n' + extra, pair=pair))
     return load_problem(path)
 
 

@@ -12,42 +12,11 @@ from covcontact.io.loader import load_problem
 from covcontact.io.validate import InputError
 from covcontact.solvers.model import Model
 from covcontact.tangent_check import check_tangent
-
-TWO_BLOCKS = """
-[problem]
-name = "two-blocks-sts"
-[[bodies]]
-name = "base"
-element = "CELL"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 4, ny = 4, nz = 1, origin = [-1.0, -1.0, -0.5] }
-[[bodies]]
-name = "punch"
-element = "CELL"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
-[[contact]]
-slave = "punch.zmin"
-master = "base.zmax"
-penalty = 2.0e4
-type = "sts"
-tangent = "exact"
-EXTRA
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.03, 0.01, -0.01]
-[steps]
-count = 3
-"""
-
+from two_blocks import two_blocks
 
 def _problem(tmp_path, extra: str = "", cell: str = "hex8"):
     path = tmp_path / "p.toml"
-    path.write_text(TWO_BLOCKS.replace("EXTRA", extra).replace("CELL", cell))
+    path.write_text(two_blocks(cell, cell, 'type = "sts"\n' + extra))
     return load_problem(path)
 
 
@@ -198,7 +167,7 @@ def test_bad_input(tmp_path, extra, message):
      "self-contact: write self = \"punch.zmin\""),
 ])
 def test_bad_pairs(tmp_path, old, new, message):
-    text = TWO_BLOCKS.replace("EXTRA", "").replace("CELL", "hex8")
+    text = two_blocks(extra='type = "sts"')
     assert old in text
     path = tmp_path / "p.toml"
     path.write_text(text.replace(old, new))

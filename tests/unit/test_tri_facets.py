@@ -16,6 +16,7 @@ from covcontact.io.loader import load_problem
 from covcontact.mesh.convert import convert
 from covcontact.mesh.generators import block
 from covcontact.tangent_check import check_tangent
+from two_blocks import PAIR, two_blocks
 
 RNG = np.random.default_rng(7)
 
@@ -133,37 +134,6 @@ def test_row_expansion_is_the_chain_rule():
     assert set(c2[1]) == {1, 2, 6, 4, 8, 9, 10, 11, 12, 13}
 
 
-TWO_BLOCKS = """
-[problem]
-name = "two-blocks-tri"
-[[bodies]]
-name = "base"
-element = "BASE"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 4, ny = 4, nz = 1, origin = [-1.0, -1.0, -0.5] }
-[[bodies]]
-name = "punch"
-element = "PUNCH"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
-[[contact]]
-slave = "punch.zmin"
-master = "base.zmax"
-penalty = 2.0e4
-tangent = "exact"
-EXTRA
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.03, 0.01, -0.01]
-[steps]
-count = 3
-"""
-
-
 @pytest.mark.parametrize("base, punch, extra", [
     ("tet4", "tet4", 'type = "sts"'),
     ("tet4", "hex8", ""),
@@ -179,7 +149,7 @@ def test_exact_tangent_against_differences(tmp_path, base, punch, extra):
     matches central differences of the residual to 1e-6 (relative, 60 columns, half of them in the contact zone) at
     steps 1 and 3 (sticking and sliding with friction)."""
     path = tmp_path / "p.toml"
-    path.write_text(TWO_BLOCKS.replace("BASE", base).replace("PUNCH", punch).replace("EXTRA", extra))
+    path.write_text(two_blocks(base, punch, extra))
     prob = load_problem(path)
     for step in (1, 3):
         rep = check_tangent(prob, step=step, columns=60)
@@ -193,7 +163,7 @@ def test_run_reports_triangle_facets(tmp_path):
     import meshio
 
     path = tmp_path / "p.toml"
-    path.write_text(TWO_BLOCKS.replace("BASE", "hex8").replace("PUNCH", "tet10").replace("EXTRA", 'type = "sts"'))
+    path.write_text(two_blocks("hex8", "tet10", 'type = "sts"'))
     res = load_problem(path).run(out=tmp_path / "out")
     assert res.exit_code == 0
     vtu = meshio.read(tmp_path / "out" / "step_0003.vtu")
@@ -215,13 +185,11 @@ def test_self_contact_on_triangles(tmp_path, cell, extra):
     """Two tetrahedral bodies' face sets merged into one self-contact surface act as the two-pass pair between them
     (same iterations, displacements to round-off): a facet excluded for a slave takes all its patch quadrilaterals
     with it. The exact tangent matches central differences."""
-    pair = 'slave = "punch.zmin"\nmaster = "base.zmax"'
-    text = TWO_BLOCKS.replace("BASE", cell).replace("PUNCH", cell).replace("EXTRA", extra + "\nweighting = \"area\""
-                                                                           if cell == "tet4" else extra)
+    extra = extra + '\nweighting = "area"' if cell == "tet4" else extra
     runs = {}
-    for name, repl in (("self", 'self = ["punch.zmin", "base.zmax"]'), ("pair", pair + "\ntwo_pass = true")):
+    for name, pair in (("self", 'self = ["punch.zmin", "base.zmax"]'), ("pair", PAIR + "\ntwo_pass = true")):
         path = tmp_path / f"{name}.toml"
-        path.write_text(text.replace(pair, repl))
+        path.write_text(two_blocks(cell, cell, extra, pair))
         runs[name] = load_problem(path)
     a = runs["self"].run(out=tmp_path / "self")
     b = runs["pair"].run(out=tmp_path / "pair")

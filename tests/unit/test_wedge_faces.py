@@ -15,6 +15,7 @@ from covcontact.mesh.faces import face_normals
 from covcontact.mesh.generators import block
 from covcontact.mesh.io import MeshError, read_mesh
 from covcontact.tangent_check import check_tangent
+from two_blocks import two_blocks
 
 
 def test_generated_sets_are_one_type_each_and_outward():
@@ -155,34 +156,7 @@ def test_face_filters_of_one_type(tmp_path):
 def test_wedge_faces_in_contact(tmp_path):
     """A block pressed onto a wedge block: the wedges' triangular top as the master (tri3 patches) and their
     quadrilateral sides are not involved; exact tangent against central differences."""
-    text = """
-[problem]
-name = "on-wedges"
-[[bodies]]
-name = "base"
-element = "wedge6"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 4, ny = 4, nz = 1, origin = [-1.0, -1.0, -0.5] }
-[[bodies]]
-name = "punch"
-material = { model = "neo-hooke", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
-[[contact]]
-slave = "punch.zmin"
-master = "base.zmax"
-penalty = 2.0e4
-type = "sts"
-friction = 0.2
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.03, 0.01, -0.01]
-[steps]
-count = 3
-"""
+    text = two_blocks("wedge6", "hex8", 'type = "sts"\nfriction = 0.2')
     path = tmp_path / "w.toml"
     path.write_text(text)
     prob = load_problem(path)

@@ -142,3 +142,33 @@ def hertz_measures(result, mesh: Mesh, d_max: float = D_MAX, pressure: bool = Tr
     out["a_ratio"] = np.array(a_m) / np.sqrt(R * d)
     out["p_center_error"] = np.array(p_err)
     return out
+
+
+def impact_problem(mesh: Mesh, v: float, steps: int = 100, mass: str = "redistributed", density: float = 1.0,
+                   span: float = 1.2) -> Problem:
+    """The quarter half-ball ``mesh`` (St. Venant-Kirchhoff) touching the rigid plane z = 0 at t = 0 with speed v
+    downward, Newmark's trapezoidal rule, ``steps`` steps over ``span`` times Hertz's contact duration t_c
+    (:func:`impact_reference`) (tests/verification/test_hertz_impact.py)."""
+    from covcontact.problem import Dynamics, InitialVelocity
+
+    t_c = impact_reference(v, density)[0]
+    dyn = Dynamics(dt=span * t_c / steps, t_end=span * t_c, method="newmark", mass=mass)
+    return Problem(
+        name="hertz-impact",
+        bodies=[Body("ball", mesh, SaintVenantKirchhoff(E=E, nu=NU, density=density))],
+        dirichlet=[Dirichlet("ball", "symx", (0,), (0.0,)), Dirichlet("ball", "symy", (1,), (0.0,))],
+        rigid=[RigidBody("floor", shape="plane", params={"point": (0.0, 0.0, 0.0), "normal": (0.0, 0.0, 1.0)})],
+        contacts=[ContactPair("floor", ("ball", "curved"), ("floor", ""), penalty=1e4, weighting="area")],
+        steps=dyn.steps(), output=OutputOptions(vtu=False), dynamics=dyn,
+        initial_velocity=[InitialVelocity("ball", "", (0.0, 0.0, -v))],
+    )
+
+
+def impact_reference(v: float, density: float = 1.0) -> tuple[float, float, float]:
+    """Hertz's impact of the half-ball (mass rho 2 pi R^3 / 3) at speed v (Johnson, Contact Mechanics, section
+    11.4): (contact duration t_c, peak force F_max, largest indentation)."""
+    m = density * 2.0 / 3.0 * math.pi * R ** 3
+    t_c = 2.868 * (m ** 2 / (R * E_STAR ** 2 * v)) ** 0.2
+    f_max = (5.0 / 4.0) ** 0.6 * (m * v * v) ** 0.6 * (4.0 / 3.0 * E_STAR * math.sqrt(R)) ** 0.4
+    depth = (15.0 * m * v * v / (16.0 * E_STAR * math.sqrt(R))) ** 0.4
+    return t_c, f_max, depth

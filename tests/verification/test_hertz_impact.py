@@ -12,28 +12,12 @@ half-ball's (4 times the quarter's).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-from hertz_setup import E, E_STAR, NU, R, hertz_mesh
+from hertz_setup import hertz_mesh, impact_problem, impact_reference
 
-from covcontact.materials import SaintVenantKirchhoff
-from covcontact.problem import (
-    Body,
-    ContactPair,
-    Dirichlet,
-    Dynamics,
-    InitialVelocity,
-    OutputOptions,
-    Problem,
-    RigidBody,
-)
-
-V, RHO = 3e-4, 1.0
-M_HALF = RHO * 2.0 / 3.0 * math.pi * R ** 3
-T_C = 2.868 * (M_HALF ** 2 / (R * E_STAR ** 2 * V)) ** 0.2
-F_MAX = (5.0 / 4.0) ** 0.6 * (M_HALF * V * V) ** 0.6 * (4.0 / 3.0 * E_STAR * math.sqrt(R)) ** 0.4
+V = 3e-4
+T_C, F_MAX, _ = impact_reference(V)
 
 
 def test_contact_duration_and_peak_force(tmp_path):
@@ -41,24 +25,15 @@ def test_contact_duration_and_peak_force(tmp_path):
     between 0.972 and 0.984 t_c; 0.975 to 0.980 with 240 steps), the peak force within 1 % of F_max (measured
     +0.14 %), one closing and one opening, the energy balance within 1e-3 (measured 2.2e-4) and the ball leaving
     with its kinetic energy (within 0.5 %)."""
-    mesh = hertz_mesh()
-    dyn = Dynamics(dt=1.2 * T_C / 100, t_end=1.2 * T_C, method="newmark", mass="redistributed")
-    prob = Problem(
-        name="hertz-impact",
-        bodies=[Body("ball", mesh, SaintVenantKirchhoff(E=E, nu=NU, density=RHO))],
-        dirichlet=[Dirichlet("ball", "symx", (0,), (0.0,)), Dirichlet("ball", "symy", (1,), (0.0,))],
-        rigid=[RigidBody("floor", shape="plane", params={"point": (0.0, 0.0, 0.0), "normal": (0.0, 0.0, 1.0)})],
-        contacts=[ContactPair("floor", ("ball", "curved"), ("floor", ""), penalty=1e4, weighting="area")],
-        steps=dyn.steps(), output=OutputOptions(vtu=False), dynamics=dyn,
-        initial_velocity=[InitialVelocity("ball", "", (0.0, 0.0, -V))],
-    )
+    prob = impact_problem(hertz_mesh(), V)
+    dt = prob.dynamics.dt
     res = prob.run(out=tmp_path)
     assert res.exit_code == 0
     steps = res.summary["steps"]
     active = np.array([s["active_contacts"] > 0 for s in steps])
     assert active[0] and np.count_nonzero(np.diff(active.astype(int))) == 1
     last = steps[int(np.flatnonzero(active)[-1])]["time"]
-    assert 0.97 * T_C < last and last + dyn.dt < 1.03 * T_C, (last / T_C, (last + dyn.dt) / T_C)
+    assert 0.97 * T_C < last and last + dt < 1.03 * T_C, (last / T_C, (last + dt) / T_C)
     force = 4.0 * np.array([s["contact_force"][2] for s in steps])
     assert force.max() == pytest.approx(F_MAX, rel=0.01)
     assert max(abs(s["energy"]["balance_error"]) for s in steps) < 1e-3

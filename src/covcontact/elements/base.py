@@ -130,7 +130,26 @@ class SolidStress:
 # ----------------------------------------------------------------------------- body
 
 
-class ElementBody:
+class CellCounts:
+    """Node, element and node-per-element counts of a body with reference coordinates ``X`` and ``cells``."""
+
+    X: np.ndarray
+    cells: np.ndarray
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.X.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        return int(self.cells.shape[0])
+
+    @property
+    def nen(self) -> int:
+        return int(self.cells.shape[1])
+
+
+class ElementBody(CellCounts):
     """Generic body of one hexahedral cell type (the subclass checks ``cell_type`` first).
 
     Args:
@@ -161,18 +180,6 @@ class ElementBody:
         self._flags = np.empty(0, dtype=np.int64)
         self._ranks_key: tuple[Pattern, int] | None = None
         self._ranks = np.empty((0, nen, nen), dtype=np.int32)
-
-    @property
-    def n_nodes(self) -> int:
-        return int(self.X.shape[0])
-
-    @property
-    def n_elements(self) -> int:
-        return int(self.cells.shape[0])
-
-    @property
-    def nen(self) -> int:
-        return int(self.cells.shape[1])
 
     # -- kernel calls (subclass) ----------------------------------------------------------------
     def _chunk(self, u: np.ndarray, e0: int, want_K: bool, Ke: np.ndarray, fe: np.ndarray,

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import ElementBody, stress_from_fields
+from .base import CellCounts, ElementBody, stress_from_fields
 
 
-class CompositeBody:
+class CompositeBody(CellCounts):
     """Element bodies ``parts`` over the same nodes, part k holding the cells ``index[k]`` of ``cells``.
 
     Args:
@@ -44,18 +44,6 @@ class CompositeBody:
         self.dNdxi, self.weights = getattr(first, "dNdxi", None), getattr(first, "weights", None)
         #: per part, the per-element shape of each of its state arrays
         self._tails = [{key: arr.shape[1:] for key, arr in b.new_state().items()} for b in self.parts]
-
-    @property
-    def n_nodes(self) -> int:
-        return int(self.X.shape[0])
-
-    @property
-    def n_elements(self) -> int:
-        return int(self.cells.shape[0])
-
-    @property
-    def nen(self) -> int:
-        return int(self.cells.shape[1])
 
     # -- state ----------------------------------------------------------------------------------
     def new_state(self) -> dict[str, np.ndarray]:
