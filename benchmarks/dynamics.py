@@ -23,7 +23,7 @@ from _report import emit
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "verification"))
 
-from hertz_setup import hertz_mesh, hertz_problem, impact_problem, impact_reference  # noqa: E402
+from hertz_setup import hertz_mesh, hertz_problem, impact_problem, impact_reference
 
 V = 3e-4
 DEPTH = impact_reference(V)[2]  # Hertz's largest indentation

@@ -13,7 +13,8 @@ import gmsh
 H_MIN, H_MAX = 0.016, 0.25
 
 
-def main(path: Path = Path(__file__).with_name("hertz_tet10.msh")) -> None:
+def main(path: Path | None = None) -> None:
+    path = Path(__file__).with_name("hertz_tet10.msh") if path is None else path
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.model.add("hertz")

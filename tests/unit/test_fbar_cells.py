@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from test_fbar import F_HOM, fd_tangent, residual, rotation, tangent
 
 from covcontact.elements.fbar import FbarBody
 from covcontact.materials import J2Plasticity, LinearHardening, NeoHooke, stress_tangent
 from covcontact.mesh.convert import SOURCE, convert
 from covcontact.mesh.generators import block
-from test_fbar import F_HOM, fd_tangent, residual, rotation, tangent
 
 
 def distorted(cell: str, n: int = 2, amp: float = 0.12, seed: int = 0):

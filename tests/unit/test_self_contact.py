@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from two_blocks import two_blocks
 
 from covcontact.contact.selfcontact import drop_excluded, excluded_facets
 from covcontact.io.loader import load_problem
 from covcontact.mesh.generators import block
 from covcontact.tangent_check import check_tangent
-from two_blocks import two_blocks
 
 MERGED = 'self = ["punch.zmin", "base.zmax"]'
 PAIR = 'slave = "punch.zmin"\nmaster = "base.zmax"\ntwo_pass = true'

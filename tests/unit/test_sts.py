@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from two_blocks import two_blocks
 
 from covcontact.contact.element import CASES
 from covcontact.contact.points import VirtualPoints, gauss_points
@@ -12,7 +13,7 @@ from covcontact.io.loader import load_problem
 from covcontact.io.validate import InputError
 from covcontact.solvers.model import Model
 from covcontact.tangent_check import check_tangent
-from two_blocks import two_blocks
+
 
 def _problem(tmp_path, extra: str = "", cell: str = "hex8"):
     path = tmp_path / "p.toml"

@@ -7,6 +7,7 @@ from __future__ import annotations
 import meshio
 import numpy as np
 import pytest
+from two_blocks import two_blocks
 
 from covcontact.io.loader import load_problem
 from covcontact.io.validate import InputError
@@ -15,7 +16,6 @@ from covcontact.mesh.faces import face_normals
 from covcontact.mesh.generators import block
 from covcontact.mesh.io import MeshError, read_mesh
 from covcontact.tangent_check import check_tangent
-from two_blocks import two_blocks
 
 
 def test_generated_sets_are_one_type_each_and_outward():

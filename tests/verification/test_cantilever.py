@@ -12,7 +12,7 @@ from scipy.optimize import brentq
 
 from covcontact.materials import SaintVenantKirchhoff
 from covcontact.mesh.generators import block
-from covcontact.problem import Body, Dirichlet, NodalForce, Problem, SolverOptions, Steps, OutputOptions
+from covcontact.problem import Body, Dirichlet, NodalForce, OutputOptions, Problem, SolverOptions, Steps
 
 MATTIASSON = {1.0: (0.05643, 0.30174), 2.0: (0.16064, 0.49346), 4.0: (0.32894, 0.66996)}
 

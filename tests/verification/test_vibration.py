@@ -12,6 +12,7 @@ tip's motion (the deflected shape of a tip force is close to it).
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -69,7 +70,7 @@ def _swing(tmp_path, nx, dt, method, rho_inf=1.0, periods=2.0):
     s = np.sign(w)
     k = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0))
     tz = t[k] - w[k] * (t[k + 1] - t[k]) / (w[k + 1] - w[k])
-    lows = np.array([w[(t >= a) & (t < b)].min() for a, b in zip(tz[:-1], tz[1:])])
+    lows = np.array([w[(t >= a) & (t < b)].min() for a, b in pairwise(tz)])
     return np.diff(tz), lows
 
 

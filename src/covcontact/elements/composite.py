@@ -69,7 +69,7 @@ class CompositeBody(CellCounts):
         own = self._tails[k]
         sub, where = {}, {}
         for key, arr in state.items():
-            base = key[:-2] if key.endswith("_n") else key
+            base = key.removesuffix("_n")
             if base not in own:
                 continue
             sel = (self.index[k], *(slice(0, n) for n in own[base]))

@@ -66,11 +66,41 @@ from typing import Any
 import numpy as np
 
 from .hyperelastic import LameConstants, lame
-from .logstrain import _dd1, _dd2  # noqa: F401  (re-exported for tests)
-from .plasticity_kernels import (  # noqa: F401  (the layout constants belong to this module's interface)
-    H_ALPHA, H_BETA, H_EP, H_FLAG, H_WP, J2, LAW_LINEAR, LAW_SWIFT, LAW_VOCE, NHIST, NPARAMS, P_BULK, P_E,
-    P_H, P_HILL, P_HILL_COEF, P_HKIN, P_LAMBDA, P_LAW, P_MU, P_NU, P_P, P_Q3, P_SWIFT_EPS0, P_SWIFT_K,
-    P_SWIFT_N, P_SY0, P_VOCE_DELTA, P_VOCE_SINF, RM_MAXIT, RM_TOL, _hardening, j2_response,
+from .logstrain import _dd1, _dd2
+from .plasticity_kernels import (
+    H_ALPHA,
+    H_BETA,
+    H_EP,
+    H_FLAG,
+    H_WP,
+    J2,
+    LAW_LINEAR,
+    LAW_SWIFT,
+    LAW_VOCE,
+    NHIST,
+    NPARAMS,
+    P_BULK,
+    P_E,
+    P_H,
+    P_HILL,
+    P_HILL_COEF,
+    P_HKIN,
+    P_LAMBDA,
+    P_LAW,
+    P_MU,
+    P_NU,
+    P_P,
+    P_Q3,
+    P_SWIFT_EPS0,
+    P_SWIFT_K,
+    P_SWIFT_N,
+    P_SY0,
+    P_VOCE_DELTA,
+    P_VOCE_SINF,
+    RM_MAXIT,
+    RM_TOL,
+    _hardening,
+    j2_response,
 )
 
 _LAWS = {"linear": LAW_LINEAR, "swift": LAW_SWIFT, "voce": LAW_VOCE}
