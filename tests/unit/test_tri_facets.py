@@ -184,7 +184,7 @@ def test_run_reports_triangle_facets(tmp_path):
 def test_self_contact_on_triangles(tmp_path, cell, extra):
     """Two tetrahedral bodies' face sets merged into one self-contact surface act as the two-pass pair between them
     (same iterations, displacements to round-off): a facet excluded for a slave takes all its patch quadrilaterals
-    with it. The exact tangent matches central differences."""
+    with it. The exact tangent of the tri3 self-contact matches central differences."""
     extra = extra + '\nweighting = "area"' if cell == "tet4" else extra
     runs = {}
     for name, pair in (("self", 'self = ["punch.zmin", "base.zmax"]'), ("pair", PAIR + "\ntwo_pass = true")):
@@ -197,6 +197,7 @@ def test_self_contact_on_triangles(tmp_path, cell, extra):
     assert [s["iterations"] for s in a.summary["steps"]] == [s["iterations"] for s in b.summary["steps"]]
     np.testing.assert_allclose(a.u, b.u, rtol=0, atol=1e-9 * np.abs(b.u).max())
     assert a.summary["steps"][-1]["pairs"]["contact1"]["active_contacts"] > 16
-    rep = check_tangent(runs["self"], step=3, columns=60)
-    assert rep["converged"] and rep["zones"]["contact"] > 0
-    assert rep["relative_error"] <= 1e-6, rep["relative_error"]
+    if cell == "tet4":  # (tri6 facets' tangents with friction: test_exact_tangent_against_differences)
+        rep = check_tangent(runs["self"], step=3, columns=60)
+        assert rep["converged"] and rep["zones"]["contact"] > 0
+        assert rep["relative_error"] <= 1e-6, rep["relative_error"]
