@@ -180,6 +180,13 @@ mass = "redistributed"
     return path
 
 
+def dynamic_auto(tmp: Path) -> Path:
+    """The dynamic maker's run with automatic time steps (their control's state is part of the checkpoint)."""
+    path = tmp / "dynamic_auto.toml"
+    path.write_text(dynamic(tmp).read_text().replace("dt = 0.05", "dt = 0.05\ndt_min = 0.005\ndt_max = 0.2"))
+    return path
+
+
 def _run(problem: Path, out: Path, *extra: str, wait=None) -> subprocess.CompletedProcess:
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(problem), "--out", str(out), *extra]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
@@ -224,9 +231,10 @@ def _has_gamg() -> bool:
 
 
 @pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks,
-                                  sts_friction, self_friction, two_materials, dynamic],
+                                  sts_friction, self_friction, two_materials, dynamic, dynamic_auto],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials", "dynamic"])
+                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials", "dynamic",
+                              "dynamic-auto"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():
         pytest.skip("petsc4py not installed (the `mpi` extra)")

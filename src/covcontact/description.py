@@ -141,16 +141,27 @@ class Dynamics:
     """A dynamic stage (``procedure = "dynamic"``): time steps ``dt`` up to ``t_end`` (the stage's load factor is
     t / t_end), the integrator ``method`` with the spectral radius ``rho_inf`` at infinite frequency (1: no
     numerical damping; generalized-alpha in [0, 1], HHT in [0.5, 1]; Newmark is the trapezoidal rule), and the
-    ``mass`` matrix, "consistent" or "lumped" (docs/theory.md, section 20)."""
+    ``mass`` matrix, "consistent", "lumped" or "redistributed" (docs/theory.md, section 20); ``dt_min`` and ``dt_max``
+    make the time steps automatic (from ``dt``, on the local error estimate against ``tolerance``)."""
 
     dt: float
     t_end: float
     method: str = "generalized-alpha"
     rho_inf: float = 1.0
     mass: str = "consistent"
+    dt_min: float | None = None  # with dt_max: automatic time steps from dt (docs/theory.md, section 20)
+    dt_max: float | None = None
+    tolerance: float = 1e-3      # automatic time steps: the local error estimate's target, relative
+
+    @property
+    def automatic(self) -> bool:
+        return self.dt_min is not None
 
     def steps(self) -> Steps:
-        """The stage's load factors: t / t_end at every time step (the last one may be shorter)."""
+        """The stage's load factors: t / t_end at every time step (the last one may be shorter); automatic time
+        steps start at dt and stay within [dt_min, dt_max]."""
+        if self.automatic:
+            return Steps.automatic(self.dt / self.t_end, self.dt_min / self.t_end, self.dt_max / self.t_end)
         n = int(np.ceil(self.t_end / self.dt * (1.0 - 1e-12)))
         return Steps(tuple(min((k + 1) * self.dt / self.t_end, 1.0) for k in range(n)))
 

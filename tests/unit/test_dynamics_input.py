@@ -36,6 +36,9 @@ value = [0.0, 0.0, 0.1]
     (('set = "bar.xmax"', 'set = "bar.xmux"'), "initial_velocity[0].set", "has no node set 'xmux'"),
     (('procedure = "dynamic"\n', ""), "problem.dt", "belongs to a dynamic stage"),
     (("[[dirichlet]]", "[steps]\ncount = 3\n[[dirichlet]]"), "steps", "takes its steps from dt and t_end"),
+    (("t_end = 1.0", "t_end = 1.0\ndt_min = 0.01"), "problem.dt_min", "need both dt_min and dt_max"),
+    (("t_end = 1.0", "t_end = 1.0\ndt_min = 0.2\ndt_max = 0.5"), "problem.dt", "must lie between dt_min"),
+    (("t_end = 1.0", "t_end = 1.0\ndt_min = 0.01\ndt_max = 2.0"), "problem.dt_max", "must not exceed"),
 ])
 def test_one_line(tmp_path, change, key, message):
     path = tmp_path / "p.toml"

@@ -8,7 +8,7 @@ from ..description import DYNAMIC_METHODS, Dynamics, InitialVelocity
 from .validate import Section
 
 #: the keys of a dynamic stage besides ``procedure``
-DYNAMIC_KEYS = ("dt", "t_end", "method", "rho_inf", "mass")
+DYNAMIC_KEYS = ("dt", "t_end", "method", "rho_inf", "mass", "dt_min", "dt_max", "tolerance")
 
 
 def read_dynamics(sec: Section) -> Dynamics | None:
@@ -34,7 +34,21 @@ def read_dynamics(sec: Section) -> Dynamics | None:
     if not lo <= rho <= 1.0:
         sec.fail(f"must lie in [{lo:g}, 1] for method = \"{method}\", got {rho:g}", "rho_inf")
     mass = sec.get("mass", "str", "consistent", choices=("consistent", "lumped", "redistributed"))
-    return Dynamics(dt=dt, t_end=t_end, method=method, rho_inf=rho, mass=mass)
+    auto = [k for k in ("dt_min", "dt_max") if sec.has(k)]
+    if len(auto) == 1:
+        sec.fail(f"automatic time steps need both dt_min and dt_max (and dt, the first step); add "
+                 f"{'dt_max' if auto[0] == 'dt_min' else 'dt_min'}", auto[0])
+    lo = sec.get("dt_min", "float", None, positive=True)
+    hi = sec.get("dt_max", "float", None, positive=True)
+    tol = sec.get("tolerance", "float", 1e-3, positive=True)
+    if auto:
+        if lo > hi:
+            sec.fail(f"dt_min = {lo:g} is above dt_max = {hi:g}", "dt_min")
+        if not lo <= dt <= hi:
+            sec.fail(f"the first time step must lie between dt_min = {lo:g} and dt_max = {hi:g}, got {dt:g}", "dt")
+        if hi > t_end:
+            sec.fail(f"must not exceed the stage's duration t_end = {t_end:g}, got {hi:g}", "dt_max")
+    return Dynamics(dt=dt, t_end=t_end, method=method, rho_inf=rho, mass=mass, dt_min=lo, dt_max=hi, tolerance=tol)
 
 
 def read_initial_velocities(top: Section, sets) -> list[InitialVelocity]:

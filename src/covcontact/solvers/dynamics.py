@@ -200,7 +200,7 @@ class Dynamic(QuasiStatic):
         if np.any(R[inert]):
             a[inert] = sla.spsolve(self.M[inert][:, inert].tocsc(), -R[inert])
         Rd = R + self.M @ a  # the supports' forces at rest or with the initial velocities' inertia
-        dyn = {"u": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
+        dyn = {"u": u.copy(), "u0": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
                "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam)}
         dyn["e0"] = np.array(self._energies(u, state.but(dynamics=dyn))["mechanical"])
         return state.but(dynamics=dyn)
@@ -212,13 +212,30 @@ class Dynamic(QuasiStatic):
         step instead of 2.2, the same iterations)."""
         newton = self.newton
         opt = newton.opt
+        self._before = state
         newton.model = self.dynamic_model
         if opt.reuse_factorization == "auto":
             newton.opt = replace(opt, reuse_factorization=True)
         try:
-            return super().advance(u, state, step, lam)
+            inc = super().advance(u, state, step, lam)
         finally:
             newton.model, newton.opt = self.model, opt
+        return inc
+
+    def _error(self, before: State, after: State) -> float:
+        """The step's local error estimate (Zienkiewicz and Xie 1991): dt^2 |beta - 1/6| ||a_(n+1) - a_n|| over the
+        displacement since the stage's start, in the mass norm ||x||_M = sqrt(x.M x) (dofs without mass, the contact
+        nodes of a redistributed mass, follow quasi-statically and do not count)."""
+        d0, d1 = before.dynamics, after.dynamics
+        dt = float(d1["time"]) - float(d0["time"])
+
+        def norm(x):
+            return float(np.sqrt(max(float(x @ (self.M @ x)), 0.0)))
+
+        moved = norm(d1["u"] - d1["u0"])
+        if not moved > 0.0:
+            return 0.0
+        return dt * dt * abs(self.integrator.beta - 1.0 / 6.0) * norm(d1["a"] - d0["a"]) / moved
 
     def _energies(self, u: np.ndarray, state: State) -> dict:
         """Kinetic, strain and contact (penalty) energy of ``state`` and their sum."""
@@ -233,7 +250,11 @@ class Dynamic(QuasiStatic):
         return {"kinetic": kinetic, "strain": strain, "contact": contact, "mechanical": kinetic + strain + contact}
 
     def _report(self, inc: Increment, u: np.ndarray, stats0: dict, time0: dict) -> dict:
+        if inc.success and self.automatic:  # (the increment control reads it after the report)
+            inc.error = self._error(self._before, inc.state)
         entry = super()._report(inc, u, stats0, time0)
+        if inc.success and self.automatic:
+            entry["error_estimate"] = inc.error
         if not inc.success:
             return entry
         state = inc.state

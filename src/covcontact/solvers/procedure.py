@@ -110,10 +110,47 @@ class AutomaticIncrements:
         self.increment, self.easy = float(state["increment"]), int(state["easy"])
 
 
-def increment_control(spec, steps):
-    """The increment control of stage ``spec`` from its ``Steps``: automatic or the given load factors."""
+class TimeSteps(AutomaticIncrements):
+    """Automatic time steps of a dynamic stage: on the local error estimate of Zienkiewicz and Xie (1991, Earthquake
+    Eng. Struct. Dyn. 20, 871-887), eta = dt^2 |beta - 1/6| ||a_(n+1) - a_n|| / ||u_(n+1) - u_start|| in the mass
+    norm (the step's ``error``, set by the procedure), against ``tol``: a step above it makes the next dt * max(0.5, 0.9
+    (tol / eta)^(1/3)); below tol / 4, after ``EASY_STEPS`` such steps in a row without a change of the active set,
+    the next grows by min(``GROW``, 0.9 (tol / eta)^(1/3)). Newton's verdicts as in ``AutomaticIncrements``: cutbacks
+    set the size that converged, a hard step (more than ``HARD_ITERATIONS``) or a contact that opened or closed
+    shrinks by ``SHRINK`` (contact events are resolved with short steps)."""
+
+    def __init__(self, initial: float, lo: float, hi: float, end: float, tol: float, marks=()):
+        super().__init__(initial, lo, hi, end, marks)
+        self.tol = float(tol)
+
+    def record(self, inc, converged: list) -> None:
+        if not inc.success:
+            return
+        if inc.cutbacks:
+            a, b = converged[-1]
+            self.increment, self.easy = min(max(b - a, self.lo), self.hi), 0
+            return
+        eta = float(getattr(inc, "error", 0.0))
+        factor = 0.9 * (self.tol / eta) ** (1.0 / 3.0) if eta > 0.0 else self.GROW
+        if eta > self.tol:
+            self.increment, self.easy = max(self.increment * max(0.5, factor), self.lo), 0
+        elif inc.outcomes[-1].iterations > self.HARD_ITERATIONS or inc.opened_closed > 0:
+            self.increment, self.easy = max(self.increment * self.SHRINK, self.lo), 0
+        elif eta < 0.25 * self.tol:
+            self.easy += 1
+            if self.easy >= self.EASY_STEPS:
+                self.increment, self.easy = min(self.increment * min(self.GROW, factor), self.hi), 0
+        else:
+            self.easy = 0
+
+
+def increment_control(spec, steps, dynamics=None):
+    """The increment control of stage ``spec`` from its ``Steps``: automatic (time steps of a dynamic stage
+    ``dynamics`` on their error estimate) or the given load factors."""
     marks = () if steps is None else steps.output_at
     if steps is not None and steps.is_automatic:
+        if dynamics is not None:
+            return TimeSteps(steps.initial, steps.min, steps.max, spec.lam_end, dynamics.tolerance, marks)
         return AutomaticIncrements(steps.initial, steps.min, steps.max, spec.lam_end, marks)
     return FixedIncrements(spec.factors, marks)
 
@@ -139,6 +176,7 @@ class Increment:
     active: int = 0  # slave nodes in contact at its end (automatic increments)
     plastic_changed: int = 0  # Gauss points that started or stopped yielding in the step (automatic increments)
     yielding: int = 0  # Gauss points yielding in the step (automatic increments)
+    error: float = 0.0  # a dynamic step's local error estimate (automatic time steps)
 
     @property
     def iterations(self) -> int:

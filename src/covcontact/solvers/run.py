@@ -220,7 +220,7 @@ class Run:
                 self.state = model.enter_stage(self.u, self.state)
                 self.newton.linear.set_near_null_space(model.near_null_space())
             t_stage = sum(q.lam_end for q in plan.stages[:si])     # the earlier stages' total pseudo-time
-            control = increment_control(spec, stage_steps(self.problem)[si])
+            control = increment_control(spec, stage_steps(self.problem)[si], self.problem.stage_dynamics(si))
             if self.control_state.get("stage") == si:  # resumed inside this stage
                 control.restore(self.control_state)
             dyn = self.problem.stage_dynamics(si)
