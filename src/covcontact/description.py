@@ -52,6 +52,8 @@ class RigidBody:
     force: tuple = (0.0, 0.0, 0.0)      # applied force (at load factor 1 of the first stage)
     moment: tuple = (0.0, 0.0, 0.0)     # applied moment about the reference point
     reference: tuple | None = None      # reference point (default: centre, point, or the mesh's centroid)
+    mass: float | None = None           # dynamics: the mass of a body with free translations
+    inertia: tuple | None = None        # dynamics: principal moments about the reference point (x, y, z axes)
 
     def reference_point(self) -> np.ndarray:
         if self.reference is not None:

@@ -171,7 +171,14 @@ class System:
                     raise ValueError(f"body {body.name!r}: its material has no density (needed for the mass)")
                 cells = body.mesh.cells[idx]
                 parts.append((cells + blk.offset, element_masses(body.mesh.cell_type, body.mesh.points, cells, rho)))
-        return dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless))
+        M = dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless))
+        if self.reference:  # rigid bodies with free components: mass on A, rotary inertia on B (small rotations)
+            diag = np.zeros(self.n_dofs)
+            for ref in self.reference:
+                diag[3 * ref.A: 3 * ref.A + 3] = ref.mass
+                diag[3 * ref.B: 3 * ref.B + 3] = ref.inertia
+            M = (M + sp.diags(diag)).tocsr()
+        return M
 
     @staticmethod
     def _reference_nodes(rigid, offset: int) -> list:
@@ -184,7 +191,8 @@ class System:
             if rb.free:
                 A = offset + 2 * len(out)
                 out.append(ReferenceBody(rb.name, A, A + 1, rb.reference_point(), tuple(rb.free),
-                                         np.asarray(rb.force, dtype=float), np.asarray(rb.moment, dtype=float)))
+                                         np.asarray(rb.force, dtype=float), np.asarray(rb.moment, dtype=float),
+                                         float(rb.mass or 0.0), np.asarray(rb.inertia or (0.0, 0.0, 0.0), float)))
         return out
 
     # -- numbering ------------------------------------------------------------------------------

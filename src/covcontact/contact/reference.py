@@ -23,7 +23,7 @@ to round-off).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -115,6 +115,8 @@ class ReferenceBody:
     free: tuple[int, ...]  # free components 0..5 (x, y, z, rx, ry, rz)
     force: np.ndarray      # applied force at load factor 1
     moment: np.ndarray     # applied moment (about the reference point) at load factor 1
+    mass: float = 0.0      # dynamics and gravity: the body's mass (on A)
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros(3))  # principal moments about X_ref (on B)
 
     def pose(self, x: np.ndarray) -> Pose:
         """The pose at the system positions x (N, 3): A's position is p, B's is theta."""

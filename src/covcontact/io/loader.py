@@ -85,9 +85,14 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     if dynamics is not None or any(st.dynamics is not None for st in stages) or gravity is not None:
         check_densities(top, bodies, "gravity" if dynamics is None and not any(st.dynamics for st in stages)
                         else "a dynamic stage")
-        if any(r.free for r in rigid):
-            top.fail("rigid bodies with free components have no mass yet: a dynamic stage cannot move them; "
-                     "prescribe their motion", "rigid")
+        for i, r in enumerate(rigid):  # a free rigid body moves by its mass and inertia
+            if any(c < 3 for c in r.free) and r.mass is None:
+                top.fail("missing: a rigid body with free translations needs its mass in a dynamic stage (or with "
+                         "gravity)", f"rigid[{i}].mass")
+            if any(c >= 3 for c in r.free) and r.inertia is None and (dynamics is not None or any(
+                    st.dynamics is not None for st in stages)):
+                top.fail("missing: a rigid body with free rotations needs its principal moments of inertia "
+                         "[Ixx, Iyy, Izz] about its reference point in a dynamic stage", f"rigid[{i}].inertia")
     elif velocities:
         top.fail("initial velocities need a dynamic stage (procedure = \"dynamic\")", "initial_velocity")
     solver = read_solver(top)

@@ -51,6 +51,14 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         force = r.get("force", "vector", (0.0, 0.0, 0.0))
         moment = r.get("moment", "vector", (0.0, 0.0, 0.0))
         reference = r.get("reference", "vector", None)
+        mass = r.get("mass", "float", None, positive=True)
+        inertia = r.get("inertia", "vector", None)
+        if inertia is not None and not all(v > 0.0 for v in inertia):
+            r.fail(f"the principal moments of inertia must be > 0, got {list(inertia)}", "inertia")
+        for key, val in (("mass", mass), ("inertia", inertia)):
+            if val is not None and not free:
+                r.fail(f"{key} is for a body with free components (its motion follows equilibrium); this one's "
+                       f"motion is prescribed", key)
         for key, vec, first in (("force", force, 0), ("moment", moment, 3)):
             bad = [i for i in range(3) if vec[i] != 0.0 and first + i not in free]
             if bad:
@@ -59,7 +67,7 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
                        key)
         r.done()
         rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params, free=free,
-                               force=force, moment=moment, reference=reference))
+                               force=force, moment=moment, reference=reference, mass=mass, inertia=inertia))
     return rigid
 
 
