@@ -76,14 +76,21 @@ class AutomaticIncrements:
         stop = next((m for m in self.marks + (self.end,) if m > lam + 1e-9 * max(1.0, abs(m))), self.end)
         return stop if t >= stop - self.lo else t
 
-    def record(self, inc, converged: list) -> None:
-        """Adapt the increment to how step ``inc`` went (``converged``: its increments that converged, after
-        cutbacks the last one is the size that worked)."""
+    def _settled(self, inc, converged: list) -> bool:
+        """True when step ``inc`` leaves nothing to adapt: it failed, or it needed cutbacks (then the increment that
+        finally converged, the last of ``converged``, is the next one's size)."""
         if not inc.success:
-            return
+            return True
         if inc.cutbacks:
             a, b = converged[-1]
             self.increment, self.easy = min(max(b - a, self.lo), self.hi), 0
+            return True
+        return False
+
+    def record(self, inc, converged: list) -> None:
+        """Adapt the increment to how step ``inc`` went (``converged``: its increments that converged, after
+        cutbacks the last one is the size that worked)."""
+        if self._settled(inc, converged):
             return
         its = inc.outcomes[-1].iterations
         moved = (inc.opened_closed > max(self.SET_CHANGE_MIN, self.SET_CHANGE * inc.active)
@@ -124,11 +131,7 @@ class TimeSteps(AutomaticIncrements):
         self.tol = float(tol)
 
     def record(self, inc, converged: list) -> None:
-        if not inc.success:
-            return
-        if inc.cutbacks:
-            a, b = converged[-1]
-            self.increment, self.easy = min(max(b - a, self.lo), self.hi), 0
+        if self._settled(inc, converged):
             return
         eta = float(getattr(inc, "error", 0.0))
         factor = 0.9 * (self.tol / eta) ** (1.0 / 3.0) if eta > 0.0 else self.GROW
