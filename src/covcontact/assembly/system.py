@@ -106,15 +106,7 @@ def make_solid(body, elements: np.ndarray | None = None):
     cells = body.mesh.cells if elements is None else body.mesh.cells[elements]
     if not body.materials:
         return _element_body(body, body.material, cells)
-    owner = np.full(body.mesh.n_cells, -1)
-    for k, name in enumerate(body.materials):
-        owner[body.mesh.element_sets[name]] = k
-    owner = owner if elements is None else owner[elements]
-    parts = []
-    for k, material in enumerate([body.material, *body.materials.values()]):
-        idx = np.flatnonzero(owner == k - 1)
-        if idx.size:
-            parts.append((idx, _element_body(body, material, cells[idx])))
+    parts = [(idx, _element_body(body, material, cells[idx])) for _, idx, material in body.material_parts(elements)]
     if len(parts) <= 1:  # one material over these cells (in their order)
         return parts[0][1] if parts else _element_body(body, body.material, cells)
     from ..elements.composite import CompositeBody
@@ -159,13 +151,7 @@ class System:
 
         parts = []
         for blk, body in zip(self.blocks, self.bodies.values()):
-            owner = np.full(body.mesh.n_cells, -1)
-            for k, name in enumerate(body.materials):
-                owner[body.mesh.element_sets[name]] = k
-            for k, material in enumerate([body.material, *body.materials.values()]):
-                idx = np.flatnonzero(owner == k - 1)
-                if not idx.size:
-                    continue
+            for _, idx, material in body.material_parts():
                 rho = getattr(material, "density", None)
                 if rho is None:
                     raise ValueError(f"body {body.name!r}: its material has no density (needed for the mass)")

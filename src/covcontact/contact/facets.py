@@ -51,16 +51,21 @@ def patch_nen(nen: int) -> int:
     return 4 if nen in (3, 4) else 9
 
 
+def _patch_parameters(nen: int) -> np.ndarray:
+    """(nsub, 4|9, 2): the face parameters zeta_v of the patch nodes of each sub-quadrilateral of a tri3, tri6 or
+    quad8 face (the bilinear map of the sub-quadrilateral's corners)."""
+    corners = _CORNERS["quad8" if nen == 8 else "tri"]
+    Nq = shape_functions("quad4", NODES["quad4" if patch_nen(nen) == 4 else "quad9"].astype(float))[0]
+    return np.einsum("vc,scd->svd", Nq, corners)
+
+
 def patch_weights(nen: int) -> np.ndarray:
     """(nsub, 4|9, nen): the weights N_a(zeta_v) of the patch nodes v of each sub-quadrilateral on the face's nodes."""
     ftype = FACE_BY_NODES[nen]
     if ftype in ("quad4", "quad9"):
         return np.eye(nen)[None]
-    corners = _CORNERS["quad8" if ftype == "quad8" else "tri"]
-    qn = patch_nen(nen)
-    Nq = shape_functions("quad4", NODES["quad4" if qn == 4 else "quad9"].astype(float))[0]  # bilinear map
-    zeta = np.einsum("vc,scd->svd", Nq, corners)  # (nsub, qn, 2) parameters of the patch nodes
-    T = face_shapes(ftype, zeta.reshape(-1, 2))[0].reshape(len(corners), qn, nen)
+    zeta = _patch_parameters(nen)
+    T = face_shapes(ftype, zeta.reshape(-1, 2))[0].reshape(*zeta.shape[:2], nen)
     T[np.abs(T) < 1e-14] = 0.0
     return T
 
@@ -75,13 +80,9 @@ def _edges(ftype: str) -> tuple[np.ndarray, np.ndarray]:
 def _classify(nen: int) -> list[tuple]:
     """Per patch node (sub, v): ("node", a) a node of the face; ("edge", ca, cb, s) a point at fraction s of the edge
     from corner ca to cb; ("inner", zx, zy) an inner point at those parameters."""
-    ftype = FACE_BY_NODES[nen]
-    T = patch_weights(nen)
-    corners = _CORNERS["quad8" if ftype == "quad8" else "tri"]
+    T, zeta = patch_weights(nen), _patch_parameters(nen)
     qn = T.shape[1]
-    Nq = shape_functions("quad4", NODES["quad4" if qn == 4 else "quad9"].astype(float))[0]
-    zeta = np.einsum("vc,scd->svd", Nq, corners)
-    cp, edges = _edges(ftype)
+    cp, edges = _edges(FACE_BY_NODES[nen])
     out = []
     for s in range(T.shape[0]):
         for v in range(qn):

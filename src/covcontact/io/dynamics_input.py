@@ -74,23 +74,11 @@ def read_initial_velocities(top: Section, sets) -> list[InitialVelocity]:
 
 
 def check_densities(top: Section, bodies, why: str = "a dynamic stage") -> None:
-    """A problem with a dynamic stage (or gravity, ``why``) needs the mass density of every material: one line
-    naming the first one without."""
+    """A problem with a dynamic stage (or gravity, ``why``) needs the mass density of every material that has cells:
+    one line naming the first one without."""
     for i, body in enumerate(bodies):
-        if getattr(body.material, "density", None) is None and (not body.materials or _uses_default(body)):
-            top.fail(f"missing: {why} needs the mass density of every material (e.g. density = 7.85e-9 "
-                     f"in t/mm^3 with mm, N, MPa)", f"bodies[{i}].material.density")
-        for name, mat in body.materials.items():
-            if getattr(mat, "density", None) is None:
-                top.fail(f"missing: {why} needs the mass density of every material",
-                         f"bodies[{i}].materials.{name}.density")
-
-
-def _uses_default(body) -> bool:
-    """Whether some cell of ``body`` takes its ``material`` (lies in none of the sets of ``materials``)."""
-    import numpy as np
-
-    covered = np.zeros(body.mesh.n_cells, dtype=bool)
-    for name in body.materials:
-        covered[body.mesh.element_sets[name]] = True
-    return not covered.all()
+        for name, _, material in body.material_parts():
+            if getattr(material, "density", None) is None:
+                key = f"bodies[{i}].materials.{name}.density" if name else f"bodies[{i}].material.density"
+                top.fail(f"missing: {why} needs the mass density of every material (e.g. density = 7.85e-9 "
+                         f"in t/mm^3 with mm, N, MPa)", key)

@@ -82,15 +82,14 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     for st in top.get("stages", "array", []):
         stages.append(stage(st, named, dirichlet, rigid, contacts, stages, stage_name))
 
-    if dynamics is not None or any(st.dynamics is not None for st in stages) or gravity is not None:
-        check_densities(top, bodies, "gravity" if dynamics is None and not any(st.dynamics for st in stages)
-                        else "a dynamic stage")
+    dynamic = dynamics is not None or any(st.dynamics is not None for st in stages)
+    if dynamic or gravity is not None:
+        check_densities(top, bodies, "a dynamic stage" if dynamic else "gravity")
         for i, r in enumerate(rigid):  # a free rigid body moves by its mass and inertia
             if any(c < 3 for c in r.free) and r.mass is None:
                 top.fail("missing: a rigid body with free translations needs its mass in a dynamic stage (or with "
                          "gravity)", f"rigid[{i}].mass")
-            if any(c >= 3 for c in r.free) and r.inertia is None and (dynamics is not None or any(
-                    st.dynamics is not None for st in stages)):
+            if any(c >= 3 for c in r.free) and r.inertia is None and dynamic:
                 top.fail("missing: a rigid body with free rotations needs its principal moments of inertia "
                          "[Ixx, Iyy, Izz] about its reference point in a dynamic stage", f"rigid[{i}].inertia")
     elif velocities:

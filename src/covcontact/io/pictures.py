@@ -212,9 +212,10 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
     written = []
     lam = _load_factor(out_dir, last.name)
     step = int(last.stem.split("_")[1])
-    ends = _stage_ends(out_dir)
-    length = _length_unit(out_dir)
-    if _dynamic(out_dir):  # the pvd time of a dynamic step is the time
+    summary = _summary(out_dir)
+    ends = _stage_ends(summary)
+    length = _length_unit(summary)
+    if _dynamic(summary):  # the pvd time of a dynamic step is the time
         final = f"final state: step {step}" + (f", time {lam:.4g}" if lam is not None else "")
     elif ends:  # a staged run: the pvd time is not a load factor
         final = f"final state: step {step}, end of stage {ends[-1][0]!r}"
@@ -224,33 +225,28 @@ def render_pictures(out_dir: Path, view: tuple[float, float] = (18.0, -65.0)) ->
         path = out_dir / name
         _draw(path, state, lo, hi, vmax, label, view, length, plastic)
         written.append(path)
-    for name, k in _stage_ends(out_dir)[:-1]:  # a staged run: the end of every stage but the last
+    for name, k in ends[:-1]:  # a staged run: the end of every stage but the last
         f = out_dir / f"step_{k:04d}.vtu"
         if f.exists():
             path = out_dir / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png"
             _draw(path, _state(f), lo, hi, vmax, f"end of stage {name!r}: step {k}", view, length, plastic)
             written.append(path)
-    energy = energy_plot(out_dir)
+    energy = energy_plot(out_dir, summary)
     return written + ([energy] if energy is not None else [])
 
 
-def energy_plot(out_dir: Path) -> Path | None:
+def energy_plot(out_dir: Path, summary: dict | None = None) -> Path | None:
     """``energy.png``: the energies of a run with dynamic steps (summary.json ``energy`` against ``time``): kinetic,
     strain, contact, their sum, the applied forces' work and the dissipation; None without dynamic steps."""
-    import json
-
+    summary = _summary(out_dir) if summary is None else summary
+    steps = [s for s in summary.get("steps", []) if s.get("converged") and "energy" in s]
+    if not steps:
+        return None
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    try:
-        steps = [s for s in json.loads((out_dir / "summary.json").read_text()).get("steps", [])
-                 if s.get("converged") and "energy" in s]
-    except (OSError, ValueError):
-        return None
-    if not steps:
-        return None
     t = np.array([s["time"] for s in steps])
     e = {k: np.array([s["energy"][k] for s in steps]) for k in steps[0]["energy"]}
     fig, ax = plt.subplots(figsize=(6.4, 3.6), dpi=110)
@@ -273,36 +269,30 @@ def energy_plot(out_dir: Path) -> Path | None:
     return path
 
 
-def _dynamic(out_dir: Path) -> bool:
-    """Whether the run's last step was a dynamic one (its summary record has energies)."""
+def _summary(out_dir: Path) -> dict:
+    """The run's summary.json ({} when there is none that reads)."""
     import json
 
     try:
-        steps = json.loads((out_dir / "summary.json").read_text()).get("steps", [])
+        return json.loads((out_dir / "summary.json").read_text())
     except (OSError, ValueError):
-        return False
+        return {}
+
+
+def _dynamic(summary: dict) -> bool:
+    """Whether the run's last step was a dynamic one (its summary record has energies)."""
+    steps = summary.get("steps", [])
     return bool(steps) and "energy" in steps[-1]
 
 
-def _length_unit(out_dir: Path) -> str:
-    """The length unit of the problem's ``units`` (its first entry), from summary.json; "" if not stated."""
-    import json
-
-    try:
-        units = json.loads((out_dir / "summary.json").read_text()).get("units", "")
-    except (OSError, ValueError):
-        return ""
+def _length_unit(summary: dict) -> str:
+    """The length unit of the problem's ``units`` (its first entry); "" if not stated."""
+    units = summary.get("units", "")
     return units.replace(";", ",").split(",")[0].strip() if units else ""
 
 
-def _stage_ends(out_dir: Path) -> list[tuple[str, int]]:
-    """(stage name, its last converged step) of a staged run's summary.json; [] for a single stage."""
-    import json
-
-    try:
-        summary = json.loads((out_dir / "summary.json").read_text())
-    except (OSError, ValueError):
-        return []
+def _stage_ends(summary: dict) -> list[tuple[str, int]]:
+    """(stage name, its last converged step) of a staged run; [] for a single stage."""
     ends: dict[str, int] = {}
     for entry in summary.get("steps", []):
         if entry.get("converged") and "stage" in entry:

@@ -136,8 +136,7 @@ def auto_line(linear: str, ranks: int, one_core_hint: bool = False, started: boo
 
 def _dynamic(problem) -> bool:
     """Whether ``problem`` has a dynamic stage (serial only for now)."""
-    return getattr(problem, "dynamics", None) is not None or any(
-        getattr(st, "dynamics", None) is not None for st in problem.stages)
+    return any(problem.stage_dynamics(k) is not None for k in range(len(problem.stages) + 1))
 
 
 def check_distributable(problem, linear: str, ranks: int) -> None:

@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .procedure import Increment, QuasiStatic
+from .procedure import Increment, QuasiStatic, reactions
 from .state import State
 
 
@@ -267,19 +267,8 @@ class Dynamic(QuasiStatic):
         entry["energy"] = {"kinetic": e["kinetic"], "strain": e["strain"], "contact": e["contact"],
                            "external_work": float(d["work"]), "dissipation": dissipation,
                            "balance_error": balance / scale}
-        entry["reactions"] = self._reactions(d["rd"])
         return entry
 
-    def _reactions(self, Rd: np.ndarray) -> dict:
-        """The supports' resultant forces (inertia included) of every Dirichlet condition in force."""
-        out = {}
-        held = {c.name for c in self.model.loading.spec.conditions}
-        for i, bc in enumerate(self.problem.dirichlet):
-            if (bc.name or f"#{i}") not in held:
-                continue
-            nodes = self.model.system.global_nodes(bc.body, bc.set)
-            total = Rd.reshape(-1, 3)[nodes].sum(axis=0)
-            comp = np.zeros(3, dtype=bool)
-            comp[list(bc.components)] = True
-            out[f"{bc.body}.{bc.set}"] = np.where(comp, total, 0.0).tolist()
-        return out
+    def _reactions(self, u: np.ndarray, lam: float, state: State) -> dict:
+        """The supports' resultant forces with the inertia: the step's dynamic residual on their dofs."""
+        return reactions(self.model, u, lam, state, R=state.dynamics["rd"])

@@ -251,6 +251,10 @@ class QuasiStatic:
         self.control.record(inc, newton.converged_increments)
         return inc
 
+    def _reactions(self, u: np.ndarray, lam: float, state: State) -> dict:
+        """The supports' resultant forces at the committed ``state`` (``reactions``)."""
+        return reactions(self.model, u, lam, state)
+
     def _report(self, inc: Increment, u: np.ndarray, stats0: dict, time0: dict) -> dict:
         """The summary record of ``inc`` (its model reports computed at the new committed state)."""
         newton, model = self.newton, self.model
@@ -292,16 +296,18 @@ class QuasiStatic:
             entry["plastic_work"] = self.work = work
         state.step = inc.step
         entry.update(model.step_report(u, lam, state))
-        entry["reactions"] = reactions(model, u, lam, state)
+        entry["reactions"] = self._reactions(u, lam, state)
         rigid = model.rigid_report(u, lam, state)
         if rigid:
             entry["rigid_bodies"] = rigid
         return entry
 
 
-def reactions(model, u: np.ndarray, lam: float, state: State) -> dict:
-    """The resultant reaction of every Dirichlet condition in force (released ones are left out)."""
-    R, _, _ = model.evaluate(u, lam, state, want_K=False)
+def reactions(model, u: np.ndarray, lam: float, state: State, R: np.ndarray | None = None) -> dict:
+    """The resultant reaction of every Dirichlet condition in force (released ones are left out): the residual ``R``
+    (default the quasi-static one at ``u``) summed over its nodes."""
+    if R is None:
+        R, _, _ = model.evaluate(u, lam, state, want_K=False)
     out = {}
     held = {c.name for c in model.loading.spec.conditions}
     for i, bc in enumerate(model.problem.dirichlet):

@@ -229,8 +229,8 @@ class Run:
             else:
                 from .dynamics import Dynamic
 
-                t_start = sum(self.problem.stage_dynamics(k).t_end if self.problem.stage_dynamics(k) is not None
-                              else plan.stages[k].lam_end for k in range(si))
+                t_start = sum(d.t_end if (d := self.problem.stage_dynamics(k)) is not None else plan.stages[k].lam_end
+                              for k in range(si))
                 self.procedure = Dynamic(model, self.newton, spec, t_stage, len(plan) > 1, control, dyn,
                                          self.problem, t_start)
             self.state = self.procedure.start(self.state, self.u)
