@@ -132,6 +132,40 @@ def two_materials(tmp: Path) -> Path:
     return path
 
 
+def mixed(tmp: Path) -> Path:
+    """A Gmsh block of bricks and wedges (tests/data/mixed_block.msh) pressed by a rigid plate, the wedges in J2
+    (history of two cell types side by side), the bricks elastic."""
+    mesh = Path(__file__).parent / "data" / "mixed_block.msh"
+    J2_HARDENING = '{ law = "linear", modulus = 10.0 }'  # noqa: N806
+    text = f"""
+[problem]
+name = "mixed"
+[[bodies]]
+name = "block"
+mesh = {{ file = "{mesh}" }}
+material = {{ model = "neo-hooke", E = 100.0, nu = 0.3 }}
+materials = {{ wedges = {{ model = "j2", E = 100.0, nu = 0.3, yield_stress = 1.0, hardening = {J2_HARDENING} }} }}
+[bodies.cells]
+wedges = {{ box = [[1.0, -1.0, -1.0], [3.0, 2.0, 2.0]] }}
+[[rigid]]
+name = "plate"
+shape = "plane"
+point = [0.0, 0.0, 1.0]
+normal = [0.0, 0.0, -1.0]
+motion = {{ translation = [0.0, 0.0, -0.05] }}
+[[contact]]
+slave = "block.zmax"
+master = "plate"
+penalty = 1.0e4
+[[dirichlet]]
+set = "block.zmin"
+components = "xyz"
+{_steps(10)}"""
+    path = tmp / "mixed.toml"
+    path.write_text(text)
+    return path
+
+
 def dynamic(tmp: Path) -> Path:
     """A static preload, then a dynamic stage: the bar of the impact test pushed against a block by its end, then
     let go (the kinematic state u, v, a and the energy account are part of the committed state)."""
@@ -231,9 +265,9 @@ def _has_gamg() -> bool:
 
 
 @pytest.mark.parametrize("make", [ironing, ironing_extrapolated, augmented, shells, gamg, mumps, two_blocks,
-                                  sts_friction, self_friction, two_materials, dynamic, dynamic_auto],
+                                  sts_friction, self_friction, two_materials, mixed, dynamic, dynamic_auto],
                          ids=["ironing", "ironing-extrapolate", "augmented", "solid-shells", "petsc-gamg",
-                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials", "dynamic",
+                              "petsc-mumps", "two-blocks", "sts-friction", "self-friction", "two-materials", "mixed", "dynamic",
                               "dynamic-auto"])
 def test_stopped_and_resumed_equals_uninterrupted(tmp_path, make):
     if make is gamg and not _has_gamg():

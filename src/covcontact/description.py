@@ -29,18 +29,20 @@ class Body:
     options: dict = field(default_factory=dict)
     materials: dict = field(default_factory=dict)  # element set -> material (the other cells take ``material``)
 
-    def material_parts(self, elements: np.ndarray | None = None) -> list[tuple[str, np.ndarray, Any]]:
-        """(element set name, "" for ``material``; indices into ``elements`` (default all cells); material) of every
-        material with cells among ``elements``."""
+    def material_parts(self, elements: np.ndarray | None = None) -> list[tuple[str, np.ndarray, Any, str]]:
+        """(element set name, "" for ``material``; indices into ``elements`` (default all cells); material; cell type)
+        of every material with cells among ``elements``, per cell type of a mixed mesh."""
         owner = np.full(self.mesh.n_cells, -1)
         for k, name in enumerate(self.materials):
             owner[self.mesh.element_sets[name]] = k
-        owner = owner if elements is None else owner[elements]
+        els = np.arange(self.mesh.n_cells) if elements is None else np.asarray(elements, dtype=np.int64)
+        owner = owner[els]
         parts = []
         for k, (name, material) in enumerate([("", self.material), *self.materials.items()]):
-            idx = np.flatnonzero(owner == k - 1)
-            if idx.size:
-                parts.append((name, idx, material))
+            for cell_type, idx in self.mesh.type_parts(els):
+                idx = idx[owner[idx] == k - 1]
+                if idx.size:
+                    parts.append((name, idx, material, cell_type))
         return parts
 
 

@@ -236,7 +236,7 @@ def zones(model, state: State) -> dict[str, np.ndarray]:
         yielding = np.flatnonzero(hist[..., H_FLAG].max(axis=1) > 0)
         if not yielding.size:
             yielding = np.flatnonzero(hist[..., H_ALPHA].max(axis=1) > 0)
-        plastic.append(np.unique(blk.solid.cells[yielding]).ravel() + blk.offset)
+        plastic.append(blk.solid.element_nodes(yielding) + blk.offset)
     plastic_nodes = np.unique(np.concatenate(plastic)) if plastic else np.zeros(0, np.int64)
 
     def dofs(n):

@@ -105,15 +105,16 @@ def test_serial_petsc_matches_default(tmp_path):
     ("sts", "petsc", 1e-7),             # segment-to-surface with friction: points split by their facet's owner
     ("self", "petsc", 1e-7),            # self-contact of both blocks' faces merged, with friction
     ("materials", "petsc", 1e-7),       # the base in two materials by element set, one of them plastic
-], ids=["deformable-pair", "friction", "gamg", "sts-friction", "self-contact", "two-materials"])
+    ("mixed", "petsc", 1e-7),           # a body of bricks and wedges, the wedges plastic, under a rigid plate
+], ids=["deformable-pair", "friction", "gamg", "sts-friction", "self-contact", "two-materials", "mixed-cells"])
 def test_two_ranks_match_serial(tmp_path, path, solver, tol):
-    if path == "materials":  # the resume test's set-up (tests/test_resume.py, two_materials)
+    if path in ("materials", "mixed"):  # the resume test's set-ups (tests/test_resume.py)
         import importlib.util
 
         spec = importlib.util.spec_from_file_location("resume_setups", ROOT / "tests" / "test_resume.py")
         setups = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(setups)
-        path = setups.two_materials(tmp_path)
+        path = setups.two_materials(tmp_path) if path == "materials" else setups.mixed(tmp_path)
     if path in ("sts", "self"):
         text = TWO_BLOCKS.read_text()
         pair = 'slave = "punch.zmin"\nmaster = "base.zmax"\n'

@@ -133,7 +133,7 @@ def test_abaqus_wedge_surfaces(tmp_path):
     path.write_text(DECK.replace("W, S3", "W, S3\nW, S1"))
     with pytest.raises(MeshError) as err:
         read_mesh(path)
-    assert "mixes triangular (S1, S2) and quadrilateral (S3..S5) wedge faces" in str(err.value)
+    assert "mixes triangular and quadrilateral faces (wedges: S1, S2 and S3..S5)" in str(err.value)
     assert "\n" not in str(err.value)
 
 

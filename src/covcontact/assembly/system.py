@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
+from ..elements.base import NNODES
 from ..elements.solid import SolidBody
 from ..fem.cells import any_face
 from ..loads import NodalForce, Pressure
@@ -87,31 +88,34 @@ def face_load_vector(X: np.ndarray, faces: np.ndarray, area_only: bool = False) 
     return out
 
 
-def _element_body(body, material, cells: np.ndarray):
-    """The element body of ``body``'s formulation over ``cells`` with ``material``."""
+def _element_body(body, material, cell_type: str, cells: np.ndarray):
+    """The element body of ``body``'s formulation over ``cells`` of ``cell_type`` with ``material``."""
     if body.formulation == "solid-shell":
         from ..elements.solidshell import SolidShellBody
 
-        return SolidShellBody(body.mesh.cell_type, body.mesh.points, cells, material, **body.options)
+        return SolidShellBody(cell_type, body.mesh.points, cells, material, **body.options)
     if body.formulation == "fbar":
         from ..elements.fbar import FbarBody
 
-        return FbarBody(body.mesh.cell_type, body.mesh.points, cells, material, **body.options)
-    return SolidBody(body.mesh.cell_type, body.mesh.points, cells, material, **body.options)
+        return FbarBody(cell_type, body.mesh.points, cells, material, **body.options)
+    return SolidBody(cell_type, body.mesh.points, cells, material, **body.options)
 
 
 def make_solid(body, elements: np.ndarray | None = None):
-    """The element body of a ``covcontact.problem.Body`` over its cells ``elements`` (default all): one material,
-    or a :class:`covcontact.elements.composite.CompositeBody` of one part per material of ``body.materials``."""
-    cells = body.mesh.cells if elements is None else body.mesh.cells[elements]
-    if not body.materials:
-        return _element_body(body, body.material, cells)
-    parts = [(idx, _element_body(body, material, cells[idx])) for _, idx, material in body.material_parts(elements)]
-    if len(parts) <= 1:  # one material over these cells (in their order)
-        return parts[0][1] if parts else _element_body(body, body.material, cells)
+    """The element body of a ``covcontact.problem.Body`` over its cells ``elements`` (default all): one material
+    over cells of one type, or a :class:`covcontact.elements.composite.CompositeBody` of one part per material of
+    ``body.materials`` and cell type of a mixed mesh."""
+    elements = np.arange(body.mesh.n_cells) if elements is None else np.asarray(elements, dtype=np.int64)
+    parts = [(idx, _element_body(body, material, cell_type, body.mesh.cells_of(elements[idx])[1]))
+             for _, idx, material, cell_type in body.material_parts(elements)]
+    if len(parts) == 1:  # one material over cells of one type (in their order)
+        return parts[0][1]
+    if not parts:
+        cell_type = body.mesh.cell_types[0]
+        return _element_body(body, body.material, cell_type, np.empty((0, NNODES[cell_type]), dtype=np.int64))
     from ..elements.composite import CompositeBody
 
-    return CompositeBody(cells, parts)
+    return CompositeBody(parts)
 
 
 class System:
@@ -138,8 +142,8 @@ class System:
         for ref in self.reference:
             self.X[ref.A] = ref.origin
         pairs = [np.array([[ref.A, ref.B] for ref in self.reference], dtype=np.int64)] if self.reference else []
-        self.pattern = Pattern(self.n_nodes, [body.mesh.cells + blk.offset
-                                              for blk, body in zip(self.blocks, bodies)] + pairs)
+        self.pattern = Pattern(self.n_nodes, [b.cells + blk.offset for blk, body in zip(self.blocks, bodies)
+                                              for b in body.mesh.blocks] + pairs)
         self._build_loads()
         self._build_dirichlet()
 
@@ -151,12 +155,12 @@ class System:
 
         parts = []
         for blk, body in zip(self.blocks, self.bodies.values()):
-            for _, idx, material in body.material_parts():
+            for _, idx, material, cell_type in body.material_parts():
                 rho = getattr(material, "density", None)
                 if rho is None:
                     raise ValueError(f"body {body.name!r}: its material has no density (needed for the mass)")
-                cells = body.mesh.cells[idx]
-                parts.append((cells + blk.offset, element_masses(body.mesh.cell_type, body.mesh.points, cells, rho)))
+                cells = body.mesh.cells_of(idx)[1]
+                parts.append((cells + blk.offset, element_masses(cell_type, body.mesh.points, cells, rho)))
         M = dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless))
         if self.reference:  # rigid bodies with free components: mass on A, rotary inertia on B (small rotations)
             diag = np.zeros(self.n_dofs)

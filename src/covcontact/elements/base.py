@@ -148,6 +148,15 @@ class CellCounts:
     def nen(self) -> int:
         return int(self.cells.shape[1])
 
+    def incidence(self) -> tuple[np.ndarray, np.ndarray]:
+        """(element, node) of every node of every cell, flat."""
+        return np.repeat(np.arange(self.n_elements), self.cells.shape[1]), self.cells.ravel()
+
+    def element_nodes(self, elements: np.ndarray) -> np.ndarray:
+        """The sorted distinct nodes of ``elements``."""
+        els, nodes = self.incidence()
+        return np.unique(nodes[np.isin(els, np.asarray(elements, dtype=np.int64))])
+
 
 class ElementBody(CellCounts):
     """Generic body of one hexahedral cell type (the subclass checks ``cell_type`` first).
@@ -333,18 +342,19 @@ class ElementBody(CellCounts):
     def stress(self, u: np.ndarray, state: dict | None = None) -> SolidStress:
         """Element-averaged Cauchy stress, S and Green-Lagrange strain; nodal averaged Cauchy stress at
         displacement u and element history ``state`` (default: the reference state)."""
-        return stress_from_fields(self._fields(u, 2, 18, state), self.cells, self.n_nodes)
+        return stress_from_fields(self._fields(u, 2, 18, state), self.incidence(), self.n_nodes)
 
 
-def stress_from_fields(f: np.ndarray, cells: np.ndarray, n_nodes: int) -> SolidStress:
+def stress_from_fields(f: np.ndarray, incidence: tuple[np.ndarray, np.ndarray], n_nodes: int) -> SolidStress:
     """The stresses of the element fields ``f`` (nelem, 18: Cauchy, S, Green-Lagrange, Voigt): the Cauchy stress
-    averaged at the nodes of ``cells`` and the von Mises stress."""
-    nen = cells.shape[1]
+    averaged at the nodes of the cells (``incidence``: (element, node) of every node of every cell) and the von
+    Mises stress."""
+    els, nodes = incidence
     cauchy = np.ascontiguousarray(f[:, :6])
-    count = np.bincount(cells.ravel(), minlength=n_nodes).astype(np.float64)
+    count = np.bincount(nodes, minlength=n_nodes).astype(np.float64)
     nodal = np.empty((n_nodes, 6))
     for I in range(6):
-        nodal[:, I] = np.bincount(cells.ravel(), weights=np.repeat(cauchy[:, I], nen), minlength=n_nodes)
+        nodal[:, I] = np.bincount(nodes, weights=cauchy[els, I], minlength=n_nodes)
     nodal /= np.maximum(count, 1.0)[:, None]
     s = cauchy
     vm = np.sqrt(0.5 * ((s[:, 0] - s[:, 1]) ** 2 + (s[:, 1] - s[:, 2]) ** 2 + (s[:, 2] - s[:, 0]) ** 2)

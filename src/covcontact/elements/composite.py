@@ -16,23 +16,32 @@ from .base import CellCounts, ElementBody, stress_from_fields
 
 
 class CompositeBody(CellCounts):
-    """Element bodies ``parts`` over the same nodes, part k holding the cells ``index[k]`` of ``cells``.
+    """Element bodies ``parts`` over the same nodes, part k holding the cells ``index[k]`` of the body (of one
+    material and one cell type each).
 
     Args:
-        cells: (nelem, nen) all cells (local node ids).
-        parts: (element indices into ``cells``, the element body of those cells) per material; every cell in one
-            part.
+        parts: (element indices of the body, the element body of those cells) per material and cell type; every
+            element in one part.
     """
 
-    def __init__(self, cells: np.ndarray, parts: list[tuple[np.ndarray, ElementBody]]):
-        self.cells = np.ascontiguousarray(cells, dtype=np.int64)
+    def __init__(self, parts: list[tuple[np.ndarray, ElementBody]]):
         self.index = [np.asarray(idx, dtype=np.int64) for idx, _ in parts]
         self.parts = [body for _, body in parts]
-        covered = np.bincount(np.concatenate(self.index), minlength=len(self.cells)) if self.index else []
-        if len(self.cells) and not np.all(covered == 1):
+        self._n = int(sum(len(idx) for idx in self.index))
+        covered = np.bincount(np.concatenate(self.index), minlength=self._n) if self.index else []
+        if self._n and not np.all(covered == 1):
             raise ValueError("every cell of a composite body must lie in exactly one part")
         first = self.parts[0]
-        self.cell_type, self.X = first.cell_type, first.X
+        self.X = first.X
+        types = {b.cell_type for b in self.parts}
+        #: the cell type of the parts, "mixed" when they differ
+        self.cell_type = first.cell_type if len(types) == 1 else "mixed"
+        #: (nelem, nen) all cells in body order when the parts have one number of nodes per cell, else None
+        self.cells = None
+        if len({b.cells.shape[1] for b in self.parts}) == 1:
+            self.cells = np.empty((self._n, first.cells.shape[1]), dtype=np.int64)
+            for idx, b in zip(self.index, self.parts):
+                self.cells[idx] = b.cells
         from ..materials.plasticity import J2
 
         plastic = [b.material for b in self.parts if b.material.kind == J2]
@@ -44,6 +53,19 @@ class CompositeBody(CellCounts):
         self.dNdxi, self.weights = getattr(first, "dNdxi", None), getattr(first, "weights", None)
         #: per part, the per-element shape of each of its state arrays
         self._tails = [{key: arr.shape[1:] for key, arr in b.new_state().items()} for b in self.parts]
+
+    @property
+    def n_elements(self) -> int:
+        return self._n
+
+    @property
+    def nen(self) -> int:
+        return max(b.nen for b in self.parts)
+
+    def incidence(self) -> tuple[np.ndarray, np.ndarray]:
+        pairs = [b.incidence() for b in self.parts]
+        return (np.concatenate([idx[e] for idx, (e, _) in zip(self.index, pairs)]),
+                np.concatenate([n for _, n in pairs]))
 
     # -- state ----------------------------------------------------------------------------------
     def new_state(self) -> dict[str, np.ndarray]:
@@ -94,10 +116,13 @@ class CompositeBody(CellCounts):
         return min(bad) if bad else -1
 
     def _gather(self, rows_of_part) -> np.ndarray:
+        """The parts' rows in body order (rows of different widths, e.g. Gauss points of two cell types: padded
+        with zeros to the widest)."""
         rows = [rows_of_part(k) for k in range(len(self.parts))]
-        out = np.zeros((self.n_elements, *rows[0].shape[1:]))
+        tail = tuple(max(r.shape[d] for r in rows) for d in range(1, rows[0].ndim))
+        out = np.zeros((self.n_elements, *tail))
         for idx, r in zip(self.index, rows):
-            out[idx] = r
+            out[(idx, *(slice(0, n) for n in r.shape[1:]))] = r
         return out
 
     def energy(self, u: np.ndarray, state: dict | None = None) -> float:
@@ -107,7 +132,7 @@ class CompositeBody(CellCounts):
     def stress(self, u: np.ndarray, state: dict | None = None):
         state = self.new_state() if state is None else state
         f = self._gather(lambda k: self.parts[k]._fields(u, 2, 18, self._views(k, state)[0]))
-        return stress_from_fields(f, self.cells, self.n_nodes)
+        return stress_from_fields(f, self.incidence(), self.n_nodes)
 
     def check_reference(self) -> list[int]:
         return sorted(int(self.index[k][e]) for k, b in enumerate(self.parts) for e in b.check_reference())

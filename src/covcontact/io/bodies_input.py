@@ -28,15 +28,21 @@ def mesh_generators() -> dict:
 _MESH_FILES: dict = {}
 
 
-def _read_once(path: Path):
+def _read_once(path: Path, element: str | None = None):
     """A mesh file read once per problem file for all the bodies that take parts of it (keyed by path and
-    modification time); callers copy or select from it, never change it."""
-    from ..mesh.io import read_mesh
+    modification time); callers copy or select from it, never change it. A file of cell types that do not mix
+    gives the cells of ``element`` when that is given."""
+    from ..mesh.io import MixedTypesError, read_mesh
 
     key = (str(path.resolve()), path.stat().st_mtime_ns)
     if key not in _MESH_FILES:
         _MESH_FILES.clear()  # one file at a time: a problem's bodies come one after the other
-        _MESH_FILES[key] = read_mesh(path)
+        try:
+            _MESH_FILES[key] = read_mesh(path)
+        except MixedTypesError:
+            if element is None:
+                raise
+            return read_mesh(path, element)
     return _MESH_FILES[key]
 
 
@@ -55,12 +61,13 @@ def build_mesh(sec: Section, base: Path, element: str | None):
             sec.fail(f"mesh file {fname!r} does not exist (looked for {path}; a relative path is taken from the "
                      f"problem file's folder)", "file")
         try:
-            mesh = _read_once(path)
+            mesh = _read_once(path, element)
         except (MeshError, ValueError, KeyError, OSError) as exc:
             sec.fail(f"cannot read mesh file {path}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}",
                      "file")
         if element is not None and mesh.cell_type != element:
-            sec.fail(f"element {element!r} does not match the mesh file's cells ({mesh.cell_type})", "file")
+            sec.fail(f"element {element!r} does not match the mesh file's cells ({' and '.join(mesh.cell_types)})",
+                     "file")
         if volume is not None:  # one body of several in the file: its element set (Gmsh physical volume, ELSET)
             if volume not in mesh.element_sets:
                 known = ", ".join(sorted(mesh.element_sets)) or "none"
@@ -99,17 +106,28 @@ def build_mesh(sec: Section, base: Path, element: str | None):
         sec.fail(f"generator {name!r}: {exc}")
 
 
-HARDENING = {"linear": ("modulus",), "swift": ("K", "eps0", "n"), "voce": ("sigma_inf", "delta", "modulus")}
+HARDENING = {"linear": ("modulus",), "swift": ("K", "eps0", "n"), "voce": ("sigma_inf", "delta", "modulus"),
+             "table": ("stress", "strain")}
 
 
 def _hardening(sec: Section) -> dict:
     law = sec.get("law", "str", choices=tuple(HARDENING))
     out: dict = {"law": law}
     for key in HARDENING[law]:
+        if law == "table":  # arrays of numbers: (yield stress, equivalent plastic strain) points
+            out[key] = sec.get(key, "floats")
+            continue
         optional = law == "voce" and key == "modulus"
         value = sec.get(key, "float", 0.0 if optional else _REQUIRED)
         out[key] = value
     sec.done()
+    if law == "table":  # the table's own checks, reported at the hardening table
+        from ..materials.plasticity import hardening_from_dict
+
+        try:
+            hardening_from_dict(out)
+        except ValueError as exc:
+            sec.fail(str(exc))
     return out
 
 
@@ -173,7 +191,7 @@ def user_cells(sec: Section | None, mesh) -> None:
                                                                 for v in q) for q in box)):
                 d.fail("must be [[x0, y0, z0], [x1, y1, z1]]", "box")
             lo, hi = np.asarray(box, dtype=float)
-            c = mesh.points[mesh.cells].mean(axis=1)
+            c = mesh.centroids()
             ids = np.flatnonzero(np.all((c >= lo) & (c <= hi), axis=1))
             if ids.size == 0:
                 d.fail("no cell centroid lies inside this box", "box")
@@ -300,8 +318,8 @@ def user_faces(sec: Section | None, mesh) -> None:
                 if keep.any():
                     picked.append(faces[keep])
             if len(picked) > 1:
-                sec.fail(f"these filters pick {len(picked[0])} triangles and {len(picked[1])} quadrilaterals of the "
-                         f"wedges; a face set holds faces of one type: narrow the filters (normal, box)", name)
+                sec.fail(f"these filters pick {len(picked[0])} triangles and {len(picked[1])} quadrilaterals; "
+                         f"a face set holds faces of one type: narrow the filters (normal, box)", name)
             chosen = picked[0] if picked else np.zeros((0, 3), dtype=np.int64)
         if len(chosen) == 0:
             sec.fail("no boundary face passes these filters", name)
@@ -311,7 +329,8 @@ def user_faces(sec: Section | None, mesh) -> None:
 
 def _check_cells(sec: Section, mesh, formulation: str) -> None:
     """Inverted or degenerate cells (det J <= 0 at an integration point) are one line naming them (solid-shells
-    check their own points later)."""
+    check their own points later); so are the cells of a mixed mesh whose faces do not match (a triangle on a
+    quadrilateral)."""
     from ..mesh import Mesh
     from ..mesh.faces import jacobian_determinants
 
@@ -319,13 +338,21 @@ def _check_cells(sec: Section, mesh, formulation: str) -> None:
         return
     chunk = 20000  # (cells, points, 3, 3) Jacobians a chunk at a time
     bad = np.concatenate([np.flatnonzero(~np.all(jacobian_determinants(
-        Mesh(mesh.points, mesh.cell_type, mesh.cells[k: k + chunk])) > 0.0, axis=1)) + k
-        for k in range(0, mesh.n_cells, chunk)])
+        Mesh(mesh.points, b.cell_type, b.cells[k: k + chunk])) > 0.0, axis=1)) + b.first + k
+        for b in mesh.blocks for k in range(0, len(b.cells), chunk)])
     if bad.size:
         cells = ", ".join(map(str, bad[:5])) + (f" and {bad.size - 5} more" if bad.size > 5 else "")
-        sec.fail(f"{bad.size} of {mesh.n_cells} {mesh.cell_type} cells are inverted or degenerate (det J <= 0 at an "
-                 f"integration point): cells {cells} (numbered from 0); check the file's node order (VTK's) or the "
-                 f"geometry", "mesh")
+        sec.fail(f"{bad.size} of {mesh.n_cells} {'/'.join(mesh.cell_types)} cells are inverted or degenerate (det J "
+                 f"<= 0 at an integration point): cells {cells} (numbered from 0); check the file's node order (VTK's) "
+                 f"or the geometry", "mesh")
+    from ..mesh.faces import nonconforming_cells
+
+    pairs = nonconforming_cells(mesh) if mesh.is_mixed else ()
+    if len(pairs):
+        a, q = pairs[0]
+        sec.fail(f"the mesh is not conforming: {len(pairs)} triangular faces lie on quadrilateral faces of other cells "
+                 f"(first: cell {a} against cell {q}, numbered from 0); a tetrahedron or wedge meets a brick only "
+                 f"through a wedge's quadrilateral face", "mesh")
 
 
 def _materials_by_set(sec: Section, mesh, default) -> dict:
@@ -382,8 +409,8 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
             from ..elements.fbar import FBAR_CELLS
 
             if mesh.cell_type not in FBAR_CELLS:
-                b.fail(f"formulation = \"fbar\" needs {', '.join(FBAR_CELLS)} elements, got {mesh.cell_type}",
-                       "formulation")
+                b.fail(f"formulation = \"fbar\" needs {', '.join(FBAR_CELLS)} elements, got "
+                       f"{' and '.join(mesh.cell_types)}", "formulation")
             unknown = sorted(set(options) - {"form"})
             if unknown:
                 b.fail(f"unknown option {unknown[0]!r} for formulation = \"fbar\" (known: form)", "options")

@@ -77,7 +77,7 @@ def check_densities(top: Section, bodies, why: str = "a dynamic stage") -> None:
     """A problem with a dynamic stage (or gravity, ``why``) needs the mass density of every material that has cells:
     one line naming the first one without."""
     for i, body in enumerate(bodies):
-        for name, _, material in body.material_parts():
+        for name, _, material, _ in body.material_parts():
             if getattr(material, "density", None) is None:
                 key = f"bodies[{i}].materials.{name}.density" if name else f"bodies[{i}].material.density"
                 top.fail(f"missing: {why} needs the mass density of every material (e.g. density = 7.85e-9 "

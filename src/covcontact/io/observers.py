@@ -14,7 +14,7 @@ import numpy as np
 from ..fem.cells import FACE_BY_NODES
 from ..observer import Observer
 from . import checkpoint
-from .output import ResultWriter, _jsonable
+from .output import ResultWriter, _jsonable, body_blocks
 from .rigid_visual import rigid_visual
 
 
@@ -156,14 +156,14 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
     U = u.reshape(-1, 3)[:n]
     cauchy = np.zeros((n, 6))
     blocks = []
-    for blk, body, est in zip(sysm.blocks, model.problem.bodies, state.elements):
+    for body_id, (blk, body, est) in enumerate(zip(sysm.blocks, model.problem.bodies, state.elements)):
         sl = slice(blk.offset, blk.offset + blk.n_nodes)
         st = blk.solid.stress(U[sl], est)
         cauchy[sl] = st.cauchy_nodal
         cd = st.cell_data()
         cd.update(blk.solid.plastic_fields(est))
-        cd["body_id"] = np.full(body.mesh.n_cells, len(blocks), dtype=float)
-        blocks.append((body.mesh.cell_type, body.mesh.cells + blk.offset, cd))
+        cd["body_id"] = np.full(body.mesh.n_cells, body_id, dtype=float)
+        blocks += body_blocks(body.mesh, blk.offset, cd)
     fields = model.contact.node_fields(state.contact)  # (gap, pressure, status) over the extended nodes
     if model.contact.passes:  # the slave surfaces with their facets' mean contact pressure
         for faces, pressure in model.contact.facet_fields(state.contact, fields[1]):

@@ -35,6 +35,13 @@ def vtk_cells(cell_type: str, cells: np.ndarray) -> tuple[str, np.ndarray, np.nd
     return _VTK_NAME[cell_type], cells, np.arange(len(cells))
 
 
+def body_blocks(mesh, offset: int, cell_data: dict[str, np.ndarray]) -> list[tuple[str, np.ndarray, dict]]:
+    """The VTU blocks of a body's ``mesh`` whose nodes start at ``offset``: (cell type, connectivity, its rows of
+    the mesh-order ``cell_data``) per cell block."""
+    return [(b.cell_type, b.cells + offset, {k: np.asarray(v)[b.first: b.first + len(b.cells)]
+                                             for k, v in cell_data.items()}) for b in mesh.blocks]
+
+
 class ResultWriter:
     """Writes the output folder of one run, one converged step at a time."""
 

@@ -11,6 +11,7 @@ import numpy as np
 from ..contact.analytic import CYLINDER, EXTRUDED, PLANE, REVOLVED
 from ..contact.profile import ARC, profile_point
 from ..contact.setup import analytic_surface
+from .output import body_blocks
 
 
 def _grid_quads(nu: int, nv: int, closed_u: bool) -> np.ndarray:
@@ -103,8 +104,7 @@ def rigid_visual(manager, lam: float, fields) -> tuple:
             gaps.append(gap[sl])
             press.append(pressure[sl])
             stats.append(status[sl])
-            blocks.append((rb.mesh.cell_type, rb.mesh.cells + n, {"body_id": np.full(rb.mesh.n_cells, body_id,
-                                                                                       dtype=float)}))
+            blocks += body_blocks(rb.mesh, n, {"body_id": np.full(rb.mesh.n_cells, body_id, dtype=float)})
             disp.append(p - rb.mesh.points)
             p = rb.mesh.points
         else:

@@ -23,6 +23,7 @@ from .plasticity import (
     J2Plasticity,
     LinearHardening,
     SwiftHardening,
+    TableHardening,
     VoceHardening,
     j2_point,
     j2_response,
@@ -33,5 +34,5 @@ __all__ = [
     "NEO_HOOKE", "SVK", "VOIGT", "Material", "NeoHooke", "SaintVenantKirchhoff", "lame",
     "material_energy", "material_from_name", "material_response", "strain_energy", "stress_tangent",
     "voigt_to_tensor", "J2", "NHIST", "Hill48", "J2Plasticity", "LinearHardening", "SwiftHardening",
-    "VoceHardening", "j2_point", "j2_response", "material_update",
+    "TableHardening", "VoceHardening", "j2_point", "j2_response", "material_update",
 ]

@@ -4,11 +4,12 @@ Formulation (docs/theory.md, section 12): the total-Lagrangian
 logarithmic strain E_log = 1/2 ln C (spectral decomposition of C = F^T F) is split additively,
 E_log = E_e + E_p, with the plastic log strain E_p as history. The stress T conjugate to E_log follows
 from Hencky elasticity, T = lambda tr(E_e) I + 2 mu E_e, and a small-strain-like return mapping is done
-in that space (backward Euler, associative flow, isotropic hardening sigma_y(alpha), linear Prager
-kinematic hardening d beta = 2/3 H_kin d E_p, yield function phi = sqrt((T - beta) : P_H : (T - beta))
-- sigma_y(alpha), P_H the von Mises or Hill 1948 matrix). The second Piola-Kirchhoff stress is
-S = T : P with P = 2 dE_log/dC, and the algorithmic tangent dS/dE = P : C_alg : P + T : L with
-L = 4 d^2 E_log / dC dC, all from the spectral (divided-difference) formulas of the matrix logarithm.
+in that space (backward Euler, associative flow, isotropic hardening sigma_y(alpha) (linear, Swift, Voce or
+a piecewise-linear table), linear Prager kinematic hardening d beta = 2/3 H_kin d E_p, yield function
+phi = sqrt((T - beta) : P_H : (T - beta)) - sigma_y(alpha), P_H the von Mises or Hill 1948 matrix). The
+second Piola-Kirchhoff stress is S = T : P with P = 2 dE_log/dC, and the algorithmic tangent
+dS/dE = P : C_alg : P + T : L with L = 4 d^2 E_log / dC dC, all from the spectral (divided-difference)
+formulas of the matrix logarithm.
 
 Return mapping. In Mandel coordinates (shear components times sqrt 2) the Hill matrix is
 P_hat = Q diag(p) Q^T with a fixed orthogonal Q (first column the hydrostatic direction, p_0 = 0) and the
@@ -28,13 +29,14 @@ when |d| < 1e-3 (exact 1/(2 l_a) at d = 0). Second divided differences: divided 
 when that exceeds 1e-3 of the largest argument, else a Taylor series about the mean. Equal or nearly equal
 eigenvalues (F = I, uniaxial, volumetric) therefore need no special case.
 
-``params`` layout (float64, length NPARAMS; P_* are the index constants below):
+``params`` layout (float64, length NPARAMS, the table law NPARAMS + 1 + 2 n; P_* are the index constants
+below):
 
     0  E        Young's modulus             1  nu      Poisson's ratio
     2  lambda   first Lame constant         3  mu      shear modulus
     4  K        bulk modulus lambda + 2/3 mu
-    5  law      hardening law code: 0 linear, 1 Swift, 2 Voce
-    6  sigma_y0 initial yield stress (Swift: K eps0^n)
+    5  law      hardening law code: 0 linear, 1 Swift, 2 Voce, 3 table
+    6  sigma_y0 initial yield stress (Swift: K eps0^n; table: its first stress)
     7  H        linear hardening modulus (linear law; the optional linear term of Voce; 0 for Swift)
     8  K_swift  9  eps0      10 n          (Swift: sigma_y = K (eps0 + alpha)^n)
     11 sigma_inf 12 delta                  (Voce: sigma_y0 + (sigma_inf - sigma_y0)(1 - exp(-delta alpha))
@@ -44,6 +46,10 @@ eigenvalues (F = I, uniaxial, volumetric) therefore need no special case.
     15..20      Hill coefficients F, G, H, L, M, N (von Mises: 1/2, 1/2, 1/2, 3/2, 3/2, 3/2)
     21..29      Q3, row-major 3x3: the normal block of Q (column 0 = (1, 1, 1)/sqrt 3)
     30..35      p: eigenvalues of P_hat in the order of z (0, p_1, p_2, N, L, M)
+    table law only, after the fixed part (P_TAB_N = NPARAMS = 36, P_TAB = 37):
+    36          n, the number of points (>= 1)
+    37..36+n    equivalent plastic strains of the points (0 first, strictly increasing)
+    37+n..36+2n yield stresses of the points (sigma_y piecewise linear between them, constant from the last)
 
 History layout (float64, length NHIST = 15) per material point:
 
@@ -59,6 +65,7 @@ Voigt order of S and D: 11, 22, 33, 12, 23, 13; D acts on engineering shear stra
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -76,6 +83,7 @@ from .plasticity_kernels import (
     J2,
     LAW_LINEAR,
     LAW_SWIFT,
+    LAW_TABLE,
     LAW_VOCE,
     NHIST,
     NPARAMS,
@@ -95,6 +103,8 @@ from .plasticity_kernels import (
     P_SWIFT_K,
     P_SWIFT_N,
     P_SY0,
+    P_TAB,
+    P_TAB_N,
     P_VOCE_DELTA,
     P_VOCE_SINF,
     RM_MAXIT,
@@ -103,7 +113,7 @@ from .plasticity_kernels import (
     j2_response,
 )
 
-_LAWS = {"linear": LAW_LINEAR, "swift": LAW_SWIFT, "voce": LAW_VOCE}
+_LAWS = {"linear": LAW_LINEAR, "swift": LAW_SWIFT, "voce": LAW_VOCE, "table": LAW_TABLE}
 
 # ----------------------------------------------------------------------------------------------
 # Python side: parameters and validation
@@ -167,23 +177,98 @@ class VoceHardening:
             raise ValueError(f"Voce linear modulus must be >= 0, got modulus={self.modulus}")
 
 
-Hardening = LinearHardening | SwiftHardening | VoceHardening
+def _numbers(name: str, values: Any) -> tuple[float, ...]:
+    """A 1-D sequence of finite numbers as a tuple of floats; ValueError naming ``name`` otherwise."""
+    if isinstance(values, (str, bytes, dict)) or np.ndim(values) != 1:
+        raise ValueError(f"table hardening {name} must be a list of numbers, got {name}={values!r}")
+    try:
+        out = tuple(float(v) for v in values)
+    except (TypeError, ValueError):
+        raise ValueError(f"table hardening {name} must be a list of numbers, got {name}={list(values)!r}"
+                         ) from None
+    if not all(math.isfinite(v) for v in out):
+        raise ValueError(f"table hardening {name} must be finite, got {name}={list(out)}")
+    return out
+
+
+@dataclass(frozen=True)
+class TableHardening:
+    """Piecewise-linear sigma_y(alpha) through the points (strain[i], stress[i]), as an Abaqus or CalculiX
+    *PLASTIC table (yield stress, equivalent plastic strain): strain[0] = 0, strains strictly increasing,
+    stresses > 0; constant (slope 0, perfect plasticity) beyond the last point, as in Abaqus and CalculiX.
+    One point is perfect plasticity at stress[0]."""
+
+    stress: tuple[float, ...]
+    strain: tuple[float, ...]
+    law: str = field(init=False, default="table")
+
+    def __post_init__(self) -> None:
+        stress = _numbers("stress", self.stress)
+        strain = _numbers("strain", self.strain)
+        if len(stress) != len(strain):
+            raise ValueError(f"table hardening stress and strain must have the same length, got "
+                             f"{len(stress)} stress and {len(strain)} strain values")
+        if len(stress) == 0:
+            raise ValueError("table hardening needs at least one point, got stress=[] and strain=[]")
+        if not all(v > 0.0 for v in stress):
+            raise ValueError(f"table hardening stress must be > 0 at every point, got stress={list(stress)}")
+        if strain[0] != 0.0:
+            raise ValueError(f"table hardening strain must start at 0 (the initial yield stress), "
+                             f"got strain[0]={strain[0]}")
+        if not all(b > a for a, b in itertools.pairwise(strain)):
+            raise ValueError(f"table hardening strain must be strictly increasing, got strain={list(strain)}")
+        object.__setattr__(self, "stress", stress)
+        object.__setattr__(self, "strain", strain)
+
+    @property
+    def initial_yield(self) -> float:
+        return self.stress[0]
+
+    def _segment(self, alpha: float) -> int | None:
+        """Index i of the segment [strain[i], strain[i + 1]) holding alpha (the first one for alpha < 0),
+        None from the last point on."""
+        e = self.strain
+        if len(e) == 1 or alpha >= e[-1]:
+            return None
+        return max(0, min(len(e) - 2, int(np.searchsorted(e, alpha, side="right")) - 1))
+
+    def slope(self, alpha: float) -> float:
+        """d sigma_y / d alpha: the slope of the segment holding alpha (the right one at a point), 0 from
+        the last point on."""
+        i = self._segment(float(alpha))
+        if i is None:
+            return 0.0
+        return (self.stress[i + 1] - self.stress[i]) / (self.strain[i + 1] - self.strain[i])
+
+    def sigma_y(self, alpha: float) -> float:
+        """sigma_y(alpha), linear between the points, stress[-1] from the last point on."""
+        a = float(alpha)
+        i = self._segment(a)
+        if i is None:
+            return self.stress[-1]
+        return self.stress[i] + self.slope(a) * (a - self.strain[i])
+
+
+Hardening = LinearHardening | SwiftHardening | VoceHardening | TableHardening
 
 
 def hardening_from_dict(spec: dict[str, Any]) -> Hardening:
-    """A hardening law from {"law": "linear"|"swift"|"voce", ...parameters}."""
+    """A hardening law from {"law": "linear"|"swift"|"voce"|"table", ...parameters}."""
     spec = dict(spec)
     law = str(spec.pop("law", "linear")).strip().lower()
-    cls = {"linear": LinearHardening, "swift": SwiftHardening, "voce": VoceHardening}.get(law)
+    cls = {"linear": LinearHardening, "swift": SwiftHardening, "voce": VoceHardening,
+           "table": TableHardening}.get(law)
     if cls is None:
         raise ValueError(f"unknown hardening law {law!r}; known: {', '.join(sorted(_LAWS))}")
     allowed = {"linear": {"modulus"}, "swift": {"K", "eps0", "n"},
-               "voce": {"sigma_inf", "delta", "modulus"}}[law]
+               "voce": {"sigma_inf", "delta", "modulus"}, "table": {"stress", "strain"}}[law]
     unknown = set(spec) - allowed
     if unknown:
         raise ValueError(f"unknown parameter(s) {sorted(unknown)} for hardening law {law!r}; "
                          f"expected {sorted(allowed)}")
     try:
+        if law == "table":
+            return cls(**{k: _numbers(k, v) for k, v in spec.items()})
         return cls(**{k: float(v) for k, v in spec.items()})
     except TypeError as exc:
         raise ValueError(f"hardening law {law!r} needs {sorted(allowed)}: {exc}") from None
@@ -262,8 +347,10 @@ class J2Plasticity(LameConstants):
 
     Args:
         E, nu: Young's modulus and Poisson's ratio.
-        yield_stress: initial yield stress sigma_y0 (derived as K eps0^n for Swift when None).
-        hardening: LinearHardening / SwiftHardening / VoceHardening or a dict {"law": ..., ...}.
+        yield_stress: initial yield stress sigma_y0 (derived as K eps0^n for Swift, as the first stress
+            for the table, when None).
+        hardening: LinearHardening / SwiftHardening / VoceHardening / TableHardening or a dict
+            {"law": ..., ...}.
         kinematic_modulus: H_kin of linear (Prager) kinematic hardening, d beta = 2/3 H_kin d E_p.
         hill48: None (von Mises), Hill48, a dict {"r0", "r45", "r90"} or a tuple (r0, r45, r90).
         density: mass per unit reference volume (dynamics), or None.
@@ -291,7 +378,7 @@ class J2Plasticity(LameConstants):
         hard = self.hardening
         if isinstance(hard, dict):
             hard = hardening_from_dict(hard)
-        elif not isinstance(hard, (LinearHardening, SwiftHardening, VoceHardening)):
+        elif not isinstance(hard, (LinearHardening, SwiftHardening, VoceHardening, TableHardening)):
             raise ValueError(f"hardening must be a dict or a hardening law, got {type(hard).__name__}")
         object.__setattr__(self, "hardening", hard)
         sy = self.yield_stress
@@ -301,6 +388,13 @@ class J2Plasticity(LameConstants):
                 sy = derived
             elif not abs(float(sy) - derived) <= 1e-6 * abs(derived):
                 raise ValueError(f"yield_stress={sy} does not match the Swift law's K eps0^n = {derived!r} "
+                                 f"(relative tolerance 1e-6)")
+        elif isinstance(hard, TableHardening):
+            derived = hard.initial_yield
+            if sy is None:
+                sy = derived
+            elif not abs(float(sy) - derived) <= 1e-6 * abs(derived):
+                raise ValueError(f"yield_stress={sy} does not match the table's first stress {derived!r} "
                                  f"(relative tolerance 1e-6)")
         elif sy is None:
             raise ValueError(f"yield_stress is required for the {hard.law} hardening law")
@@ -323,7 +417,8 @@ class J2Plasticity(LameConstants):
 
     @property
     def params(self) -> np.ndarray:
-        """float64 array (NPARAMS,) handed to the kernels (layout in the module docstring)."""
+        """float64 array (NPARAMS,), (NPARAMS + 1 + 2 n) for a table of n points, handed to the kernels
+        (layout in the module docstring)."""
         return self._params.copy()
 
     def yield_stress_at(self, alpha: float) -> float:
@@ -334,21 +429,28 @@ class J2Plasticity(LameConstants):
             return self.yield_stress + h.modulus * a
         if isinstance(h, SwiftHardening):
             return h.K * (h.eps0 + a) ** h.n
+        if isinstance(h, TableHardening):
+            return h.sigma_y(a)
         return (self.yield_stress + (h.sigma_inf - self.yield_stress) * (1.0 - math.exp(-h.delta * a))
                 + h.modulus * a)
 
     def _build_params(self) -> np.ndarray:
-        p = np.zeros(NPARAMS)
+        h = self.hardening
+        n_tab = len(h.strain) if isinstance(h, TableHardening) else 0
+        p = np.zeros(NPARAMS + (1 + 2 * n_tab if n_tab else 0))
         lam, mu = lame(float(self.E), float(self.nu))
         p[P_E], p[P_NU], p[P_LAMBDA], p[P_MU] = float(self.E), float(self.nu), lam, mu
         p[P_BULK] = lam + 2.0 * mu / 3.0
-        h = self.hardening
         p[P_LAW] = _LAWS[h.law]
         p[P_SY0] = self.yield_stress
         if isinstance(h, LinearHardening):
             p[P_H] = h.modulus
         elif isinstance(h, SwiftHardening):
             p[P_SWIFT_K], p[P_SWIFT_EPS0], p[P_SWIFT_N] = h.K, h.eps0, h.n
+        elif isinstance(h, TableHardening):
+            p[P_TAB_N] = n_tab
+            p[P_TAB:P_TAB + n_tab] = h.strain
+            p[P_TAB + n_tab:P_TAB + 2 * n_tab] = h.stress
         else:
             p[P_VOCE_SINF], p[P_VOCE_DELTA], p[P_H] = h.sigma_inf, h.delta, h.modulus
         p[P_HKIN] = float(self.kinematic_modulus)

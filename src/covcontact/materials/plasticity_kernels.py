@@ -17,7 +17,7 @@ from .logstrain import _dd1, _dd2, _eigh3
 J2 = 2
 #: history length per material point
 NHIST = 15
-#: params length
+#: params length of the fixed part (every law); the table law appends its points after it (P_TAB_N)
 NPARAMS = 36
 
 # history indices
@@ -37,12 +37,40 @@ P_HILL = 14
 P_HILL_COEF = 15
 P_Q3 = 21
 P_P = 30
+# table law only: params[P_TAB_N] = n points, then strains params[P_TAB:P_TAB + n], stresses after them
+P_TAB_N = NPARAMS
+P_TAB = NPARAMS + 1
 
-LAW_LINEAR, LAW_SWIFT, LAW_VOCE = 0, 1, 2
+LAW_LINEAR, LAW_SWIFT, LAW_VOCE, LAW_TABLE = 0, 1, 2, 3
 
 #: return mapping: relative residual tolerance and iteration limit
 RM_TOL = 1e-13
 RM_MAXIT = 60
+
+
+@njit(cache=True)
+def _table(params, alpha):
+    """Piecewise-linear sigma_y(alpha) through the table's points and the slope of the segment that holds
+    alpha (the right one at a point); constant, slope 0, from the last point on."""
+    n = int(params[P_TAB_N])
+    s0 = P_TAB + n
+    last = n - 1
+    if n == 1 or alpha >= params[P_TAB + last]:
+        return params[s0 + last], 0.0
+    # bisection for the segment lo: strain[lo] <= alpha < strain[lo + 1] (the first one below strain 0)
+    lo = 0
+    hi = last
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if params[P_TAB + mid] <= alpha:
+            lo = mid
+        else:
+            hi = mid
+    ea = params[P_TAB + lo]
+    sa = params[s0 + lo]
+    H = (params[s0 + lo + 1] - sa) / (params[P_TAB + lo + 1] - ea)
+    return sa + H * (alpha - ea), H
+
 
 @njit(cache=True, inline="always")
 def _hardening(params, alpha):
@@ -56,6 +84,8 @@ def _hardening(params, alpha):
         n = params[P_SWIFT_N]
         sy = params[P_SWIFT_K] * x ** n
         return sy, n * sy / x
+    if law == LAW_TABLE:
+        return _table(params, alpha)
     sy0 = params[P_SY0]
     ds = params[P_VOCE_SINF] - sy0
     delta = params[P_VOCE_DELTA]

@@ -25,10 +25,14 @@ _TET10_EDGES = np.array([[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]])
 SOURCE = {"tet4": "hex8", "tet10": "hex8", "wedge6": "hex8", "hex20": "hex27"}
 
 
-def convert(mesh: Mesh, cell: str) -> Mesh:
-    """``mesh`` (hex8, or hex27 for hex20) as a mesh of ``cell``."""
+def convert(mesh: Mesh, cell: str, elements: np.ndarray | None = None) -> Mesh:
+    """``mesh`` (hex8, or hex27 for hex20) as a mesh of ``cell``; with ``elements`` (hex8 -> wedge6 only) just those
+    bricks, the others kept: a mixed mesh of the bricks, then the wedges (conforming where every column of bricks
+    along z is split or kept whole)."""
     if mesh.cell_type != SOURCE[cell]:
         raise ValueError(f"{cell} meshes are made from {SOURCE[cell]} meshes, not {mesh.cell_type}")
+    if elements is not None:
+        return _split_part(mesh, np.unique(np.asarray(elements, dtype=np.int64)), cell)
     X, h = mesh.points, mesh.cells
     if cell == "hex20":
         cells, per = h[:, :20], 1
@@ -64,4 +68,32 @@ def convert(mesh: Mesh, cell: str) -> Mesh:
                 continue
             if len(f):
                 out.add_face_set(name, f)
+    return out
+
+
+def _split_part(mesh: Mesh, elements: np.ndarray, cell: str) -> Mesh:
+    """The bricks ``elements`` of a hex8 mesh cut into two wedges each, the others kept (before them)."""
+    if cell != "wedge6":
+        raise ValueError(f"only wedges (not {cell}) replace part of a hex8 mesh: their quadrilateral faces meet the "
+                         f"bricks'")
+    split = np.zeros(mesh.n_cells, dtype=bool)
+    split[elements] = True
+    kept = np.flatnonzero(~split)
+    out = Mesh.of_blocks(mesh.points, [("hex8", mesh.cells[kept]), ("wedge6", mesh.cells[elements][:, _WEDGES]
+                                                                     .reshape(-1, 6))])
+    out.node_sets = {k: v.copy() for k, v in mesh.node_sets.items()}
+    where = np.empty(mesh.n_cells, dtype=np.int64)
+    where[kept] = np.arange(kept.size)
+    where[elements] = kept.size + 2 * np.arange(elements.size)
+    for name, elems in mesh.element_sets.items():
+        e = np.asarray(elems)
+        out.element_sets[name] = np.unique(np.concatenate([where[e[~split[e]]], where[e[split[e]]],
+                                                           where[e[split[e]]] + 1]))
+    for name, faces in mesh.face_sets.items():
+        try:
+            f = faces_on_nodes(out, np.unique(faces), corners_only=True)
+        except ValueError:  # triangles and quadrilaterals on these nodes (no face set of one type)
+            continue
+        if len(f):
+            out.add_face_set(name, f)
     return out

@@ -98,32 +98,66 @@ def _corners(ftype_nodes: int) -> int:
     return 3 if ftype_nodes in (3, 6) else 4
 
 
-def _tables(mesh: Mesh) -> list[np.ndarray]:
-    """The face tables of the mesh's cell type (wedges: the triangles', then the quadrilaterals')."""
-    return list(WEDGE_FACES.values()) if mesh.cell_type == "wedge6" else [FACES[mesh.cell_type]]
+def cell_face_tables(cell_type: str) -> list[np.ndarray]:
+    """The face tables of a cell type: one, or for wedges the triangles', then the quadrilaterals'."""
+    return list(WEDGE_FACES.values()) if cell_type == "wedge6" else [FACES[cell_type]]
+
+
+def _face_sizes(mesh: Mesh) -> list[int]:
+    """Nodes per face of the mesh's face types (triangles first)."""
+    return sorted({t.shape[1] for c in mesh.cell_types for t in cell_face_tables(c)})
 
 
 def boundary_faces(mesh: Mesh, nfn: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Faces used by exactly one element (for hex18 only the t = -1 and t = +1 faces); of a wedge mesh those of
-    ``nfn`` nodes (3: triangles, 4: quadrilaterals; default the triangles).
+    """Faces used by exactly one element (for hex18 only the t = -1 and t = +1 faces); of a mesh with triangular
+    and quadrilateral faces (wedges, mixed meshes) those of ``nfn`` nodes (3: triangles, 4: quadrilaterals; default
+    the first of its face types).
 
     Returns:
-        faces (nf, nfn) outward ordered, elem (nf,) owning element, local_face (nf,) row of the cell type's face
-        table (``FACES[mesh.cell_type]``, ``WEDGE_FACES``).
+        faces (nf, nfn) outward ordered, elem (nf,) owning element, local_face (nf,) row of the owner's cell type's
+        face table of that face type (``FACES``, ``WEDGE_FACES``).
     """
-    tables = _tables(mesh)
-    table = next((t for t in tables if t.shape[1] == nfn), tables[0]) if nfn is not None else tables[0]
-    nlf, nfn = table.shape
-    allf = mesh.cells[:, table].reshape(-1, nfn)
+    sizes = _face_sizes(mesh)
+    nfn = sizes[0] if nfn is None or nfn not in sizes else nfn
+    allf, elem, local = [], [], []
+    for b in mesh.blocks:
+        table = next((t for t in cell_face_tables(b.cell_type) if t.shape[1] == nfn), None)
+        if table is None:
+            continue
+        nlf = table.shape[0]
+        allf.append(b.cells[:, table].reshape(-1, nfn))
+        k = np.arange(len(b.cells) * nlf)
+        elem.append(b.first + k // nlf)
+        local.append(k % nlf)
+    allf = np.concatenate(allf)
     corners = np.sort(allf[:, :_corners(nfn)], axis=1)
     _, inv, cnt = np.unique(corners, axis=0, return_inverse=True, return_counts=True)
     idx = np.nonzero(cnt[inv.ravel()] == 1)[0]
-    return np.ascontiguousarray(allf[idx]), idx // nlf, idx % nlf
+    return np.ascontiguousarray(allf[idx]), np.concatenate(elem)[idx], np.concatenate(local)[idx]
 
 
 def all_boundary_faces(mesh: Mesh) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """:func:`boundary_faces` of every face type of the mesh (one, or two for wedges)."""
-    return [boundary_faces(mesh, t.shape[1]) for t in _tables(mesh)]
+    """:func:`boundary_faces` of every face type of the mesh (one, or two for wedges and mixed meshes)."""
+    return [boundary_faces(mesh, n) for n in _face_sizes(mesh)]
+
+
+def nonconforming_cells(mesh: Mesh) -> np.ndarray:
+    """Pairs (cell with a triangular face, cell with a quadrilateral face) where the triangle's corners are three
+    corners of the quadrilateral (a tetrahedron or wedge against a brick: the mesh is not conforming), (n, 2)."""
+    sizes = _face_sizes(mesh)
+    if 3 not in sizes or 4 not in sizes:
+        return np.zeros((0, 2), dtype=np.int64)
+    tri, tel, _ = boundary_faces(mesh, 3)
+    quad, qel, _ = boundary_faces(mesh, 4)
+    sub = np.sort(quad[:, [[0, 1, 2], [1, 2, 3], [2, 3, 0], [3, 0, 1]]], axis=2).reshape(-1, 3)
+    keys = np.sort(tri, axis=1)
+    both = np.concatenate([sub, keys])
+    _, inv = np.unique(both, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    owner = np.full(inv.max() + 1, -1, dtype=np.int64)
+    owner[inv[: len(sub)]] = np.repeat(qel, 4)
+    hit = owner[inv[len(sub):]]
+    return np.column_stack([tel[hit >= 0], hit[hit >= 0]])
 
 
 def faces_on_nodes(mesh: Mesh, node_ids: np.ndarray, corners_only: bool = False) -> np.ndarray:
@@ -150,7 +184,7 @@ def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.
         matched (nm, nfn) boundary faces in the order of ``faces``, and found (nf,) bool.
     """
     given = np.asarray(faces).shape[1] if np.ndim(faces) == 2 else 4
-    bf, _, _ = boundary_faces(mesh, 3 if given == 3 else 4) if mesh.cell_type == "wedge6" else boundary_faces(mesh)
+    bf, _, _ = boundary_faces(mesh, 3 if given == 3 else 4) if len(_face_sizes(mesh)) > 1 else boundary_faces(mesh)
     nc = _corners(bf.shape[1])
     query = np.sort(np.asarray(faces, dtype=np.int64)[:, :nc], axis=1)
     if query.shape[0] == 0 or bf.shape[0] == 0:
@@ -182,10 +216,11 @@ def face_normals(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def jacobian_determinants(mesh: Mesh, points: np.ndarray | None = None) -> np.ndarray:
-    """det(dX/dxi) of every element at natural ``points`` (npts, 3), (nelem, npts).
+    """det(dX/dxi) of every element of a mesh of one cell type at natural ``points`` (npts, 3), (nelem, npts).
 
     The default points are the full Gauss rule of the cell type.
     """
+    mesh.connectivity()
     if mesh.cell_type in other_cells.CELLS:
         pts = other_cells.rule(mesh.cell_type)[0] if points is None else np.atleast_2d(points)
         dN = other_cells.shapes(mesh.cell_type, pts)[1]
@@ -202,5 +237,8 @@ _CENTRE = {"tet4": (0.25, 0.25, 0.25), "tet10": (0.25, 0.25, 0.25), "wedge6": (1
 
 def check_orientation(mesh: Mesh) -> list[int]:
     """Elements whose Jacobian at the element centre is not positive (inverted node order)."""
-    det = jacobian_determinants(mesh, np.array([_CENTRE.get(mesh.cell_type, (0.0, 0.0, 0.0))]))[:, 0]
-    return [int(e) for e in np.nonzero(~(det > 0.0))[0]]
+    bad = []
+    for first, piece in mesh.pieces():
+        det = jacobian_determinants(piece, np.array([_CENTRE.get(piece.cell_type, (0.0, 0.0, 0.0))]))[:, 0]
+        bad += [first + int(e) for e in np.nonzero(~(det > 0.0))[0]]
+    return bad

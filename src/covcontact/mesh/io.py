@@ -30,7 +30,7 @@ import numpy as np
 from ..fem.shapes import NODES
 from ..io.atomic import replacing
 from .faces import match_boundary_faces
-from .mesh import Mesh
+from .mesh import MIXABLE, Mesh
 
 if TYPE_CHECKING:
     import meshio
@@ -38,8 +38,6 @@ if TYPE_CHECKING:
 _VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27", "tetra": "tet4", "tetra10": "tet10", "wedge": "wedge6",
            "hexahedron20": "hex20"}
 _TO_MESHIO = {v: k for k, v in _VOLUME.items()}
-#: cells whose face groups become face sets (contact and pressure surfaces; tet4, tet10, hex20: pressure only)
-_FACED = ("hex8", "hex27", "tet4", "tet10", "hex20", "wedge6")
 _FACE_CELLS = ("quad", "quad8", "quad9", "triangle", "triangle6")
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
@@ -47,6 +45,10 @@ _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad
 
 class MeshError(ValueError):
     """A mesh file that cannot be read or holds no supported volume cells."""
+
+
+class MixedTypesError(MeshError):
+    """A mesh file of volume cell types that one mesh does not mix (read one of them with ``cell_type``)."""
 
 
 def _fail(path: Path, problem: str) -> MeshError:
@@ -93,17 +95,27 @@ def to_meshio(
     for k, v in (cell_data or {}).items():
         if np.shape(v)[0] != mesh.n_cells:
             raise ValueError(f"cell data {k!r} has {np.shape(v)[0]} rows for {mesh.n_cells} cells")
-    points, cells, ctype = mesh.points, mesh.cells, mesh.cell_type
-    if ctype == "hex18":
+    points = mesh.points
+    if mesh.cell_type == "hex18":
         cells, lo, hi = _expand_hex18(mesh)
         points = np.concatenate([points, 0.5 * (points[lo] + points[hi])])
         pdata = {k: np.concatenate([v, 0.5 * (v[lo] + v[hi])]) for k, v in pdata.items()}
-        ctype = "hex27"
+        blocks = [("hex27", cells, 0)]
+    else:
+        blocks = mesh.blocks
+    split = [b.first for b in blocks[1:]] if len(blocks) > 1 else []
+
+    def per_block(v: np.ndarray) -> list[np.ndarray]:
+        return np.split(np.asarray(v), split) if split else [np.asarray(v)]
+
+    def set_per_block(v: np.ndarray) -> list[np.ndarray]:
+        return [v[(v >= b[2]) & (v < b[2] + len(b[1]))] - b[2] for b in blocks]
+
     return meshio.Mesh(
-        points, [(_TO_MESHIO[ctype], cells)], point_data=pdata,
-        cell_data={k: [np.asarray(v)] for k, v in (cell_data or {}).items()},
+        points, [(_TO_MESHIO[b[0]], b[1]) for b in blocks], point_data=pdata,
+        cell_data={k: per_block(v) for k, v in (cell_data or {}).items()},
         point_sets={k: v.copy() for k, v in mesh.node_sets.items()},
-        cell_sets={k: [v.copy()] for k, v in mesh.element_sets.items()},
+        cell_sets={k: set_per_block(v) for k, v in mesh.element_sets.items()},
     )
 
 
@@ -182,20 +194,23 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         kinds = ", ".join(sorted({b.type for b in m.cells})) or "none"
         raise _fail(p, f"no supported volume cells ({', '.join(_VOLUME)}); found: {kinds}")
     if cell_type is None:
-        if len(found) > 1:
-            raise _fail(p, f"holds {' and '.join(found)} cells; choose one with cell_type")
-        cell_type = found[0]
+        if len(found) > 1 and not set(found) <= set(MIXABLE):
+            raise MixedTypesError(_fail(p, f"holds {' and '.join(found)} cells, which one mesh does not mix (only "
+                                           f"{', '.join(MIXABLE)} cells mix): take the cells of one type (a body's "
+                                           f"element = \"TYPE\", read_mesh's cell_type)"))
+        chosen = found
     elif cell_type not in found:
         raise _fail(p, f"no {cell_type} cells; found: {', '.join(found)}")
-    vol = [b for b, blk in enumerate(m.cells) if blk.type == _TO_MESHIO[cell_type]]
+    else:
+        chosen = [cell_type]
+    vol = [b for b, blk in enumerate(m.cells) if _VOLUME.get(blk.type) in chosen]
     first = np.cumsum([0] + [len(m.cells[b].data) for b in vol])
-    cells = np.concatenate([m.cells[b].data for b in vol]).astype(np.int64)
     pts = np.zeros((len(m.points), 3))
     pts[:, : min(3, m.points.shape[1])] = m.points[:, :3]
-    used = np.unique(cells)
+    used = np.unique(np.concatenate([m.cells[b].data.ravel() for b in vol]).astype(np.int64))
     new = np.full(len(pts), -1, dtype=np.int64)
     new[used] = np.arange(used.size)
-    mesh = Mesh(pts[used], cell_type, new[cells])
+    mesh = Mesh.of_blocks(pts[used], [(_VOLUME[m.cells[b].type], new[m.cells[b].data.astype(np.int64)]) for b in vol])
 
     def keep(nodes: np.ndarray) -> np.ndarray:
         k = new[np.asarray(nodes, dtype=np.int64)]
@@ -210,7 +225,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
             nodes.append(data.ravel())
             if b in vol:
                 elems.append(first[vol.index(b)] + ids)
-            elif m.cells[b].type in _FACE_CELLS and len(data) and cell_type in _FACED:
+            elif m.cells[b].type in _FACE_CELLS and len(data):
                 faces.append(new[data[:, :4]])
         if elems:
             mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)
@@ -223,7 +238,7 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         kept = keep(np.concatenate(nodes))
         if name not in mesh.node_sets and kept.size:
             mesh.add_node_set(name, kept)
-    if p.suffix.lower() == ".inp" and cell_type in _FACED:
+    if p.suffix.lower() == ".inp":
         _abaqus_surfaces(p, m, mesh, vol, first, keep)
     return mesh
 
@@ -232,9 +247,6 @@ def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep)
     """The deck's *SURFACE definitions as face sets (element surfaces: their faces, matched outward) and node
     sets (node surfaces), each element surface also a node set of its nodes."""
     from .abaqus import HEX_FACES, TET_FACES, WEDGE_FACES, read_surfaces
-
-    table = (TET_FACES if mesh.cell_type in ("tet4", "tet10") else WEDGE_FACES if mesh.cell_type == "wedge6"
-             else HEX_FACES)
 
     try:
         elem, node = read_surfaces(p)
@@ -249,14 +261,17 @@ def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep)
             for k, b in enumerate(vol):
                 ids = np.asarray(parts[b], dtype=np.int64) if b < len(parts) and parts[b] is not None else []
                 if len(ids):
+                    ctype, cells = mesh.cells_of(first[k] + ids)
+                    table = (TET_FACES if ctype in ("tet4", "tet10") else WEDGE_FACES if ctype == "wedge6"
+                             else HEX_FACES)
                     if face not in table:
-                        raise _fail(p, f"*SURFACE {name}: {mesh.cell_type} elements have the faces S1..S{len(table)}, "
+                        raise _fail(p, f"*SURFACE {name}: {ctype} elements have the faces S1..S{len(table)}, "
                                        f"not S{face}")
-                    faces.append(mesh.cells[first[k] + ids][:, list(table[face])])
+                    faces.append(cells[:, list(table[face])])
         if not faces:
             raise _fail(p, f"*SURFACE {name}: its element sets hold no volume cells")
         if len({f.shape[1] for f in faces}) > 1:
-            raise _fail(p, f"*SURFACE {name}: mixes triangular (S1, S2) and quadrilateral (S3..S5) wedge faces; "
+            raise _fail(p, f"*SURFACE {name}: mixes triangular and quadrilateral faces (wedges: S1, S2 and S3..S5); "
                            f"a surface holds faces of one type: split it in two")
         f = np.concatenate(faces)
         matched, found = match_boundary_faces(mesh, f)

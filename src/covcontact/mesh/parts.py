@@ -14,11 +14,11 @@ def select(mesh: Mesh, elements: np.ndarray) -> Mesh:
     own copies), the node sets restricted to its nodes, the element sets to its elements, and the face sets
     matched against its boundary (faces between this part and the rest are boundary faces of it)."""
     elements = np.unique(np.asarray(elements, dtype=np.int64))
-    cells = mesh.cells[elements]
-    used = np.unique(cells)
+    blocks = [(t, mesh.cells_of(elements[idx])[1]) for t, idx in mesh.type_parts(elements)]
+    used = np.unique(np.concatenate([c.ravel() for _, c in blocks]))
     new = np.full(mesh.n_nodes, -1, dtype=np.int64)
     new[used] = np.arange(used.size)
-    part = Mesh(mesh.points[used], mesh.cell_type, new[cells])
+    part = Mesh.of_blocks(mesh.points[used], [(t, new[c]) for t, c in blocks])
     for name, nodes in mesh.node_sets.items():
         k = new[nodes]
         if np.any(k >= 0):

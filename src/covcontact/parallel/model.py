@@ -159,12 +159,11 @@ class PartBody:
     def stress(self, u: np.ndarray, state: dict | None = None) -> SolidStress:
         """The body's stress fields (global element order), on every rank (collective)."""
         st = self.local.stress(u, state)
-        cells = self.local.cells
+        els, flat = self.local.incidence()
         n = self.local.n_nodes
         sums = np.zeros((n, 7))
-        flat = cells.ravel()
         for I in range(6):
-            sums[:, I] = np.bincount(flat, weights=np.repeat(st.cauchy[:, I], cells.shape[1]), minlength=n)
+            sums[:, I] = np.bincount(flat, weights=st.cauchy[els, I], minlength=n)
         sums[:, 6] = np.bincount(flat, minlength=n)
         sums = sum_all(self.comm, sums)
         fields = np.hstack([st.cauchy, st.pk2, st.green_lagrange, st.von_mises[:, None]])
@@ -213,22 +212,22 @@ class DistributedSystem(System):
         self.X = np.zeros((self.n_nodes, 3))
         for off, body in zip(offsets, bodies):
             self.X[off: off + body.mesh.n_nodes] = body.mesh.points
-        cells = [body.mesh.cells + off for off, body in zip(offsets, bodies)]
+        cells = [b.cells + off for off, body in zip(offsets, bodies) for b in body.mesh.blocks]
         centroids = np.vstack([self.X[c].mean(axis=1) for c in cells])
         weights = np.concatenate([np.full(len(c), float(c.shape[1]) ** 2) for c in cells])
         part = rcb(centroids, weights, size)
-        parts = np.split(part, np.cumsum([len(c) for c in cells])[:-1])
+        block_parts = np.split(part, np.cumsum([len(c) for c in cells])[:-1])
+        parts = np.split(part, np.cumsum([body.mesh.n_cells for body in bodies])[:-1])
         self.blocks: list[BodyBlock] = []
-        local_cells = []
+        local_cells = [c[p == rank] for c, p in zip(cells, block_parts)]
         for off, body, p in zip(offsets, bodies, parts):
             elements = np.flatnonzero(p == rank)
             local = make_solid(body, elements)
             self.blocks.append(BodyBlock(body.name, off, body.mesh.n_nodes,
                                          PartBody(local, elements, body.mesh.n_cells, comm)))
-            local_cells.append(body.mesh.cells[elements] + off)
         self.element_parts = parts
         self.pattern = Pattern(self.n_nodes, local_cells)
-        self.owner = node_owners(self.n_nodes, cells, parts)
+        self.owner = node_owners(self.n_nodes, cells, block_parts)
         self.layout = DofLayout.from_owners(self.owner, rank, size, self.X)
         self._build_loads()
         self._build_dirichlet()

@@ -34,7 +34,7 @@ class Model:
         self.tangent = tangent
         self.contact = ContactManager(problem, self.system, tangent)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
-        blocks = [body.mesh.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies)]
+        blocks = [b.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies) for b in body.mesh.blocks]
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
         self.stages = StagePlan(problem, self.system)
         self.set_stage(State([], None))
@@ -292,9 +292,9 @@ class Model:
         element that inverts next to a contact is most often crushed by it: a penalty too soft or too stiff,
         an increment too large, a tool that cuts in at a sharp corner)."""
         blk = next((b for b in self.system.blocks if b.name == body), None)
-        if self.size > 1 or blk is None or not hasattr(blk.solid, "cells"):  # (a rank holds part of the mesh)
+        if self.size > 1 or blk is None or not hasattr(blk.solid, "element_nodes"):  # (a rank holds part of it)
             return ""
-        nodes = np.asarray(blk.solid.cells[element]) + blk.offset
+        nodes = blk.solid.element_nodes([element]) + blk.offset
         X = self.system.X[nodes].mean(axis=0)
         pairs = sorted({p.pair for p in self.contact.passes if np.intersect1d(p.slaves, nodes).size})
         where = f" (centre at {X[0]:.4g}, {X[1]:.4g}, {X[2]:.4g})"
