@@ -34,7 +34,8 @@ def _parser() -> argparse.ArgumentParser:
               "(`covcontact info` lists those available here)")
     r = sub.add_parser("run", help="solve a problem file", description="Solve a problem file; results, "
                        "summary.json and checkpoints go to the output folder.")
-    r.add_argument("problem", help="the problem file (TOML; keys in docs/input.md)")
+    r.add_argument("problem", help="the problem file (TOML; keys in docs/input.md), or an Abaqus / CalculiX deck "
+                   "(.inp: imported into the output folder first, a .dat table of its *NODE PRINT requests written)")
     r.add_argument("--out", default=None, metavar="DIR",
                    help="output folder (default: results/NAME, NAME from [problem] name)")
     r.add_argument("--tangent", choices=TANGENT_CASES, default=None,
@@ -48,6 +49,18 @@ def _parser() -> argparse.ArgumentParser:
                         "petsc-gamg where auto picks it, else petsc (MUMPS), or the --solver given; 1: one "
                         "process (default auto: one rank per core where the solver auto picks petsc-gamg, else "
                         "one process)")
+    r.add_argument("--ignore-unsupported", action="store_true",
+                   help="a deck: go on without what covcontact does not support (each ignored line is listed)")
+    d = sub.add_parser("import", help="write the covcontact problem of an Abaqus / CalculiX deck",
+                       description="Read an Abaqus or CalculiX input deck and write the equivalent problem file, its "
+                       "meshes (NAME.mesh.K.inp, one per body) and node labels (NAME.nodes.json) beside it "
+                       "(docs/input.md, \"Abaqus and CalculiX decks\"). What the deck has and covcontact does not "
+                       "support is listed with its line, and nothing is written (exit 2) unless --ignore-unsupported.")
+    d.add_argument("deck", help="the deck (.inp)")
+    d.add_argument("--out", default=None, metavar="FILE", help="the problem file to write (default: NAME.toml "
+                   "beside the deck)")
+    d.add_argument("--ignore-unsupported", action="store_true",
+                   help="write the problem without what covcontact does not support (each ignored line is listed)")
     s = sub.add_parser("study", help="run a problem once per tangent case and tabulate the iterations",
                        description="Run a problem once per tangent case; writes table.md, table.csv "
                        "(the layout of the paper's Table 1) and iterations.png.")
@@ -118,9 +131,60 @@ def _check_solver(name: str | None) -> None:
                          f"(available here: {', '.join(available())})")
 
 
+def _import(deck: Path, out: Path, ignore: bool) -> object | None:
+    """Import ``deck`` into ``out``; None (after listing them on stderr) when it has unsupported parts and ``ignore``
+    is not given."""
+    from .io.deck_import import import_deck
+
+    imported = import_deck(deck, out)
+    for line in imported.unsupported:
+        print(f"covcontact: {'ignored' if ignore else 'unsupported'}: {line}", file=sys.stderr)
+    if imported.unsupported and not ignore:
+        print(f"covcontact: error: {deck}: {len(imported.unsupported)} unsupported keywords or parameters (listed "
+              f"above); --ignore-unsupported goes on without them", file=sys.stderr)
+        return None
+    return imported
+
+
+def cmd_import(args) -> int:
+    deck = Path(args.deck)
+    out = Path(args.out) if args.out else deck.with_suffix(".toml")
+    imported = _import(deck, out, args.ignore_unsupported)
+    if imported is None:
+        for f in [out, out.with_suffix(".nodes.json"), *out.parent.glob(f"{out.stem}.mesh.*.inp")]:
+            f.unlink(missing_ok=True)
+        return 2
+    print(f"wrote {imported.problem}, {', '.join(p.name for p in imported.meshes)}, {imported.labels.name}",
+          file=sys.stderr)
+    return 0
+
+
+def _run_deck(args) -> int:
+    """``covcontact run DECK.inp``: the deck imported into OUT/deck/, run in one process, the .dat table beside."""
+    from .io.deck_dat import DatTable
+    from .io.loader import load_problem
+    from .solvers.run import solve_problem
+
+    deck = Path(args.problem)
+    out = Path(args.out) if args.out else Path("results") / deck.stem
+    imported = _import(deck, out / "deck" / f"{deck.stem}.toml", args.ignore_unsupported)
+    if imported is None:
+        return 2
+    problem = load_problem(imported.problem)
+    _check_solver(args.solver or problem.solver.linear)
+    table = DatTable(imported.labels, out / f"{deck.stem}.dat")
+    result = solve_problem(problem, out=out, tangent=args.tangent, quiet=args.quiet, linear=args.solver,
+                           resume=args.resume, observers=[table])
+    if not args.quiet:
+        print(f"results in {result.out}", file=sys.stderr)
+    return result.exit_code
+
+
 def cmd_run(args) -> int:
     from .io.loader import load_problem
 
+    if Path(args.problem).suffix.lower() == ".inp":
+        return _run_deck(args)
     problem = load_problem(args.problem)
     _check_solver(args.solver or problem.solver.linear)
     started = args.ranks == "auto"
@@ -325,7 +389,7 @@ def cmd_info(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     handler = {"run": cmd_run, "study": cmd_study, "check-tangent": cmd_check_tangent,
-               "compile": cmd_compile, "info": cmd_info}[args.command]
+               "compile": cmd_compile, "info": cmd_info, "import": cmd_import}[args.command]
     if args.command not in ("info", "compile"):
         from .compile_notice import install
 

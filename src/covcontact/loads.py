@@ -25,6 +25,16 @@ class Dirichlet:
 
 
 @dataclass
+class Equation:
+    """A linear multi-point constraint sum_k c_k u(node_k, component_k) = 0 (docs/theory.md, "Multi-point
+    constraints"): ``terms`` are (body, node set of one node, component 0..2, coefficient c_k); the first term's
+    dof is the dependent one, eliminated in favour of the others."""
+
+    terms: list[tuple[str, str, int, float]]
+    name: str = ""
+
+
+@dataclass
 class NodalForce:
     """Force ``lam * value`` on every node of a node set (``per_node``) or spread evenly (``total``)."""
 

@@ -37,6 +37,8 @@ class Problem:
     name: str
     bodies: list[Body]
     dirichlet: list[Dirichlet] = field(default_factory=list)
+    #: linear multi-point constraints (``covcontact.loads.Equation``)
+    equations: list = field(default_factory=list)
     forces: list[NodalForce] = field(default_factory=list)
     pressures: list[Pressure] = field(default_factory=list)
     tractions: list[Traction] = field(default_factory=list)

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from ..description import COMPONENTS
-from ..loads import Dirichlet, NodalForce, Pressure, Traction
+from ..loads import Dirichlet, Equation, NodalForce, Pressure, Traction
 from .fields import dirichlet_values, read_motion, split_ref
 from .validate import Section, suggest
 
@@ -98,3 +98,67 @@ def read_loads(top: Section, sets: SetRefs) -> tuple[list, list, list]:
         t.done()
         tractions.append(Traction(bname, sname, value, tname))
     return forces, pressures, tractions
+
+
+def read_equations(top: Section, sets: SetRefs, dirichlet: list[Dirichlet]) -> list[Equation]:
+    """Every ``[[equation]]`` entry: ``terms = [["body.set", "x", c], ...]``, each set one node; the first term's dof is
+    eliminated: it may be the first term of no other equation, nor held by a Dirichlet condition, and eliminations
+    may not form a cycle (they may chain: an eliminated dof is a term of another equation)."""
+    out: list[Equation] = []
+    dependent: dict[tuple, str] = {}   # (body, node, component) of each eliminated dof -> its equation
+    refs: dict[tuple, list[tuple]] = {}  # eliminated dof -> the dofs of its other terms
+    for k, e in enumerate(top.get("equation", "array", [])):
+        raw = e.get("terms", "any")
+        name = e.get("name", "str", "")
+        e.done()
+        if not isinstance(raw, list) or not raw:
+            e.fail("must be a non-empty array of [\"body.set\", \"x\" | \"y\" | \"z\", coefficient]", "terms")
+        terms = []
+        for j, t in enumerate(raw):
+            key = f"terms[{j}]"
+            if not (isinstance(t, list) and len(t) == 3 and isinstance(t[0], str) and t[1] in COMPONENTS
+                    and isinstance(t[2], (int, float)) and not isinstance(t[2], bool)):
+                e.fail("must be [\"body.set\", \"x\" | \"y\" | \"z\", coefficient]", key)
+            bname, sname = sets.body_set(Section({"set": t[0]}, e.key_path(key), e.file), "set", "node")
+            sets.deformable(e, key, bname)
+            nodes = sets.mesh(bname).node_sets[sname]
+            if len(nodes) != 1:
+                e.fail(f"{t[0]!r} holds {len(nodes)} nodes; each term names a set of one node", key)
+            comp = COMPONENTS[t[1]]
+            dof = (bname, int(nodes[0]), comp)
+            if j == 0:
+                if float(t[2]) == 0.0:
+                    e.fail("the first coefficient (of the eliminated dof) must not be zero", key)
+                if dof in dependent:
+                    e.fail(f"{t[0]} {t[1]} is the eliminated (first) term of {dependent[dof]} already: put another "
+                           f"dof of this equation first", key)
+                dependent[dof] = e.path
+                first = dof
+            elif dof == first:
+                e.fail(f"{t[0]} {t[1]} is this equation's eliminated (first) term: it appears once", key)
+            terms.append((bname, sname, comp, float(t[2])))
+        out.append(Equation(terms, name))
+        refs[first] = [(b, int(sets.mesh(b).node_sets[sn][0]), c) for b, sn, c, _ in terms[1:]]
+    state: dict[tuple, int] = {}  # a cycle of eliminations (u_a = u_b, u_b = u_a) has no solution for them
+
+    def visit(d: tuple) -> None:
+        state[d] = 1
+        for r in refs.get(d, ()):
+            if state.get(r) == 1:
+                top.fail(f"the equations {dependent[d]} and {dependent[r]} eliminate each other's dofs in a cycle: "
+                         f"put another dof first in one of them", "equation")
+            if r in refs and r not in state:
+                visit(r)
+        state[d] = 2
+
+    for d in refs:
+        if d not in state:
+            visit(d)
+    for i, bc in enumerate(dirichlet):
+        nodes = set(sets.mesh(bc.body).node_sets[bc.set].tolist())
+        for (bname, node, comp), where in dependent.items():
+            if bname == bc.body and node in nodes and comp in bc.components:
+                top.fail(f"the dof {'xyz'[comp]} of node {node} of {bname!r} is the eliminated (first) term of "
+                         f"{where} and held by this condition: put another dof of the equation first",
+                         f"dirichlet[{i}]")
+    return out

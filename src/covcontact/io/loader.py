@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..problem import Problem
 from .bodies_input import read_bodies
-from .conditions_input import SetRefs, read_dirichlet, read_loads
+from .conditions_input import SetRefs, read_dirichlet, read_equations, read_loads
 from .contact_input import read_contacts
 from .dynamics_input import check_densities, read_dynamics, read_initial_velocities
 from .fields import read_steps
@@ -38,8 +38,8 @@ def load_problem(path: str | Path) -> Problem:
     return problem_from_dict(raw, path)
 
 
-_TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "contact", "steps",
-              "stages", "initial_velocity", "solver", "output")
+_TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "contact", "equation",
+              "steps", "stages", "initial_velocity", "solver", "output")
 
 
 def problem_from_dict(raw: dict, path: Path) -> Problem:
@@ -63,6 +63,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     dirichlet = read_dirichlet(top, sets)
     forces, pressures, tractions = read_loads(top, sets)
     contacts = read_contacts(top, sets, rigid)
+    equations = read_equations(top, sets, dirichlet)
 
     for i, r in enumerate(rigid):
         if r.free and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
@@ -94,10 +95,13 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                          "[Ixx, Iyy, Izz] about its reference point in a dynamic stage", f"rigid[{i}].inertia")
     elif velocities:
         top.fail("initial velocities need a dynamic stage (procedure = \"dynamic\")", "initial_velocity")
+    if equations and dynamic:
+        top.fail("multi-point constraints ([[equation]]) are for quasi-static stages only, not yet dynamic ones",
+                 "equation")
     solver = read_solver(top)
     output = read_output(top)
     top.done()
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
-                   units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity)
+                   units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity, equations=equations)

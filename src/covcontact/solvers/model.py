@@ -37,6 +37,11 @@ class Model:
         blocks = [b.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies) for b in body.mesh.blocks]
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
         self.stages = StagePlan(problem, self.system)
+        self.constraints = None
+        if getattr(problem, "equations", None):
+            from .constraints import LinearConstraints
+
+            self.constraints = LinearConstraints(problem.equations, self.system)
         self.set_stage(State([], None))
 
     # stages -----------------------------------------------------------------------------------
@@ -45,7 +50,8 @@ class Model:
         spec = self.stages[state.stage]
         self.loading = Loading(spec, self.system.X, state.forces.get("release"), state.forces.get("held"),
                                state.forces.get("parked"))
-        self.system.set_constraints(spec.constrained)
+        held = spec.constrained if self.constraints is None else spec.constrained | self.constraints.mask
+        self.system.set_constraints(held)
         self.contact.set_stage(spec.motions, spec.contacts)
 
     def enter_stage(self, u: np.ndarray, committed: State) -> State:
@@ -164,6 +170,8 @@ class Model:
         """
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
+        if self.constraints is not None:  # (the dependent dofs follow the others: u is set in place)
+            self.constraints.complete(u)
         x = self.positions(u)
         ev, ctrial = self.contact.evaluate(x, lam, committed.contact, guess.contact, want_K)
         if self.system.reference:
@@ -181,7 +189,10 @@ class Model:
         if timing is not None:
             timing["assembly"] += t2 - t1
             timing["contact"] += (t1 - t0) + (t3 - t2)
-        return r - self.external(lam), K, committed.but(elements=etrial, contact=ctrial, lam=lam)
+        r = r - self.external(lam)
+        if self.constraints is not None:
+            r, K = self.constraints.transform(r, K)
+        return r, K, committed.but(elements=etrial, contact=ctrial, lam=lam)
 
     # rigid bodies with a reference node ------------------------------------------------------------
     def _rigid_loads(self, blocks, x: np.ndarray, lam: float, want_K: bool) -> None:

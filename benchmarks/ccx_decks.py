@@ -1,0 +1,162 @@
+"""CalculiX's own test decks run by covcontact: the printed displacements against the reference results.
+
+Install the decks and their references first (they are not downloaded here):
+
+    apt-get install calculix-ccx-test      # the decks sit in /usr/share/doc/calculix-ccx-test/examples/test
+
+Each deck named (default: every deck in that folder whose keywords covcontact reads) is run with
+``covcontact run DECK.inp`` in a folder of its own; the ``.dat`` table it writes is compared with the deck's
+``.dat.ref``: for every block of displacements (U) and forces (RF) that both print at the same time, the largest
+difference over the largest value of the reference block. Decks that covcontact refuses (unsupported keywords, one
+line each) or that fail are listed with the reason. Results: a JSON file and a markdown table
+(docs/verification.md, "CalculiX test decks").
+
+    python benchmarks/ccx_decks.py [--decks contact1,contact4] [--folder DIR] [--out results/ccx_decks]
+"""
+
+from __future__ import annotations
+
+import argparse
+import gzip
+import json
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+FOLDER = Path("/usr/share/doc/calculix-ccx-test/examples/test")
+
+
+def _text(path: Path) -> str | None:
+    if path.is_file():
+        return path.read_text(errors="replace")
+    gz = path.with_name(path.name + ".gz")
+    if gz.is_file():
+        return gzip.decompress(gz.read_bytes()).decode(errors="replace")
+    return None
+
+
+def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]:
+    """The displacement and force blocks of a .dat file: (kind, set, time) -> node label -> values."""
+    out: dict = {}
+    key = None
+    for line in text.splitlines():
+        if " for set " in line and " and time " in line:
+            kind = line.split(" for set")[0].split()[0]
+            key = (kind, line.split("set ")[1].split()[0], float(line.split("time")[1]))
+            out[key] = {} if kind in ("displacements", "forces") else None
+            continue
+        if key is None or out.get(key) is None or not line.strip():
+            continue
+        f = line.split()
+        try:
+            out[key][int(f[0])] = np.array([float(v) for v in f[1:4]])
+        except (ValueError, IndexError):
+            key = None
+    return {k: v for k, v in out.items() if v}
+
+
+def compare(ours: str, ref: str) -> list[dict]:
+    """Per block both print (the reference's last time of each step): max |difference| / max |reference|."""
+    a, b = dat_blocks(ours), dat_blocks(ref)
+    rows = []
+    for key, rb in b.items():
+        match = [k for k in a if k[0] == key[0] and k[1] == key[1] and abs(k[2] - key[2]) <= 1e-6 * max(1, key[2])]
+        if not match:
+            continue
+        ab = a[match[0]]
+        nodes = sorted(set(rb) & set(ab))
+        if not nodes:
+            continue
+        R = np.array([rb[n] for n in nodes])
+        A = np.array([ab[n] for n in nodes])
+        scale = float(np.abs(R).max())
+        rows.append({"kind": key[0], "set": key[1], "time": key[2], "nodes": len(nodes),
+                     "max_ref": scale, "rel_diff": float(np.abs(A - R).max() / scale) if scale > 0 else 0.0})
+    return rows
+
+
+def candidates(folder: Path) -> list[str]:
+    from covcontact.io.deck import read_deck
+    from covcontact.io.deck_model import ELEMENTS, SUPPORTED
+
+    out = []
+    for p in sorted(folder.glob("*.inp")) + sorted(folder.glob("*.inp.gz")):
+        name = p.name.removesuffix(".gz").removesuffix(".inp")
+        try:
+            text = _text(folder / f"{name}.inp")
+            tmp = Path("/tmp") / f"_ccx_{name}.inp"
+            tmp.write_text(text)
+            cards = read_deck(tmp)
+        except Exception:  # noqa: BLE001 (a deck the survey cannot read is simply not a candidate)
+            continue
+        names = {c.name for c in cards}
+        types = {c.params.get("TYPE", "").upper() for c in cards if c.name == "ELEMENT"}
+        if names <= set(SUPPORTED) and types and types <= set(ELEMENTS):
+            out.append(name)
+    return sorted(set(out))
+
+
+def run_deck(name: str, folder: Path, out: Path) -> dict:
+    work = out / name
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    deck = work / f"{name}.inp"
+    deck.write_text(_text(folder / f"{name}.inp"))
+    ref = _text(folder / f"{name}.dat.ref")
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(work / "run"),
+                           "--quiet"], capture_output=True, text=True, timeout=1800)
+    row = {"deck": name, "exit_code": proc.returncode, "seconds": round(time.perf_counter() - t0, 2)}
+    if proc.returncode == 2:
+        lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+        row["why"] = "; ".join(ln.split(": ", 1)[-1] for ln in lines[:3])
+        return row
+    dat = work / "run" / f"{name}.dat"
+    if proc.returncode != 0 or not dat.is_file():
+        row["why"] = (proc.stderr.strip().splitlines() or ["no output"])[-1][:300]
+        return row
+    blocks = compare(dat.read_text(), ref or "")
+    row["blocks"] = blocks
+    for kind in ("displacements", "forces"):
+        vals = [b["rel_diff"] for b in blocks if b["kind"] == kind]
+        if vals:
+            row[f"max_rel_{kind}"] = max(vals)
+    return row
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--decks", default=None, help="comma-separated deck names (default: the candidates)")
+    ap.add_argument("--folder", default=str(FOLDER))
+    ap.add_argument("--out", default="results/ccx_decks")
+    args = ap.parse_args()
+    folder, out = Path(args.folder), Path(args.out)
+    if not folder.is_dir():
+        print(f"{folder}: no such folder (apt-get install calculix-ccx-test)", file=sys.stderr)
+        return 2
+    names = args.decks.split(",") if args.decks else candidates(folder)
+    rows = []
+    for name in names:
+        row = run_deck(name, folder, out)
+        rows.append(row)
+        u = row.get("max_rel_displacements")
+        print(f"{name:16s} exit {row['exit_code']}  U {u if u is None else f'{u:.2e}'}  {row.get('why', '')}",
+              flush=True)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "ccx_decks.json").write_text(json.dumps(rows, indent=1))
+    lines = ["| deck | exit | U: max diff / max ref | RF: max diff / max ref | note |", "|---|---|---|---|---|"]
+    for r in rows:
+        u, f = r.get("max_rel_displacements"), r.get("max_rel_forces")
+        lines.append(f"| {r['deck']} | {r['exit_code']} | {'' if u is None else f'{u:.1e}'} | "
+                     f"{'' if f is None else f'{f:.1e}'} | {r.get('why', '')} |")
+    (out / "ccx_decks.md").write_text("\n".join(lines) + "\n")
+    print(f"wrote {out / 'ccx_decks.md'}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

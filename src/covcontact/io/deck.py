@@ -1,0 +1,185 @@
+"""Abaqus and CalculiX input decks, read as cards (docs/input.md, "Abaqus and CalculiX decks").
+
+A deck is a sequence of keyword lines (``*NAME, PARAM=VALUE, FLAG``) each followed by its data lines; ``**`` starts
+a comment line, ``*INCLUDE, INPUT=file`` reads another file in place (relative to the including file). Keywords,
+parameter names and set names are case-insensitive: they are kept upper-case. A keyword line that ends with a comma
+continues on the next line. Data lines are kept as text with their file and line number, so that the model layer
+(:mod:`covcontact.io.deck_model`) parses large blocks (nodes, elements) in one vectorised pass and still names the
+line of a malformed entry.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .validate import InputError
+
+
+class DeckError(InputError):
+    """A deck that cannot be read: the message names the file and line, what is wrong and the likely fix."""
+
+
+@dataclass
+class Card:
+    """One keyword with its data lines.
+
+    Attributes:
+        name: the keyword, upper-case, single spaces ("SOLID SECTION").
+        params: parameter name -> value (upper-case names; a flag without ``=`` maps to "").
+        data: the data lines (stripped text).
+        lines: (file, line number) of each data line.
+        file, line: where the keyword line is.
+        text: the keyword line as written.
+    """
+
+    name: str
+    params: dict[str, str]
+    file: Path
+    line: int
+    text: str
+    data: list[str] = field(default_factory=list)
+    lines: list[tuple[Path, int]] = field(default_factory=list)
+
+    def where(self, k: int | None = None) -> str:
+        """"file:line" of the keyword line, or of data line ``k``."""
+        f, n = (self.file, self.line) if k is None else self.lines[k]
+        return f"{f}:{n}"
+
+    def fail(self, problem: str, k: int | None = None) -> DeckError:
+        return DeckError(f"{self.where(k)}: *{self.name}: {problem}")
+
+    def param(self, name: str, default: str | None = None, required: bool = False) -> str | None:
+        """The value of parameter ``name`` (upper-case); a DeckError when required and missing."""
+        if name in self.params:
+            return self.params[name]
+        if required:
+            raise self.fail(f"missing parameter {name}= (e.g. *{self.name}, {name}=...)")
+        return default
+
+    def rows(self) -> list[list[str]]:
+        """The data lines split at commas, fields stripped, trailing empty fields dropped."""
+        out = []
+        for text in self.data:
+            fields = [f.strip() for f in text.split(",")]
+            while fields and fields[-1] == "":
+                fields.pop()
+            out.append(fields)
+        return out
+
+    def number(self, k: int, j: int, fields: list[str], what: str, default: float | None = None) -> float:
+        """Field ``j`` of data line ``k`` as a number (``default`` when empty or missing)."""
+        if j >= len(fields) or fields[j] == "":
+            if default is not None:
+                return default
+            raise self.fail(f"{what} is missing (field {j + 1})", k)
+        try:
+            return float(fields[j].replace("d", "e").replace("D", "E"))
+        except ValueError:
+            raise self.fail(f"{what} must be a number, got {fields[j]!r} (field {j + 1})", k) from None
+
+
+def _params(text: str, file: Path, line: int) -> tuple[str, dict[str, str]]:
+    parts = [p.strip() for p in text[1:].split(",")]
+    name = " ".join(parts[0].upper().split())
+    params: dict[str, str] = {}
+    for p in parts[1:]:
+        if not p:
+            continue
+        if "=" in p:
+            k, v = p.split("=", 1)
+            params[" ".join(k.upper().split())] = v.strip()
+        else:
+            params[" ".join(p.upper().split())] = ""
+    if not name:
+        raise DeckError(f"{file}:{line}: a keyword line without a keyword (a lone '*')")
+    return name, params
+
+
+def read_deck(path: str | Path) -> list[Card]:
+    """The cards of the deck at ``path``, with ``*INCLUDE`` files read in place."""
+    cards: list[Card] = []
+    _read(Path(path), cards, [])
+    return cards
+
+
+def _read(path: Path, cards: list[Card], stack: list[Path]) -> None:
+    if not path.is_file():
+        where = f"{stack[-1]}: " if stack else ""
+        raise DeckError(f"{where}{path}: no such deck file")
+    if path.resolve() in stack:
+        raise DeckError(f"{path}: *INCLUDE of a file that includes it (a cycle)")
+    stack.append(path.resolve())
+    try:
+        text = path.read_text(errors="replace")
+    except OSError as exc:
+        raise DeckError(f"{path}: cannot read ({exc})") from None
+    raw = text.splitlines()
+    card: Card | None = None
+    n = 0
+    while n < len(raw):
+        line = raw[n].strip()
+        n += 1
+        if not line or line.startswith("**"):
+            continue
+        if line.startswith("*"):
+            first = n
+            while line.endswith(",") and n < len(raw) and raw[n].strip() and not raw[n].strip().startswith("*"):
+                line += raw[n].strip()  # a keyword line continued
+                n += 1
+            name, params = _params(line, path, first)
+            if name == "INCLUDE":
+                target = params.get("INPUT")
+                if not target:
+                    raise DeckError(f"{path}:{first}: *INCLUDE needs INPUT=file")
+                card = None
+                _read((path.parent / target.strip('"')) if not Path(target).is_absolute() else Path(target),
+                      cards, stack)
+                continue
+            card = Card(name, params, path, first, line)
+            cards.append(card)
+        else:
+            if card is None:
+                raise DeckError(f"{path}:{n}: a data line before any keyword (a missing *NODE or *ELEMENT line?)")
+            card.data.append(line)
+            card.lines.append((path, n))
+    stack.pop()
+
+
+def numbers(card: Card, width: int | None = None, what: str = "entries") -> np.ndarray:
+    """All data lines of ``card`` as one float array of rows of ``width`` numbers (lines ending with a comma
+    continue on the next one, as element lines of 20-node bricks do); a malformed line is named."""
+    text = ",".join(card.data)
+    flat = text.replace(" ", "").replace("\t", "").split(",")
+    flat = [f for f in flat if f != ""]
+    try:
+        values = np.array(flat, dtype=float)
+    except ValueError:
+        for k, line in enumerate(card.data):
+            for f in line.split(","):
+                f = f.strip()
+                if f:
+                    try:
+                        float(f)
+                    except ValueError:
+                        raise card.fail(f"{what}: {f!r} is not a number", k) from None
+        raise card.fail(f"{what}: not numbers") from None
+    if width is None:
+        return values
+    if values.size % width:
+        _count_fail(card, width, what)
+    return values.reshape(-1, width)
+
+
+def _count_fail(card: Card, width: int, what: str) -> None:
+    """The first data line (or joined continuation) whose field count breaks rows of ``width``."""
+    count = 0
+    for k, line in enumerate(card.data):
+        fields = [f for f in line.split(",") if f.strip()]
+        count += len(fields)
+        if not line.rstrip().endswith(",") and count % width:
+            raise card.fail(f"{what}: {count % width} fields where {width} are needed per entry (a missing node, "
+                            f"or a continuation line without the trailing comma?)", k)
+    raise card.fail(f"{what}: the fields do not make whole entries of {width}")

@@ -1,0 +1,67 @@
+"""The ``.dat`` table of a deck's run: the *NODE PRINT requests (U: displacements, RF: forces) at the end of each step,
+in CalculiX's layout, with the deck's node labels (docs/input.md, "Abaqus and CalculiX decks")."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..observer import Observer
+
+_BLOCK = {"U": "displacements (vx,vy,vz)", "RF": "forces (fx,fy,fz)"}
+
+
+def fortran_e(x: float) -> str:
+    """x as CalculiX prints a time: 0.dddddddE+xx."""
+    if x == 0.0:
+        return " 0.0000000E+00"
+    e = int(np.floor(np.log10(abs(x)))) + 1
+    m = x / 10.0 ** e
+    if abs(round(m, 7)) >= 1.0:
+        m, e = m / 10.0, e + 1
+    return f"{m:10.7f}".replace("0.", "0.", 1) + f"E{e:+03d}"
+
+
+class DatTable(Observer):
+    """Writes ``path`` (the .dat table) from the labels file of :func:`covcontact.io.deck_import.import_deck`."""
+
+    def __init__(self, labels: Path, path: Path):
+        self.info = json.loads(Path(labels).read_text())
+        self.path = Path(path)
+
+    def started(self, run) -> None:
+        if run.model.is_root:
+            self.path.write_text("")
+
+    def increment_converged(self, run, inc) -> None:
+        if not inc.ends_stage:
+            return
+        stage = inc.state.stage
+        prints = self.info["node_print"][stage] if stage < len(self.info["node_print"]) else []
+        if not prints:
+            return
+        model = run.model
+        sysm = model.system
+        where = {}  # deck node label -> global node
+        for blk in sysm.blocks:
+            labels = self.info["bodies"].get(blk.name, [])
+            where.update(zip(labels, range(blk.offset, blk.offset + len(labels))))
+        R, _, _ = model.evaluate(run.u, inc.lam, run.state, want_K=False)
+        forces = (R + model.external(inc.lam)).reshape(-1, 3)  # internal and contact forces
+        U = run.u.reshape(-1, 3)
+        time = sum(self.info["periods"][:stage]) + self.info["periods"][stage] * inc.lam
+        text = []
+        for nset, variables in prints:
+            labels = [lab for lab in self.info["nsets"][nset] if lab in where]
+            rows = np.array([where[lab] for lab in labels], dtype=np.int64)
+            for var in variables:
+                if var not in _BLOCK:
+                    continue
+                values = U[rows] if var == "U" else forces[rows]
+                text.append(f"\n {_BLOCK[var]} for set {nset} and time {fortran_e(time)}\n\n")
+                text += [f"{lab:10d}" + "".join(f"{v:14.6E}" for v in row) + "\n" for lab, row in zip(labels, values)]
+        if model.is_root:
+            with open(self.path, "a") as fh:
+                fh.write("".join(text))

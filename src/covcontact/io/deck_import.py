@@ -1,0 +1,508 @@
+"""An Abaqus or CalculiX deck as a covcontact problem: ``covcontact import DECK.inp`` and ``covcontact run DECK.inp``
+(docs/input.md, "Abaqus and CalculiX decks").
+
+:func:`import_deck` maps a :class:`covcontact.io.deck_model.DeckModel` onto covcontact's own input: a mesh file
+(``NAME.mesh.K.inp`` for body K: its nodes, elements, sets and surfaces, in the plain Abaqus form covcontact's mesh
+reader takes) and a problem file (``NAME.toml``). Each connected part of the mesh (elements joined through shared
+nodes) is a body; its materials come from the *SOLID SECTIONs over it; the first *STEP is the problem's first
+stage and each further step a stage. The node labels of each body are written beside them (``NAME.nodes.json``) so
+that the ``.dat`` table (:class:`DatTable`) can print the deck's labels.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .deck import DeckError
+from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Load, read_model
+
+_COMP = "xyz"
+
+
+@dataclass
+class Imported:
+    """What :func:`import_deck` wrote, and what the deck has that covcontact does not (with the lines)."""
+
+    problem: Path
+    meshes: list[Path]
+    labels: Path
+    unsupported: list[str] = field(default_factory=list)
+
+
+def _name(text: str) -> str:
+    """A set or condition name covcontact's input takes (letters, digits, '_', '-')."""
+    return re.sub(r"[^A-Za-z0-9_-]", "_", text)
+
+
+def _toml(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
+    raise TypeError(type(value))
+
+
+def _table(header: str, entries: dict) -> str:
+    return f"{header}\n" + "".join(f"{k} = {_toml(v)}\n" for k, v in entries.items() if v is not None) + "\n"
+
+
+class _Bodies:
+    """The connected parts of the deck's mesh."""
+
+    def __init__(self, m: DeckModel):
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        self.m = m
+        self.index = m.node_index()
+        self.el_labels = np.concatenate([b[2] for b in m.blocks]) if m.blocks else np.zeros(0, np.int64)
+        conn = [b[3] for b in m.blocks]
+        for (_, _, labels, c), where in zip(m.blocks, m.block_where):
+            bad = self._lookup(c) < 0
+            if bad.any():
+                e = int(np.flatnonzero(bad.any(axis=1))[0])
+                raise DeckError(f"{where}: *ELEMENT: element {int(labels[e])} refers to node {int(c[bad][0])}, which no "
+                                f"*NODE defines")
+        top = int(self.el_labels.max()) + 1 if self.el_labels.size else 1
+        self.el_index = np.full(top, -1, dtype=np.int64)
+        if np.unique(self.el_labels).size != self.el_labels.size:
+            raise DeckError("an element label is used twice")
+        self.el_index[self.el_labels] = np.arange(self.el_labels.size)
+        rows = np.concatenate([np.repeat(np.arange(len(c)) + off, c.shape[1]) for c, off in
+                               zip(conn, np.cumsum([0] + [len(c) for c in conn])[:-1])]) if conn else np.zeros(0, int)
+        cols = np.concatenate([self.index[c.ravel()] for c in conn]) if conn else np.zeros(0, int)
+        ne, nn = self.el_labels.size, m.node_labels.size
+        g = coo_matrix((np.ones(rows.size), (rows, ne + cols)), shape=(ne + nn, ne + nn))
+        _, comp = connected_components(g, directed=False)
+        el_comp = comp[:ne]
+        kinds = np.unique(el_comp)
+        self.of_element = np.searchsorted(kinds, el_comp)      # body number of each element (deck order)
+        self.n = kinds.size
+        node_body = np.full(nn, -1, dtype=np.int64)
+        node_body[cols] = np.repeat(self.of_element, np.concatenate([np.full(len(c), c.shape[1]) for c in conn]))
+        self.of_node = node_body                                # body of each node (-1: in no element)
+
+    def _lookup(self, labels: np.ndarray) -> np.ndarray:
+        lab = np.asarray(labels, dtype=np.int64)
+        ok = (lab >= 0) & (lab < self.index.size)
+        out = np.full(lab.shape, -1, dtype=np.int64)
+        out[ok] = self.index[lab[ok]]
+        return out
+
+    def nodes_body(self, labels: np.ndarray) -> np.ndarray:
+        idx = self._lookup(labels)
+        out = np.full(idx.shape, -1, dtype=np.int64)
+        out[idx >= 0] = self.of_node[idx[idx >= 0]]
+        return out
+
+    def elements_body(self, labels: np.ndarray) -> np.ndarray:
+        lab = np.asarray(labels, dtype=np.int64)
+        ok = (lab >= 0) & (lab < self.el_index.size)
+        idx = np.full(lab.shape, -1, dtype=np.int64)
+        idx[ok] = self.el_index[lab[ok]]
+        out = np.full(idx.shape, -1, dtype=np.int64)
+        out[idx >= 0] = self.of_element[idx[idx >= 0]]
+        return out
+
+
+def import_deck(deck: str | Path, out: str | Path) -> Imported:
+    """Write the covcontact problem of ``deck`` as ``out`` (a .toml path; the mesh and the labels beside it)."""
+    deck, out = Path(deck), Path(out)
+    m = read_model(deck)
+    return _Writer(m, deck, out).write()
+
+
+class _Writer:
+    def __init__(self, m: DeckModel, deck: Path, out: Path):
+        self.m, self.deck, self.out = m, deck, out
+        self.unsupported = list(m.unsupported)
+        if not m.blocks:
+            raise DeckError(f"{deck}: no solid elements ({', '.join(ELEMENTS)})")
+        self.b = _Bodies(m)
+        self.body_names = self._body_names()
+        self.extra_nsets: dict[str, np.ndarray] = {}
+        self.extra_surfaces: dict[str, list[tuple[np.ndarray, int]]] = {}
+        cell_of = np.concatenate([np.full(len(b[2]), b[1], dtype=object) for b in m.blocks])
+        faces = [(els, face, where, "S") for kind, refs in m.surfaces.values() if kind == "ELEMENT"
+                 for els, face, where in refs]
+        faces += [(ld.elements, ld.dof, ld.where, "P") for st in m.steps for ld in st.loads if ld.kind == "dload"]
+        for els, face, where, letter in faces:  # a face the element does not have: the line that names it
+            idx = self.b.el_index[els[(els >= 0) & (els < self.b.el_index.size)]]
+            if idx.size < els.size or np.any(idx < 0):
+                bad = [int(e) for e in els if e < 0 or e >= self.b.el_index.size or self.b.el_index[e] < 0]
+                raise DeckError(f"{where}: element {bad[0]} is not defined")
+            for cell in set(cell_of[idx]):
+                if not 1 <= face <= NFACES[cell]:
+                    raise DeckError(f"{where}: {letter}{face}: {cell} elements have the faces {letter}1..{letter}"
+                                    f"{NFACES[cell]}")
+
+    # -- bodies -------------------------------------------------------------------------------
+    def _body_names(self) -> list[str]:
+        names = []
+        for k in range(self.b.n):
+            els = set(self.b.el_labels[self.b.of_element == k].tolist())
+            exact = [s for s, _, _ in self.m.sections if set(self.m.elsets.get(s, np.zeros(0)).tolist()) == els]
+            name = _name(exact[0]) if exact else f"PART{k + 1}"
+            names.append(name if name not in names else f"{name}_{k + 1}")
+        return names
+
+    def _material(self, name: str, where: str) -> dict:
+        mat = self.m.materials.get(name)
+        if mat is None:
+            raise DeckError(f"{where}: *SOLID SECTION names the material {name!r}, which no *MATERIAL defines")
+        if "unsupported" in mat:
+            raise DeckError(mat["unsupported"])
+        if "E" not in mat:
+            raise DeckError(f"{mat['where']}: *MATERIAL {name} has no *ELASTIC")
+        out: dict = {"model": "svk", "E": mat["E"], "nu": mat["nu"]}
+        if "plastic" in mat:
+            pts = mat["plastic"]
+            out = {"model": "j2", "E": mat["E"], "nu": mat["nu"]}
+            if len(pts) == 1 or pts[0][1] != 0.0:
+                if pts[0][1] != 0.0:
+                    raise DeckError(f"{mat['where']}: *PLASTIC of {name}: the first plastic strain must be 0")
+                out["yield_stress"] = pts[0][0]
+                out["hardening"] = {"law": "linear", "modulus": 0.0}
+            else:
+                out["hardening"] = {"law": "table", "stress": [p[0] for p in pts], "strain": [p[1] for p in pts]}
+        if "density" in mat:
+            out["density"] = mat["density"]
+        return out
+
+    def _bodies_toml(self) -> str:
+        text = ""
+        for k, name in enumerate(self.body_names):
+            mine = self.b.of_element == k
+            labels = self.b.el_labels[mine]
+            types = {self.m.blocks[j][0] for j in range(len(self.m.blocks))
+                     if np.any(self.b.of_element[self._block_range(j)] == k)}
+            reduced = {ELEMENTS[t][1].get("integration") == "reduced" for t in types}
+            if len(reduced) > 1:
+                self.unsupported.append(f"{self.deck}: body {name} mixes C3D20 and C3D20R elements")
+            secs = [(s, mat, w) for s, mat, w in self.m.sections
+                    if np.intersect1d(self.m.elsets.get(s, np.zeros(0, np.int64)), labels).size]
+            for s, _, w in self.m.sections:
+                if s not in self.m.elsets:
+                    raise DeckError(f"{w}: *SOLID SECTION names the element set {s!r}, which no *ELSET defines")
+            covered = np.zeros(labels.size, dtype=bool)
+            for s, _, _ in secs:
+                covered |= np.isin(labels, self.m.elsets[s])
+            if not covered.all():
+                raise DeckError(f"{self.deck}: element {int(labels[~covered][0])} has no *SOLID SECTION (a material "
+                                f"for its element set)")
+            entries: dict = {"name": name, "mesh": {"file": self.mesh_path.with_suffix(f".{k + 1}.inp").name}}
+            entries["material"] = self._material(secs[0][1], secs[0][2])
+            if len(secs) > 1:
+                entries["materials"] = {_name(s): self._material(mat, w) for s, mat, w in secs[1:]}
+            if True in reduced:
+                entries["options"] = {"integration": "reduced"}
+            text += _table("[[bodies]]", entries)
+        return text
+
+    def _block_range(self, j: int) -> slice:
+        start = sum(len(self.m.blocks[i][2]) for i in range(j))
+        return slice(start, start + len(self.m.blocks[j][2]))
+
+    # -- sets per body --------------------------------------------------------------------------
+    def _node_targets(self, name: str, labels: np.ndarray, where: str) -> list[tuple[int, str]]:
+        """(body, set name) of the nodes ``labels`` (a deck set ``name`` or a single node), per body."""
+        bodies = self.b.nodes_body(labels)
+        if np.all(bodies < 0):  # nodes of no element carry no unknowns (a support of nothing)
+            return []
+        set_name = _name(name) if not name.isdigit() else f"_N{name}"
+        if name.isdigit() or name not in self.m.nsets:
+            self.extra_nsets[set_name] = np.asarray(labels, dtype=np.int64)
+        return [(int(k), set_name) for k in np.unique(bodies[bodies >= 0])]
+
+    def _ref(self, body: int, set_name: str) -> str:
+        return f"{self.body_names[body]}.{set_name}"
+
+    # -- conditions and steps ---------------------------------------------------------------------
+    def _conditions(self) -> tuple[str, str]:
+        """The [[dirichlet]], [[force]], [[pressure]] entries (their first-stage values) and the [[stages]]."""
+        m = self.m
+        if not m.steps:
+            raise DeckError(f"{self.deck}: no *STEP")
+        names: dict[tuple, str] = {}      # key -> condition name
+        first: dict[tuple, object] = {}   # key -> first-stage entry (dict)
+        stages: list[dict] = []
+        active: dict[tuple, float] = {}   # boundary key (body, set, dof) -> value held now
+        loads: dict[tuple, float] = {}    # load key -> value now
+        where: dict[tuple, str] = {}
+        model = {}
+        for b in m.model_boundary:
+            model.update(self._boundary_keys(b, where))
+        for s, step in enumerate(m.steps):
+            targets, release, remove = {}, [], []
+            if step.boundary_new:
+                now: dict[tuple, float] = {}
+            else:
+                now = dict(model) if s == 0 else dict(active)
+            for b in step.boundary:
+                now.update(self._boundary_keys(b, where))
+            for key, v in now.items():
+                if key not in names:
+                    if s > 0:
+                        self.unsupported.append(f"{where[key]}: *BOUNDARY on dofs that were free in the steps before "
+                                                f"(covcontact adds no condition after the first step)")
+                        continue
+                    names[key] = f"bc{len(names) + 1}"
+                    first[key] = {"name": names[key], "set": self._ref(key[0], key[1]), "components": _COMP[key[2]],
+                                  "value": v}
+                elif key not in active:
+                    self.unsupported.append(f"{where[key]}: *BOUNDARY again on dofs released in an earlier step")
+                    continue
+                elif active[key] != v:
+                    targets[names[key]] = v
+            release = [names[key] for key in active if key not in now]
+            active = {k: v for k, v in now.items() if k in names and (s == 0 or k in active)}
+            # loads
+            cur: dict[tuple, float] = dict(loads)
+            for kind in step.loads_new:
+                for key in list(cur):
+                    if key[0] == kind:
+                        cur[key] = 0.0
+            for ld in step.loads:
+                for key in self._load_keys(ld):
+                    cur[key] = ld.value
+            for key, v in cur.items():
+                if key not in names:
+                    names[key] = f"{'f' if key[0] == 'cload' else 'p'}{len(names) + 1}"
+                    first[key] = self._load_entry(key, names[key], v if s == 0 else 0.0)
+                    if s > 0:
+                        targets[names[key]] = self._load_value(key, v)
+                elif s > 0 and loads.get(key) != v:
+                    if v == 0.0:
+                        remove.append(names[key])
+                    else:
+                        targets[names[key]] = self._load_value(key, v)
+            loads = cur
+            if s > 0:
+                st = {"name": f"step{s + 1}", "steps": self._steps(step)}
+                if release:
+                    st["release"] = release
+                if targets:
+                    st["targets"] = targets
+                if remove:
+                    st["remove"] = remove
+                stages.append(st)
+        conds = ""
+        for key, entry in first.items():
+            kind = "dirichlet" if key[0] not in ("cload", "dload") else ("force" if key[0] == "cload" else "pressure")
+            conds += _table(f"[[{kind}]]", entry)
+        text = _table("[steps]", self._steps(m.steps[0]))
+        for st in stages:
+            steps = st.pop("steps")
+            text += _table("[[stages]]", {**st, "steps": steps})
+        return conds, text
+
+    def _boundary_keys(self, b: Boundary, where: dict) -> dict:
+        out = {}
+        for body, set_name in self._node_targets(b.name, b.nodes, b.where):
+            for d in b.dofs:
+                key = (body, set_name, d - 1)
+                where.setdefault(key, b.where)
+                out[key] = 0.0 if b.value is None else b.value
+        return out
+
+    def _load_keys(self, ld: Load):
+        if ld.kind == "cload":
+            targets = self._node_targets(ld.target, ld.nodes, ld.where)
+            if not targets:
+                raise DeckError(f"{ld.where}: *CLOAD on nodes of no element ({ld.target})")
+            for body, set_name in targets:
+                yield ("cload", body, set_name, ld.dof - 1)
+        else:
+            bodies = self.b.elements_body(ld.elements)
+            if np.any(bodies < 0):
+                raise DeckError(f"{ld.where}: element {int(ld.elements[bodies < 0][0])} is not defined")
+            for body in np.unique(bodies):
+                name = f"_P{_name(ld.target)}_{ld.dof}"
+                self.extra_surfaces[name] = [(ld.elements[bodies == body], ld.dof)]
+                yield ("dload", int(body), name, ld.dof)
+
+    def _load_entry(self, key: tuple, name: str, v: float) -> dict:
+        return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v)} | (
+            {"distribution": "per_node"} if key[0] == "cload" else {})
+
+    @staticmethod
+    def _load_value(key: tuple, v: float):
+        if key[0] == "cload":
+            vec = [0.0, 0.0, 0.0]
+            vec[key[3]] = float(v)
+            return vec
+        return float(v)
+
+    @staticmethod
+    def _steps(step) -> dict:
+        a, period, lo, hi = step.increments
+        if step.direct:
+            return {"count": max(1, int(round(period / a)))}
+        out = {"initial": min(1.0, a / period)}
+        if lo is not None and lo > 0:
+            out["min"] = min(out["initial"], lo / period)
+        if hi is not None and hi > 0:
+            out["max"] = min(1.0, hi / period)
+        return out
+
+    # -- contact ------------------------------------------------------------------------------------
+    def _contacts(self) -> str:
+        text = ""
+        for k, (inter, kind, slave, master, where) in enumerate(self.m.pairs):
+            it = self.m.interactions.get(inter)
+            if it is None:
+                raise DeckError(f"{where}: *CONTACT PAIR names the interaction {inter!r}, which no *SURFACE "
+                                f"INTERACTION defines")
+            for s in (slave, master):
+                if s not in self.m.surfaces:
+                    raise DeckError(f"{where}: *CONTACT PAIR names the surface {s!r}, which no *SURFACE defines")
+            mk, mrefs = self.m.surfaces[master]
+            if mk != "ELEMENT":
+                raise DeckError(f"{where}: the master surface {master} must be an element surface (faces)")
+            mb = self._surface_body(master, mrefs, where)
+            sk, sref = self.m.surfaces[slave]
+            sts = kind == "SURFACE TO SURFACE" and sk == "ELEMENT"
+            if sk == "NODE":
+                targets = self._node_targets(slave, sref, where)
+                if len(targets) > 1:
+                    raise DeckError(f"{where}: the slave surface {slave} lies on several parts of the mesh")
+                sb = targets[0][0]
+                sname = targets[0][1]
+            else:
+                sb = self._surface_body(slave, sref, where)
+                sname = _name(slave)
+            entry: dict = {"name": f"pair{k + 1}", "slave": self._ref(sb, sname), "master": self._ref(mb, _name(master))}
+            if sts:
+                entry["type"] = "sts"
+            else:  # a node surface: the law's value per node (unit area, as CalculiX takes it); faces: per area
+                entry["weighting"] = "nodal" if sk == "NODE" else "area"
+            if it.behavior == "tied":
+                entry.update({"law": "tied", "penalty": "auto"})
+            elif it.behavior == "linear":
+                entry["penalty"] = it.values[0]
+            elif it.behavior == "exponential":
+                entry.update({"law": "exponential", "clearance": it.values[0], "pressure": it.values[1]})
+            else:
+                entry.update({"penalty": "auto", "method": "augmented"})
+            if it.friction is not None and it.friction[0] > 0 and it.behavior != "tied":
+                entry["friction"] = it.friction[0]
+                if it.friction[1] is not None and it.friction[1] > 0:
+                    entry["tangential_penalty"] = it.friction[1]
+            text += _table("[[contact]]", entry)
+        return text
+
+    def _surface_body(self, name: str, refs, where: str) -> int:
+        bodies = np.unique(np.concatenate([self.b.elements_body(els) for els, _, _ in refs]))
+        if bodies.size != 1 or bodies[0] < 0:
+            raise DeckError(f"{where}: the surface {name} must lie on one part of the mesh (found {bodies.size})")
+        return int(bodies[0])
+
+    # -- files ---------------------------------------------------------------------------------------
+    def _equations(self) -> str:
+        text = ""
+        for terms, where in self.m.equations:
+            out = []
+            for node, dof, coef in terms:
+                if not 1 <= dof <= 3:
+                    break
+                (body, set_name), = self._node_targets(str(node), np.array([node]), where)
+                out.append([self._ref(body, set_name), _COMP[dof - 1], coef])
+            else:
+                text += _table("[[equation]]", {"terms": out})
+        return text
+
+    def write(self) -> Imported:
+        self.mesh_path = self.out.with_suffix(".mesh.inp")
+        bodies = self._bodies_toml()
+        conds, stages = self._conditions()
+        contacts = self._contacts() + self._equations()
+        head = _table("[problem]", {"name": _name(self.deck.stem)})
+        self.out.parent.mkdir(parents=True, exist_ok=True)
+        self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
+                            + conds + stages)
+        self._write_mesh()
+        labels = self.out.with_suffix(".nodes.json")
+        per_body = {}
+        for k, name in enumerate(self.body_names):
+            per_body[name] = self.m.node_labels[self.b.of_node == k].tolist()
+        prints = [[[nset, list(v)] for nset, v, _ in st.node_print] for st in self.m.steps]
+        wanted = {p[0] for per_step in prints for p in per_step}
+        missing = sorted(wanted - set(self.m.nsets))
+        if missing:
+            raise DeckError(f"{self.deck}: *NODE PRINT names the node set {missing[0]!r}, which no *NSET defines")
+        labels.write_text(json.dumps({"bodies": per_body, "node_print": prints,
+                                      "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
+                                      "periods": [st.increments[1] for st in self.m.steps]}))
+        meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
+        return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)))
+
+    def _write_mesh(self) -> None:
+        """One mesh file per body (its nodes, elements, sets and surfaces): bodies of cell types that do not mix
+        (a hex20 part and a tet10 part) each read on their own."""
+        for k in range(self.b.n):
+            self._write_body_mesh(k, self.mesh_path.with_suffix(f".{k + 1}.inp"))
+
+    def _write_body_mesh(self, k: int, path: Path) -> None:
+        m = self.m
+        meshio_type = {"hex8": "C3D8", "hex20": "C3D20", "tet10": "C3D10", "tet4": "C3D4", "wedge6": "C3D6"}
+        mine = self.b.of_node == k
+        lines = ["*NODE"]
+        lines += [f"{lab}, {x!r}, {y!r}, {z!r}" for lab, (x, y, z) in zip(m.node_labels[mine].tolist(),
+                                                                             m.X[mine].tolist())]
+        for j, (_, cell, labels, conn) in enumerate(m.blocks):
+            sel = self.b.of_element[self._block_range(j)] == k
+            if sel.any():
+                lines.append(f"*ELEMENT, TYPE={meshio_type[cell]}")
+                lines += [", ".join(map(str, row)) for row in np.column_stack([labels[sel], conn[sel]]).tolist()]
+
+        def label_lines(values) -> list[str]:
+            v = np.asarray(values).tolist()
+            return [", ".join(map(str, v[i:i + 16])) for i in range(0, len(v), 16)]
+
+        def own_elements(labels):
+            return labels[self.b.elements_body(labels) == k]
+
+        def own_nodes(labels):
+            return labels[self.b.nodes_body(labels) == k]
+
+        for name, labels in m.elsets.items():
+            labels = own_elements(labels)  # (GENERATE ranges may name labels no element has)
+            if labels.size:
+                lines.append(f"*ELSET, ELSET={_name(name)}")
+                lines += label_lines(labels)
+        node_sets = {**{_name(n): v for n, v in m.nsets.items()}, **self.extra_nsets}
+        node_sets.update({_name(n): v for n, (kind, v) in m.surfaces.items() if kind == "NODE" and _name(n) not in
+                          node_sets})
+        for name, labels in node_sets.items():
+            labels = own_nodes(labels)  # (nodes of no element carry no unknowns)
+            if labels.size:
+                lines.append(f"*NSET, NSET={name}")
+                lines += label_lines(labels)
+        surfaces = {_name(n): [(els, face) for els, face, _ in refs] for n, (kind, refs) in m.surfaces.items()
+                    if kind == "ELEMENT"}
+        surfaces.update(self.extra_surfaces)
+        for name, refs in surfaces.items():
+            rows = []
+            for j, (els, face) in enumerate(refs):
+                els = own_elements(els)
+                if els.size:
+                    lines.append(f"*ELSET, ELSET=__{name}_{j + 1}")
+                    lines += label_lines(els)
+                    rows.append(f"__{name}_{j + 1}, S{face}")
+            if rows:
+                lines.append(f"*SURFACE, NAME={name}, TYPE=ELEMENT")
+                lines += rows
+        path.write_text("\n".join(lines) + "\n")

@@ -1,0 +1,484 @@
+"""The model an Abaqus or CalculiX deck describes: nodes, elements, sets, surfaces, materials, sections, contact,
+multi-point constraints and steps (docs/input.md, "Abaqus and CalculiX decks").
+
+:func:`read_model` turns the cards of :func:`covcontact.io.deck.read_deck` into a :class:`DeckModel` in the deck's
+own terms (node and element labels, set names upper-case, dofs 1..3). What covcontact does not have is collected in
+``DeckModel.unsupported`` (file, line and what), so that a run can list all of it before solving; malformed input is
+a :class:`covcontact.io.deck.DeckError` naming the line.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .deck import Card, DeckError, numbers, read_deck
+
+#: Abaqus / CalculiX element type -> (covcontact cell type, options); C3D8R is the full-integration hex8 (there is
+#: no hourglass-controlled hex8), C3D20R the reduced hex20
+ELEMENTS = {"C3D8": ("hex8", {}), "C3D8R": ("hex8", {}), "C3D20": ("hex20", {}),
+            "C3D20R": ("hex20", {"integration": "reduced"}), "C3D10": ("tet10", {}), "C3D4": ("tet4", {}),
+            "C3D6": ("wedge6", {})}
+#: nodes per cell (the deck's node order is covcontact's, VTK's, for every one of these cells)
+NNODE = {"hex8": 8, "hex20": 20, "tet10": 10, "tet4": 4, "wedge6": 6}
+#: faces per cell (S1..Sn, P1..Pn)
+NFACES = {"hex8": 6, "hex20": 6, "tet10": 4, "tet4": 4, "wedge6": 5}
+
+#: the keywords read (everything else is unsupported); output requests are read for the .dat table
+SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL", "ELASTIC", "PLASTIC", "DENSITY",
+             "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "END STEP", "CONTACT PAIR",
+             "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
+             "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
+             "CONTACT OUTPUT", "OUTPUT", "RESTART")
+#: output requests: accepted, only *NODE PRINT's U and RF are tabulated
+_OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
+           "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
+#: parameters that do not change what covcontact computes (solver, output and bookkeeping choices)
+_HARMLESS = {"NSET", "ELSET", "NAME", "GENERATE", "TYPE", "INPUT", "FREQUENCY", "GLOBAL", "TOTALS", "OUTPUT",
+             "SOLVER", "INC", "NLGEOM", "OP", "INTERACTION", "MATERIAL", "PRESSURE-OVERCLOSURE", "UNSYMM", "READ",
+             "WRITE", "TIME POINTS", "CONTACT ELEMENTS", "LAST ITERATIONS", "SECTION FORCES", "POSITION",
+             "DIRECT", "PERTURBATION", "MODE"}
+
+
+@dataclass
+class Boundary:
+    """A *BOUNDARY entry: node labels, dofs (1..3) and value (None: fixed at zero)."""
+
+    nodes: np.ndarray
+    dofs: tuple[int, ...]
+    value: float | None
+    where: str
+    name: str            # the set name or node label as written
+
+
+@dataclass
+class Load:
+    """*CLOAD (node labels, dof, magnitude per node) or *DLOAD (element faces, pressure)."""
+
+    kind: str            # "cload" | "dload"
+    target: str          # set name or label as written
+    dof: int             # CLOAD: 1..3; DLOAD: face number 1..6
+    value: float
+    where: str
+    nodes: np.ndarray | None = None
+    elements: np.ndarray | None = None
+
+
+@dataclass
+class Step:
+    """One *STEP ... *END STEP."""
+
+    where: str
+    nlgeom: bool
+    increments: tuple[float, float, float | None, float | None]   # initial, period, min, max
+    direct: bool
+    boundary: list[Boundary] = field(default_factory=list)
+    boundary_new: bool = False
+    loads: list[Load] = field(default_factory=list)
+    loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
+    node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
+
+
+@dataclass
+class Interaction:
+    name: str
+    behavior: str = "hard"                         # hard | linear | exponential
+    values: tuple[float, ...] = ()
+    friction: tuple[float, float | None] | None = None   # (mu, stick slope)
+    where: str = ""
+
+
+@dataclass
+class DeckModel:
+    """A deck's model in its own terms (labels, upper-case names)."""
+
+    heading: str = ""
+    node_labels: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    X: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    #: element blocks: (deck type, covcontact cell type, labels (n,), connectivity as node labels (n, nen))
+    blocks: list[tuple[str, str, np.ndarray, np.ndarray]] = field(default_factory=list)
+    #: where each block's *ELEMENT line is
+    block_where: list[str] = field(default_factory=list)
+    nsets: dict[str, np.ndarray] = field(default_factory=dict)
+    elsets: dict[str, np.ndarray] = field(default_factory=dict)
+    #: name -> ("ELEMENT", [(element labels, face 1..6)]) or ("NODE", node labels)
+    surfaces: dict[str, tuple[str, object]] = field(default_factory=dict)
+    materials: dict[str, dict] = field(default_factory=dict)
+    sections: list[tuple[str, str, str]] = field(default_factory=list)   # (elset, material, where)
+    interactions: dict[str, Interaction] = field(default_factory=dict)
+    pairs: list[tuple[str, str, str, str, str]] = field(default_factory=list)  # (interaction, type, slave, master, where)
+    equations: list[tuple[list[tuple[int, int, float]], str]] = field(default_factory=list)
+    model_boundary: list[Boundary] = field(default_factory=list)
+    steps: list[Step] = field(default_factory=list)
+    unsupported: list[str] = field(default_factory=list)
+
+    def node_index(self) -> np.ndarray:
+        """label -> row of X (-1: no such node)."""
+        top = int(self.node_labels.max()) + 1 if self.node_labels.size else 1
+        idx = np.full(top, -1, dtype=np.int64)
+        idx[self.node_labels] = np.arange(self.node_labels.size)
+        return idx
+
+
+def read_model(path) -> DeckModel:
+    """The model of the deck at ``path`` (a DeckError for malformed input)."""
+    return _Reader(read_deck(path)).m
+
+
+class _Reader:
+    def __init__(self, cards: list[Card]):
+        self.m = m = DeckModel()
+        self.material: str | None = None
+        self.interaction: str | None = None
+        self.step: Step | None = None
+        nodes, coords = [], []
+        k = 0
+        while k < len(cards):
+            c = cards[k]
+            k += 1
+            if c.name not in SUPPORTED:
+                m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
+                continue
+            self._check_params(c)
+            if c.name == "HEADING":
+                m.heading = " ".join(c.data)[:200]
+            elif c.name == "NODE":
+                lab, xyz = self._nodes(c)
+                nodes.append(lab)
+                coords.append(xyz)
+                if "NSET" in c.params:
+                    self._add(m.nsets, c.params["NSET"], lab)
+            elif c.name == "ELEMENT":
+                self._elements(c)
+            elif c.name in ("NSET", "ELSET"):
+                self._set(c)
+            elif c.name == "SURFACE":
+                self._surface(c)
+            elif c.name == "MATERIAL":
+                self.material = c.param("NAME", required=True).upper()
+                m.materials[self.material] = {"where": c.where()}
+            elif c.name in ("ELASTIC", "PLASTIC", "DENSITY"):
+                self._material(c)
+            elif c.name == "SOLID SECTION":
+                m.sections.append((c.param("ELSET", required=True).upper(), c.param("MATERIAL", required=True).upper(),
+                                   c.where()))
+            elif c.name == "SURFACE INTERACTION":
+                self.interaction = c.param("NAME", required=True).upper()
+                m.interactions[self.interaction] = Interaction(self.interaction, where=c.where())
+            elif c.name in ("SURFACE BEHAVIOR", "FRICTION"):
+                self._interaction(c)
+            elif c.name == "CONTACT PAIR":
+                kind = " ".join(c.param("TYPE", "NODE TO SURFACE").upper().split())
+                if kind not in ("NODE TO SURFACE", "SURFACE TO SURFACE"):
+                    m.unsupported.append(f"{c.where()}: *CONTACT PAIR, TYPE={kind} is not supported")
+                    continue
+                for j, row in enumerate(c.rows()):
+                    if len(row) < 2:
+                        raise c.fail("a contact pair needs 'slave surface, master surface'", j)
+                    m.pairs.append((c.param("INTERACTION", required=True).upper(), kind, row[0].upper(),
+                                    row[1].upper(), c.where(j)))
+            elif c.name == "EQUATION":
+                self._equation(c)
+            elif c.name == "STEP":
+                if self.step is not None:
+                    raise c.fail("a *STEP inside a step (a missing *END STEP?)")
+                inc = c.param("INC")
+                if inc is not None and not inc.strip().isdigit():
+                    raise c.fail(f"INC must be a whole number, got {inc!r}")
+                self.step = Step(c.where(), "NLGEOM" in c.params and c.params["NLGEOM"].upper() != "NO",
+                                 (1.0, 1.0, None, None), False)
+            elif c.name == "STATIC":
+                st = self._in_step(c)
+                row = c.rows()[0] if c.data else []
+                vals = [c.number(0, j, row, w, d) for j, (w, d) in
+                        enumerate((("the initial increment", 1.0), ("the step's period", 1.0)))]
+                lo = c.number(0, 2, row, "the smallest increment", 0.0) if len(row) > 2 and row[2] else None
+                hi = c.number(0, 3, row, "the largest increment", 0.0) if len(row) > 3 and row[3] else None
+                if vals[0] <= 0 or vals[1] <= 0:
+                    raise c.fail("the initial increment and the period must be > 0", 0)
+                st.increments = (vals[0], vals[1], lo, hi)
+                st.direct = "DIRECT" in c.params
+            elif c.name == "END STEP":
+                if self.step is None:
+                    raise c.fail("*END STEP without a *STEP")
+                m.steps.append(self.step)
+                self.step = None
+            elif c.name == "BOUNDARY":
+                self._boundary(c)
+            elif c.name in ("CLOAD", "DLOAD"):
+                self._load(c)
+            elif c.name == "NODE PRINT":
+                st = self._in_step(c)
+                variables = tuple(v.upper() for row in c.rows() for v in row)
+                st.node_print.append((c.param("NSET", required=True).upper(), variables, c.where()))
+        if self.step is not None:
+            raise DeckError(f"{self.step.where}: *STEP without its *END STEP")
+        self._nodes_ready(nodes, coords)
+
+    # -- helpers ---------------------------------------------------------------------------------
+    def _check_params(self, c: Card) -> None:
+        for p in c.params:
+            if p in _HARMLESS:
+                continue
+            self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
+                                      f"supported")
+
+    def _in_step(self, c: Card) -> Step:
+        if self.step is None:
+            raise c.fail("belongs inside a *STEP")
+        return self.step
+
+    def _nodes_ready(self, nodes, coords) -> None:
+        if nodes and (len(nodes) > 1 or self.m.node_labels.size == 0):
+            lab = np.concatenate([self.m.node_labels, *nodes])
+            xyz = np.concatenate([self.m.X, *coords])
+            nodes.clear()
+            coords.clear()
+            order = np.argsort(lab, kind="stable")
+            lab, xyz = lab[order], xyz[order]
+            if lab.size > 1 and np.any(lab[1:] == lab[:-1]):
+                dup = int(lab[1:][lab[1:] == lab[:-1]][0])
+                raise DeckError(f"node {dup} is defined twice")
+            self.m.node_labels, self.m.X = lab, xyz
+        elif nodes:
+            nodes.clear()
+            coords.clear()
+
+    @staticmethod
+    def _add(sets: dict, name: str, labels: np.ndarray) -> None:
+        name = name.upper()
+        sets[name] = np.unique(np.concatenate([sets[name], labels])) if name in sets else np.unique(labels)
+
+    def _nodes(self, c: Card) -> tuple[np.ndarray, np.ndarray]:
+        widths = {len([f for f in line.split(",") if f.strip()]) for line in c.data}
+        if widths == {4}:
+            a = numbers(c, 4, "a node (label, x, y, z)")
+        else:
+            a = np.zeros((len(c.data), 4))
+            for k, row in enumerate(c.rows()):
+                if not 2 <= len(row) <= 4:
+                    raise c.fail(f"a node line is 'label, x, y, z', got {len(row)} fields", k)
+                for j in range(len(row)):
+                    a[k, j] = c.number(k, j, row, ("the node label", "x", "y", "z")[j], 0.0)
+        lab = a[:, 0]
+        if np.any(lab != np.round(lab)) or np.any(lab <= 0):
+            k = int(np.flatnonzero((lab != np.round(lab)) | (lab <= 0))[0])
+            raise c.fail(f"node labels are positive whole numbers, got {c.data[k].split(',')[0]!r}", k)
+        return lab.astype(np.int64), a[:, 1:4].copy()
+
+    def _elements(self, c: Card) -> None:
+        etype = c.param("TYPE", required=True).upper()
+        if etype not in ELEMENTS:
+            self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported (covcontact reads "
+                                      f"{', '.join(ELEMENTS)})")
+            return
+        cell = ELEMENTS[etype][0]
+        a = numbers(c, 1 + NNODE[cell], f"a {etype} element (label and {NNODE[cell]} nodes)")
+        if np.any(a != np.round(a)):
+            raise c.fail("element and node labels are whole numbers")
+        a = a.astype(np.int64)
+        self.m.blocks.append((etype, cell, a[:, 0], a[:, 1:]))
+        self.m.block_where.append(c.where())
+        if "ELSET" in c.params:
+            self._add(self.m.elsets, c.params["ELSET"], a[:, 0])
+
+    def _set(self, c: Card) -> None:
+        key = "NSET" if c.name == "NSET" else "ELSET"
+        name = c.param(key, required=True).upper()
+        sets = self.m.nsets if key == "NSET" else self.m.elsets
+        labels: list[np.ndarray] = []
+        rows = c.rows()
+        if "GENERATE" in c.params:
+            for k, row in enumerate(rows):
+                a, b = (int(c.number(k, j, row, w)) for j, w in enumerate(("the first label", "the last label")))
+                s = int(c.number(k, 2, row, "the increment", 1.0))
+                if s <= 0 or b < a:
+                    raise c.fail("GENERATE needs 'first, last, increment' with first <= last and increment > 0", k)
+                labels.append(np.arange(a, b + 1, s, dtype=np.int64))
+        else:
+            for k, row in enumerate(rows):
+                ids = []
+                for f in row:
+                    if not f:
+                        continue
+                    if f.lstrip("-").isdigit():
+                        ids.append(int(f))
+                    elif f.upper() in sets:
+                        labels.append(sets[f.upper()])
+                    else:
+                        raise c.fail(f"{f!r} is neither a label nor a {key} defined above", k)
+                labels.append(np.asarray(ids, dtype=np.int64))
+        self._add(sets, name, np.concatenate(labels) if labels else np.zeros(0, np.int64))
+
+    def _surface(self, c: Card) -> None:
+        name = c.param("NAME", required=True).upper()
+        kind = c.param("TYPE", "ELEMENT").upper()
+        if kind == "NODE":
+            labels = []
+            for k, row in enumerate(c.rows()):
+                ref = row[0].upper() if row else ""
+                if ref.isdigit():
+                    labels.append(np.array([int(ref)]))
+                elif ref in self.m.nsets:
+                    labels.append(self.m.nsets[ref])
+                else:
+                    raise c.fail(f"{row[0] if row else ''!r} is neither a node label nor a *NSET defined above", k)
+            self.m.surfaces[name] = ("NODE", np.unique(np.concatenate(labels)))
+            return
+        if kind != "ELEMENT":
+            self.m.unsupported.append(f"{c.where()}: *SURFACE, TYPE={kind} is not supported")
+            return
+        refs = []
+        for k, row in enumerate(c.rows()):
+            if len(row) < 2 or not row[1].upper().startswith("S") or not row[1][1:].isdigit():
+                raise c.fail("an element surface line is 'element set or label, S1..S6'", k)
+            ref = row[0].upper()
+            if ref.isdigit():
+                els = np.array([int(ref)])
+            elif ref in self.m.elsets:
+                els = self.m.elsets[ref]
+            else:
+                raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
+            refs.append((els, int(row[1][1:]), c.where(k)))
+        self.m.surfaces[name] = ("ELEMENT", refs)
+
+    def _material(self, c: Card) -> None:
+        if self.material is None:
+            raise c.fail("comes before any *MATERIAL")
+        mat = self.m.materials[self.material]
+        rows = c.rows()
+        if not rows:
+            raise c.fail("needs a data line")
+        if c.name == "ELASTIC":
+            if c.param("TYPE", "ISO").upper() != "ISO":
+                mat["unsupported"] = (f"{c.where()}: *ELASTIC, TYPE={c.params['TYPE']} is not supported (only "
+                                      f"isotropic elasticity)")
+                return
+            if len(rows) > 1 or len(rows[0]) > 2:
+                self.m.unsupported.append(f"{c.where()}: *ELASTIC: temperature-dependent elasticity is not supported")
+            mat["E"] = c.number(0, 0, rows[0], "Young's modulus")
+            mat["nu"] = c.number(0, 1, rows[0], "Poisson's ratio")
+        elif c.name == "DENSITY":
+            mat["density"] = c.number(0, 0, rows[0], "the density")
+        else:
+            if c.param("HARDENING", "ISOTROPIC").upper() != "ISOTROPIC":
+                self.m.unsupported.append(f"{c.where()}: *PLASTIC, HARDENING={c.params['HARDENING']} is not supported "
+                                          f"(isotropic hardening only)")
+                return
+            pts = [(c.number(k, 0, r, "the yield stress"), c.number(k, 1, r, "the plastic strain", 0.0))
+                   for k, r in enumerate(rows)]
+            if any(len(r) > 2 for r in rows):
+                self.m.unsupported.append(f"{c.where()}: *PLASTIC: temperature-dependent hardening is not supported")
+            mat["plastic"] = pts
+
+    def _interaction(self, c: Card) -> None:
+        if self.interaction is None:
+            raise c.fail("comes before any *SURFACE INTERACTION")
+        it = self.m.interactions[self.interaction]
+        rows = c.rows()
+        if c.name == "FRICTION":
+            if not rows:
+                raise c.fail("needs 'friction coefficient, stick slope'")
+            it.friction = (c.number(0, 0, rows[0], "the friction coefficient"),
+                           c.number(0, 1, rows[0], "the stick slope") if len(rows[0]) > 1 else None)
+            return
+        law = c.param("PRESSURE-OVERCLOSURE", "HARD").upper()
+        if law not in ("HARD", "LINEAR", "EXPONENTIAL", "TIED"):
+            self.m.unsupported.append(f"{c.where()}: *SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE={law} is not supported "
+                                      f"(HARD, LINEAR, EXPONENTIAL, TIED are)")
+            return
+        it.behavior = law.lower()
+        if law in ("LINEAR", "EXPONENTIAL"):
+            if not rows:
+                raise c.fail(f"PRESSURE-OVERCLOSURE={law} needs its data line")
+            it.values = tuple(c.number(0, j, rows[0], w) for j, w in
+                              enumerate(("the slope" if law == "LINEAR" else "c0",
+                                         "sigma_inf" if law == "LINEAR" else "p0")[: max(1, min(2, len(rows[0])))]))
+
+    def _equation(self, c: Card) -> None:
+        rows = c.rows()
+        k = 0
+        while k < len(rows):
+            n = int(c.number(k, 0, rows[k], "the number of terms"))
+            start = k
+            k += 1
+            terms: list[tuple[int, int, float]] = []
+            while len(terms) < n:
+                if k >= len(rows):
+                    raise c.fail(f"an equation of {n} terms ends after {len(terms)}", start)
+                row = rows[k]
+                if len(row) % 3:
+                    raise c.fail("equation terms are 'node, dof, coefficient' triples", k)
+                for j in range(0, len(row), 3):
+                    node = int(c.number(k, j, row, "the node"))
+                    dof = int(c.number(k, j + 1, row, "the dof"))
+                    if not 1 <= dof <= 3:
+                        self.m.unsupported.append(f"{c.where(k)}: *EQUATION on dof {dof} (only the displacements 1..3)")
+                    terms.append((node, dof, c.number(k, j + 2, row, "the coefficient")))
+                k += 1
+            if len(terms) != n:
+                raise c.fail(f"an equation of {n} terms has {len(terms)}", start)
+            if terms[0][2] == 0.0:
+                raise c.fail("the first coefficient of an equation (its dependent term) must not be zero", start)
+            self.m.equations.append((terms, c.where(start)))
+
+    def _resolve_nodes(self, c: Card, k: int, ref: str) -> np.ndarray:
+        if ref.isdigit():
+            return np.array([int(ref)], dtype=np.int64)
+        if ref.upper() in self.m.nsets:
+            return self.m.nsets[ref.upper()]
+        raise c.fail(f"{ref!r} is neither a node label nor a *NSET defined above", k)
+
+    def _boundary(self, c: Card) -> None:
+        out = []
+        for k, row in enumerate(c.rows()):
+            if len(row) < 2:
+                raise c.fail("a boundary line is 'node or set, first dof[, last dof[, value]]'", k)
+            first = int(c.number(k, 1, row, "the first dof"))
+            last = int(c.number(k, 2, row, "the last dof", first))
+            value = c.number(k, 3, row, "the value") if len(row) > 3 and row[3] else None
+            dofs = tuple(d for d in range(first, last + 1) if 1 <= d <= 3)
+            if any(d > 3 for d in range(first, last + 1)):
+                self.m.unsupported.append(f"{c.where(k)}: *BOUNDARY on dofs above 3 (rotations, temperature)")
+            if dofs:
+                out.append(Boundary(self._resolve_nodes(c, k, row[0]), dofs, value, c.where(k), row[0].upper()))
+        if self.step is None:  # (model data: in force from the first step on, a value reached over it)
+            if c.params.get("OP", "MOD").upper() == "NEW":
+                raise c.fail("OP=NEW belongs inside a *STEP")
+            self.m.model_boundary += out
+        else:
+            self.step.boundary += out
+            self.step.boundary_new |= c.params.get("OP", "MOD").upper() == "NEW"
+
+    def _load(self, c: Card) -> None:
+        st = self._in_step(c)
+        kind = c.name.lower()
+        if c.params.get("OP", "MOD").upper() == "NEW":
+            st.loads_new.add(kind)
+        for k, row in enumerate(c.rows()):
+            if c.name == "CLOAD":
+                if len(row) < 3:
+                    raise c.fail("a *CLOAD line is 'node or set, dof, magnitude'", k)
+                dof = int(c.number(k, 1, row, "the dof"))
+                if not 1 <= dof <= 3:
+                    self.m.unsupported.append(f"{c.where(k)}: *CLOAD on dof {dof} (only forces 1..3)")
+                    continue
+                st.loads.append(Load("cload", row[0].upper(), dof, c.number(k, 2, row, "the magnitude"), c.where(k),
+                                     nodes=self._resolve_nodes(c, k, row[0])))
+            else:
+                if len(row) < 3:
+                    raise c.fail("a *DLOAD line is 'element or set, Pn, magnitude'", k)
+                lab = row[1].upper()
+                if not (lab.startswith("P") and lab[1:].isdigit()):
+                    self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (only face pressures P1..P6)")
+                    continue
+                ref = row[0].upper()
+                if ref.isdigit():
+                    els = np.array([int(ref)], dtype=np.int64)
+                elif ref in self.m.elsets:
+                    els = self.m.elsets[ref]
+                else:
+                    raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
+                st.loads.append(Load("dload", ref, int(lab[1:]), c.number(k, 2, row, "the magnitude"), c.where(k),
+                                     elements=els))

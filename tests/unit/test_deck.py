@@ -1,0 +1,368 @@
+"""Abaqus / CalculiX decks (decks of our own, written here): the card reader (comments, continuations, *INCLUDE,
+GENERATE, case), the mapping of each supported keyword onto covcontact's problem, a deck run against the same model
+written as a problem file, the .dat table, the unsupported-keyword report, one-line errors naming the line, and the
+linear multi-point constraints (*EQUATION / [[equation]]): exact closed form, tangent against differences, chains,
+and their input errors."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from covcontact.io.deck import DeckError, read_deck
+from covcontact.io.deck_import import import_deck
+from covcontact.io.deck_model import read_model
+from covcontact.io.loader import load_problem
+from covcontact.io.validate import InputError
+
+
+def _block_nodes(nx, ny, nz, lx, ly, lz, origin, first_label):
+    """Nodes (labels, xyz) and C3D8 elements (node labels) of a structured brick block."""
+    i, j, k = np.meshgrid(np.arange(nx + 1), np.arange(ny + 1), np.arange(nz + 1), indexing="ij")
+    X = np.column_stack([i.ravel() * lx / nx, j.ravel() * ly / ny, k.ravel() * lz / nz]) + origin
+    lab = first_label + np.arange(len(X))
+    idx = lab.reshape(nx + 1, ny + 1, nz + 1)
+    els = [[idx[a, b, c], idx[a + 1, b, c], idx[a + 1, b + 1, c], idx[a, b + 1, c],
+            idx[a, b, c + 1], idx[a + 1, b, c + 1], idx[a + 1, b + 1, c + 1], idx[a, b + 1, c + 1]]
+           for a in range(nx) for b in range(ny) for c in range(nz)]
+    return lab, X, np.array(els)
+
+
+def _lines(labels, X):
+    return "\n".join(f"{n}, {x:.12g}, {y:.12g}, {z:.12g}" for n, (x, y, z) in zip(labels, X))
+
+
+def _elements(first, els):
+    return "\n".join(", ".join(map(str, [first + e, *row])) for e, row in enumerate(els))
+
+
+def two_block_deck(path: Path, *, extra_step: str = "", pair: str = "NODE TO SURFACE") -> Path:
+    """A base 2 x 2 x 1 (labels from 1) and a punch 1 x 1 x 0.5 on top (labels from 1001), C3D8, SVK-like elastic,
+    linear pressure-overclosure, the punch's top pushed down by 0.02 in two increments."""
+    lb, Xb, eb = _block_nodes(2, 2, 1, 2.0, 2.0, 1.0, [0.0, 0.0, 0.0], 1)
+    lp, Xp, ep = _block_nodes(2, 2, 1, 1.0, 1.0, 0.5, [0.5, 0.5, 1.0], 1001)
+    bottom = lb[np.isclose(Xb[:, 2], 0.0)]
+    top = lp[np.isclose(Xp[:, 2], 1.5)]
+    slave = lp[np.isclose(Xp[:, 2], 1.0)]
+    text = f"""**
+** two blocks (a deck of the tests)
+**
+*Heading
+two blocks
+*NODE, NSET=NALL
+{_lines(lb, Xb)}
+{_lines(lp, Xp)}
+*ELEMENT, TYPE=C3D8, ELSET=BASE
+{_elements(1, eb)}
+*Element, type=c3d8,
+ELSET=PUNCH
+{_elements(101, ep)}
+*NSET, NSET=BOTTOM
+{", ".join(map(str, bottom))}
+*NSET, NSET=TOP
+{", ".join(map(str, top))}
+*NSET, NSET=NSLAVE
+{", ".join(map(str, slave))}
+*ELSET, ELSET=BASETOP, GENERATE
+1, 4, 1
+*SURFACE, NAME=SMAST, TYPE=ELEMENT
+BASETOP, S2
+*SURFACE, NAME=SSLAV, TYPE=NODE
+NSLAVE
+*MATERIAL, NAME=STEEL
+*ELASTIC
+1000.0, 0.3
+*SOLID SECTION, ELSET=BASE, MATERIAL=STEEL
+*SOLID SECTION, ELSET=PUNCH, MATERIAL=STEEL
+*CONTACT PAIR, INTERACTION=SI1, TYPE={pair}
+SSLAV, SMAST
+*SURFACE INTERACTION, NAME=SI1
+*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR
+1.0e6
+*BOUNDARY
+BOTTOM, 1, 3
+*STEP, NLGEOM
+*STATIC
+0.5, 1.0
+*BOUNDARY
+TOP, 1, 2
+TOP, 3, 3, -0.02
+*NODE PRINT, NSET=BOTTOM
+U, RF
+*END STEP
+{extra_step}"""
+    path.write_text(text)
+    return path
+
+
+TWO_BLOCKS_TOML = """
+[problem]
+name = "hand"
+[[bodies]]
+name = "base"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 1.0, nx = 2, ny = 2, nz = 1 }
+[[bodies]]
+name = "punch"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [0.5, 0.5, 1.0] }
+[[contact]]
+slave = "punch.zmin"
+master = "base.zmax"
+penalty = 1.0e6
+[[dirichlet]]
+set = "base.zmin"
+components = "xyz"
+[[dirichlet]]
+set = "punch.zmax"
+components = "xyz"
+value = [0.0, 0.0, -0.02]
+[steps]
+initial = 0.5
+"""
+
+
+def test_cards_comments_continuations_include_and_case(tmp_path):
+    (tmp_path / "nodes.inc").write_text("*node, nset=n\n1, 0, 0, 0\n2, 1., 0., 0.\n")
+    deck = tmp_path / "d.inp"
+    deck.write_text("** a comment\n*HEADING\ntitle\n*INCLUDE, INPUT=nodes.inc\n*Nset, nset=TWO,\ngenerate\n1, 2, 1\n")
+    cards = read_deck(deck)
+    assert [c.name for c in cards] == ["HEADING", "NODE", "NSET"]
+    assert cards[1].params == {"NSET": "n"} and cards[1].file.name == "nodes.inc" and cards[1].lines[1][1] == 3
+    assert cards[2].params == {"NSET": "TWO", "GENERATE": ""}  # a keyword line continued after its comma
+    m = read_model(deck)
+    assert m.node_labels.tolist() == [1, 2] and m.nsets["TWO"].tolist() == [1, 2] and m.nsets["N"].tolist() == [1, 2]
+
+
+def test_malformed_lines_are_named(tmp_path):
+    """Each malformed deck is one line naming the file and line, what is wrong (and an input error: exit 2)."""
+    deck = tmp_path / "bad.inp"
+    base = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n5, 0, 0, 1\n6, 1, 0, 1\n7, 1, 1, 1\n8, 0, 1, 1\n"
+    model = "*MATERIAL, NAME=M\n*ELASTIC\n1, 0.3\n*SOLID SECTION, ELSET=EALL, MATERIAL=M\n"
+    one = "*ELEMENT, TYPE=C3D8, ELSET=EALL\n1, 1, 2, 3, 4, 5, 6, 7, 8\n"
+    cases = {
+        base.replace("3, 1, 1, 0", "3, 1, x1, 0"): "bad.inp:4: *NODE: a node (label, x, y, z): 'x1' is not a number",
+        base + "*ELEMENT, TYPE=C3D8\n1, 1, 2, 3, 4, 5, 6, 7\n": "bad.inp:11: *ELEMENT: a C3D8 element (label and 8 "
+                                                                "nodes): 8 fields where 9 are needed per entry",
+        base + one + "*NSET, NSET=A\nB\n": "bad.inp:13: *NSET: 'B' is neither a label nor a NSET defined above",
+        base + one.replace("7, 8", "7, 9") + model + "*STEP\n*STATIC\n*END STEP\n":
+            "bad.inp:10: *ELEMENT: element 1 refers to node 9, which no *NODE defines",
+        base + one + model + "*SURFACE, NAME=S\nEALL, S7\n*STEP\n*STATIC\n*END STEP\n":
+            "bad.inp:17: S7: hex8 elements have the faces S1..S6",
+        base + one + model + "*STEP\n*STATIC\n*DLOAD\nEALL, P2, x\n*END STEP\n":
+            "bad.inp:19: *DLOAD: the magnitude must be a number, got 'x' (field 3)",
+        base + one + model + "*BOUNDARY\nNOPE, 1, 3\n*STEP\n*STATIC\n*END STEP\n":
+            "bad.inp:17: *BOUNDARY: 'NOPE' is neither a node label nor a *NSET defined above",
+        base + "*BOUNDARY\n1, 1\n*STEP\n*STATIC\n": "bad.inp:12: *STEP without its *END STEP",
+    }
+    for text, words in cases.items():
+        deck.write_text(text)
+        with pytest.raises(DeckError) as err:
+            import_deck(deck, tmp_path / "out.toml")
+        msg = str(err.value)
+        assert words in msg and "\n" not in msg, (words, msg)
+        assert isinstance(err.value, InputError)  # (the command's exit code 2)
+
+
+def test_mapping_of_the_keywords(tmp_path):
+    """Each supported keyword lands where it should: two bodies (connected parts), their material, the contact pair
+    and its law, the conditions (model data and step data), the increments, the node-print request."""
+    imp = import_deck(two_block_deck(tmp_path / "tb.inp"), tmp_path / "tb.toml")
+    assert imp.unsupported == []
+    p = load_problem(imp.problem)
+    assert [b.name for b in p.bodies] == ["BASE", "PUNCH"]  # named by their sections' element sets
+    assert [b.mesh.n_cells for b in p.bodies] == [4, 4] and p.bodies[0].material.E == 1000.0
+    c = p.contacts[0]
+    assert c.slave == ("PUNCH", "SSLAV") and c.master == ("BASE", "SMAST") and c.penalty == 1.0e6
+    assert c.weighting == "nodal"  # a node surface: the law per node
+    assert {(d.body, d.set, d.components) for d in p.dirichlet} >= {("BASE", "BOTTOM", (0,)), ("PUNCH", "TOP", (2,))}
+    assert [d.values for d in p.dirichlet if d.set == "TOP" and d.components == (2,)] == [(-0.02,)]
+    assert p.steps.initial == 0.5
+    assert p.bodies[1].mesh.face_sets == {} or "SMAST" not in p.bodies[1].mesh.face_sets
+    assert p.bodies[0].mesh.face_sets["SMAST"].shape == (4, 4)
+
+
+def test_deck_run_equals_the_problem_file_and_writes_the_dat_table(tmp_path):
+    """The deck and the same model as a problem file (generated meshes) give the same reactions; the .dat table prints
+    the deck's labels with U and RF, and the forces on the support sum to the reaction."""
+    deck = two_block_deck(tmp_path / "tb.inp")
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "out"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    hand = tmp_path / "hand.toml"
+    hand.write_text(TWO_BLOCKS_TOML)
+    ref = load_problem(hand).run(out=tmp_path / "hand", quiet=True)
+    import json
+
+    ours = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert [s["iterations"] for s in ours["steps"]] == [s["iterations"] for s in ref.summary["steps"]]
+    fz = ref.summary["steps"][-1]["reactions"]["base.zmin"][2]
+    got = [v for k, v in ours["steps"][-1]["reactions"].items() if k.startswith("BASE.BOTTOM")]
+    assert sum(v[2] for v in got) == pytest.approx(fz, rel=1e-9)
+    dat = (tmp_path / "out" / "tb.dat").read_text().splitlines()
+    assert dat[1] == " displacements (vx,vy,vz) for set BOTTOM and time  0.1000000E+01"
+    rf_at = dat.index(" forces (fx,fy,fz) for set BOTTOM and time  0.1000000E+01")
+    rows = [ln.split() for ln in dat[rf_at + 2:] if ln.strip()]
+    assert [int(r[0]) for r in rows] == [1, 3, 5, 7, 9, 11, 13, 15, 17]  # the deck's labels of the bottom nodes
+    assert sum(float(r[3]) for r in rows) == pytest.approx(fz, rel=1e-6)
+
+
+def test_steps_become_stages(tmp_path):
+    """A second step with *BOUNDARY, OP=NEW that restates the support and moves the punch on: a stage whose targets
+    hold the new value; a *CLOAD that appears there is declared at zero and given its target."""
+    step2 = ("*STEP\n*STATIC\n0.5, 1.0\n*BOUNDARY, OP=NEW\nBOTTOM, 1, 3\nTOP, 1, 2\nTOP, 3, 3, -0.03\n*CLOAD\n1001, 1, "
+             "0.5\n*END STEP\n")
+    imp = import_deck(two_block_deck(tmp_path / "tb.inp", extra_step=step2), tmp_path / "tb.toml")
+    assert imp.unsupported == []
+    p = load_problem(imp.problem)
+    assert len(p.stages) == 1
+    st = p.stages[0]
+    moved = [d.name for d in p.dirichlet if d.set == "TOP" and d.components == (2,)]
+    assert st.targets[moved[0]] == pytest.approx([-0.03])
+    force = [f for f in p.forces if f.set == "_N1001"][0]
+    assert force.value == (0.0, 0.0, 0.0) and st.targets[force.name] == pytest.approx([0.5, 0.0, 0.0])
+
+
+def test_unsupported_keywords_are_listed_with_their_lines(tmp_path):
+    deck = two_block_deck(tmp_path / "tb.inp")
+    text = deck.read_text().replace("*STEP, NLGEOM", "*ORIENTATION, NAME=OR1\n1, 0, 0, 0, 1, 0\n*STEP, NLGEOM")
+    text = text.replace("*STATIC\n", "*STATIC, SOLVER=SPOOLES\n*DYNAMIC, ALPHA=-0.05\n0.1, 1.0\n")
+    deck.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.splitlines()
+    orient = text.splitlines().index("*ORIENTATION, NAME=OR1") + 1
+    assert f"covcontact: unsupported: {deck}:{orient}: *ORIENTATION is not supported" in lines
+    assert any("*DYNAMIC is not supported" in ln for ln in lines)
+    assert lines[-1].startswith(f"covcontact: error: {deck}: 2 unsupported") and "Traceback" not in proc.stderr
+    out = tmp_path / "imported.toml"
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "import", str(deck), "--out", str(out)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 2 and not out.exists()
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "import", str(deck), "--out", str(out),
+                           "--ignore-unsupported"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0 and out.exists() and "covcontact: ignored:" in proc.stderr
+
+
+# ------------------------------------------------------------------------------------------------ equations
+
+EQUATION = """
+[problem]
+name = "mpc"
+[[bodies]]
+name = "bar"
+element = "hex8"
+material = { model = "svk", E = 100.0, nu = 0.0 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 2.0, nx = 2, ny = 2, nz = 3 }
+[bodies.sets]
+corner = { closest = [0.0, 0.0, 2.0] }
+EQUATIONS
+[[dirichlet]]
+set = "bar.zmin"
+components = "z"
+[[dirichlet]]
+set = "bar.xmin"
+components = "x"
+[[dirichlet]]
+set = "bar.ymin"
+components = "y"
+[[force]]
+set = "bar.corner"
+value = [0.0, 0.0, 12.0]
+[steps]
+count = 2
+"""
+
+
+def _top_nodes():
+    from covcontact.mesh.generators import block
+
+    m = block(1.0, 1.0, 2.0, 2, 2, 3, "hex8")
+    top = np.flatnonzero(np.isclose(m.points[:, 2], 2.0))
+    corner = int(np.flatnonzero(np.all(np.isclose(m.points, [0.0, 0.0, 2.0]), axis=1))[0])
+    return m, top, corner
+
+
+def _equation_problem(tmp_path: Path, chain: bool = False) -> Path:
+    """Every top node's u_z equal to the corner's (a rigid, free-to-stretch top), the force on the corner alone; with
+    ``chain`` each node is tied to the one before it instead (eliminated dofs among other equations' terms)."""
+    m, top, corner = _top_nodes()
+    others = [int(n) for n in top if n != corner]
+    sets = "".join(f"n{n} = {{ nodes = [{n}] }}\n" for n in [corner, *others])
+    eqs = []
+    for k, n in enumerate(others):
+        ref = corner if not chain or k == 0 else others[k - 1]
+        eqs.append(f'[[equation]]\nterms = [["bar.n{n}", "z", 2.0], ["bar.n{ref}", "z", -2.0]]\n')
+    text = EQUATION.replace("corner = { closest = [0.0, 0.0, 2.0] }\n", "corner = { closest = [0.0, 0.0, 2.0] }\n"
+                            + sets).replace("EQUATIONS", "".join(eqs[::-1] if chain else eqs))
+    path = tmp_path / "mpc.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("chain", [False, True], ids=["star", "chain"])
+def test_equations_make_a_flat_top_exactly(tmp_path, chain):
+    """A bar (nu = 0) pulled by a force on one corner of its top, the top's u_z tied to that corner's: a homogeneous
+    stretch, St. Venant-Kirchhoff's uniaxial closed form F / A = E lambda (lambda^2 - 1) / 2 to 1e-8, the support's
+    reaction F, every top node at the same height."""
+    res = load_problem(_equation_problem(tmp_path, chain)).run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0
+    _, top, _ = _top_nodes()
+    uz = res.u.reshape(-1, 3)[top, 2]
+    np.testing.assert_allclose(uz, uz[0], rtol=1e-12)
+    lam = np.roots([50.0, 0.0, -50.0, -12.0])  # E/2 (l^3 - l) = F / A, E = 100, F = 12, A = 1
+    lam = float(lam[np.isreal(lam) & (lam.real > 1)].real[0])
+    assert uz[0] == pytest.approx(2.0 * (lam - 1.0), rel=1e-8)  # (Newton tolerance)
+    assert res.summary["steps"][-1]["reactions"]["bar.zmin"][2] == pytest.approx(-12.0, rel=1e-8)
+
+
+def test_equation_tangent_matches_differences(tmp_path):
+    """The reduced tangent T^T K T against central differences of the reduced residual T^T R in the independent dofs
+    (the dependent ones follow), at a deformed state."""
+    from covcontact.solvers.model import Model
+
+    model = Model(load_problem(_equation_problem(tmp_path, chain=True)))
+    committed = model.initial_state()
+    rng = np.random.default_rng(0)
+    u = 0.02 * rng.standard_normal(model.n_dofs)
+    R, K, _ = model.evaluate(u, 0.5, committed)
+    K = K.toarray()
+    dep = model.constraints.mask
+    h = 1e-6
+    for j in rng.choice(np.flatnonzero(~dep), 15, replace=False):
+        up, um = u.copy(), u.copy()
+        up[j] += h
+        um[j] -= h
+        col = (model.evaluate(up, 0.5, committed, want_K=False)[0] - model.evaluate(um, 0.5, committed,
+                                                                                   want_K=False)[0]) / (2 * h)
+        assert np.abs(col - K[:, j]).max() <= 1e-6 * np.abs(K).max()
+    assert np.all(R[dep] == 0.0) and np.allclose(K[np.ix_(dep, ~dep)], 0.0)
+
+
+def test_equation_input_errors(tmp_path):
+    path = _equation_problem(tmp_path)
+    text = path.read_text()
+    _, top, corner = _top_nodes()
+    n = int([t for t in top if t != corner][0])
+    cases = {
+        text + f'[[equation]]\nterms = [["bar.n{n}", "z", 1.0], ["bar.n{corner}", "x", 1.0]]\n':
+            "is the eliminated (first) term of equation[0] already",
+        text + f'[[equation]]\nterms = [["bar.n{corner}", "z", 1.0], ["bar.n{n}", "z", 1.0]]\n':
+            "eliminate each other's dofs in a cycle",
+        text + '[[equation]]\nterms = [["bar.zmax", "z", 1.0]]\n': "holds 9 nodes; each term names a set of one node",
+        text + f'[[equation]]\nterms = [["bar.n{corner}", "w", 1.0]]\n': "must be [\"body.set\"",
+        text.replace('[[dirichlet]]\nset = "bar.zmin"', f'[[dirichlet]]\nset = "bar.n{n}"'):
+            "is the eliminated (first) term of equation",
+    }
+    for bad, words in cases.items():
+        path.write_text(bad)
+        with pytest.raises(InputError) as err:
+            load_problem(path)
+        assert words in str(err.value) and "\n" not in str(err.value), (words, str(err.value))
