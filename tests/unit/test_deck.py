@@ -134,7 +134,7 @@ def test_cards_comments_continuations_include_and_case(tmp_path):
     deck.write_text("** a comment\n*HEADING\ntitle\n*INCLUDE, INPUT=nodes.inc\n*Nset, nset=TWO,\ngenerate\n1, 2, 1\n")
     cards = read_deck(deck)
     assert [c.name for c in cards] == ["HEADING", "NODE", "NSET"]
-    assert cards[1].params == {"NSET": "n"} and cards[1].file.name == "nodes.inc" and cards[1].lines[1][1] == 3
+    assert cards[1].params == {"NSET": "n"} and cards[1].file.name == "nodes.inc" and cards[1].lines[1] == 3
     assert cards[2].params == {"NSET": "TWO", "GENERATE": ""}  # a keyword line continued after its comma
     m = read_model(deck)
     assert m.node_labels.tolist() == [1, 2] and m.nsets["TWO"].tolist() == [1, 2] and m.nsets["N"].tolist() == [1, 2]
@@ -147,7 +147,7 @@ def test_malformed_lines_are_named(tmp_path):
     model = "*MATERIAL, NAME=M\n*ELASTIC\n1, 0.3\n*SOLID SECTION, ELSET=EALL, MATERIAL=M\n"
     one = "*ELEMENT, TYPE=C3D8, ELSET=EALL\n1, 1, 2, 3, 4, 5, 6, 7, 8\n"
     cases = {
-        base.replace("3, 1, 1, 0", "3, 1, x1, 0"): "bad.inp:4: *NODE: a node (label, x, y, z): 'x1' is not a number",
+        base.replace("3, 1, 1, 0", "3, 1, x1, 0"): "bad.inp:4: *NODE: y must be a number, got 'x1' (field 3)",
         base + "*ELEMENT, TYPE=C3D8\n1, 1, 2, 3, 4, 5, 6, 7\n": "bad.inp:11: *ELEMENT: a C3D8 element (label and 8 "
                                                                 "nodes): 8 fields where 9 are needed per entry",
         base + one + "*NSET, NSET=A\nB\n": "bad.inp:13: *NSET: 'B' is neither a label nor a NSET defined above",
@@ -186,6 +186,51 @@ def test_mapping_of_the_keywords(tmp_path):
     assert p.steps.initial == 0.5
     assert p.bodies[1].mesh.face_sets == {} or "SMAST" not in p.bodies[1].mesh.face_sets
     assert p.bodies[0].mesh.face_sets["SMAST"].shape == (4, 4)
+
+
+def test_mapping_of_laws_materials_and_loads(tmp_path):
+    """The pressure-overclosure laws, friction, *PLASTIC (the table law), *DENSITY, a *DLOAD face pressure and an element
+    slave surface for surface-to-surface contact."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    variants = {
+        "exponential": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n0.001, 50.0"),
+        "hard": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=HARD"),
+        "tied": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TIED"),
+        "friction": ("1.0e6\n", "1.0e6\n*FRICTION\n0.2, 5.0e5\n"),
+        "plastic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC\n5.0, 0.0\n6.0, 0.1\n*DENSITY\n2.0\n"),
+        "sts-dload": ("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE", "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
+                      "*SURFACE, NAME=SSLAV\nPBOT, S1"),
+    }
+    for name, (old, new) in variants.items():
+        assert old in text, name
+        body = text.replace(old, new)
+        if name == "sts-dload":
+            body = body.replace("NODE TO SURFACE", "SURFACE TO SURFACE").replace(
+                "*NODE PRINT", "*DLOAD\nPUNCH, P2, 0.5\n*NODE PRINT")
+        deck = tmp_path / f"{name}.inp"
+        deck.write_text(body)
+        imp = import_deck(deck, tmp_path / name / "p.toml")
+        assert imp.unsupported == [], (name, imp.unsupported)
+        p = load_problem(imp.problem)
+        c = p.contacts[0]
+        if name == "exponential":
+            assert (c.law, c.clearance, c.pressure) == ("exponential", 0.001, 50.0)
+        elif name == "hard":  # node slaves: augmented Lagrange, 10 E h of the base (E = 1000, h = 1)
+            assert c.method == "augmented" and c.penalty == pytest.approx(1.0e4)
+        elif name == "tied":
+            assert c.law == "tied"
+        elif name == "friction":
+            assert c.friction == 0.2 and c.tangential_penalty == 5.0e5
+        elif name == "plastic":
+            mat = p.bodies[0].material
+            assert mat.kind == 2 and mat.density == 2.0
+            assert tuple(mat.hardening.stress) == (5.0, 6.0) and tuple(mat.hardening.strain) == (0.0, 0.1)
+        else:
+            assert c.slave == ("PUNCH", "SSLAV") and c.type == "sts" and c.weighting == "area"
+            assert p.bodies[1].mesh.face_sets["SSLAV"].shape == (4, 4)
+            (pr,) = p.pressures
+            assert pr.value == 0.5 and p.bodies[1].mesh.face_sets[pr.set].shape == (4, 4)  # the punch's top faces
+            assert np.allclose(p.bodies[1].mesh.points[np.unique(p.bodies[1].mesh.face_sets[pr.set]), 2], 1.5)
 
 
 def test_deck_run_equals_the_problem_file_and_writes_the_dat_table(tmp_path):

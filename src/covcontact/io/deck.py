@@ -30,7 +30,7 @@ class Card:
         name: the keyword, upper-case, single spaces ("SOLID SECTION").
         params: parameter name -> value (upper-case names; a flag without ``=`` maps to "").
         data: the data lines (stripped text).
-        lines: (file, line number) of each data line.
+        lines: the line number of each data line (in ``file``: a card's data never spans an *INCLUDE).
         file, line: where the keyword line is.
         text: the keyword line as written.
     """
@@ -41,12 +41,11 @@ class Card:
     line: int
     text: str
     data: list[str] = field(default_factory=list)
-    lines: list[tuple[Path, int]] = field(default_factory=list)
+    lines: list[int] = field(default_factory=list)
 
     def where(self, k: int | None = None) -> str:
         """"file:line" of the keyword line, or of data line ``k``."""
-        f, n = (self.file, self.line) if k is None else self.lines[k]
-        return f"{f}:{n}"
+        return f"{self.file}:{self.line if k is None else int(self.lines[k])}"
 
     def fail(self, problem: str, k: int | None = None) -> DeckError:
         return DeckError(f"{self.where(k)}: *{self.name}: {problem}")
@@ -117,40 +116,70 @@ def _read(path: Path, cards: list[Card], stack: list[Path]) -> None:
     except OSError as exc:
         raise DeckError(f"{path}: cannot read ({exc})") from None
     raw = text.splitlines()
+    # keyword and comment lines (a '*' first, after blanks); the data lines between them are taken in bulk
+    marks = [i for i, ln in enumerate(raw) if ln[:1] == "*" or (ln[:1] in (" ", "\t") and ln.lstrip()[:1] == "*")]
+    marks.append(len(raw))
     card: Card | None = None
-    n = 0
-    while n < len(raw):
-        line = raw[n].strip()
-        n += 1
-        if not line or line.startswith("**"):
+    _data(card, raw, 0, marks[0], path)
+    k = 0
+    while k < len(marks) - 1:
+        i = marks[k]
+        line = raw[i].strip()
+        end = marks[k + 1]
+        k += 1
+        if line.startswith("**"):
+            _data(card, raw, i + 1, end, path)
             continue
-        if line.startswith("*"):
-            first = n
-            while line.endswith(",") and n < len(raw) and raw[n].strip() and not raw[n].strip().startswith("*"):
-                line += raw[n].strip()  # a keyword line continued
-                n += 1
-            name, params = _params(line, path, first)
-            if name == "INCLUDE":
-                target = params.get("INPUT")
-                if not target:
-                    raise DeckError(f"{path}:{first}: *INCLUDE needs INPUT=file")
-                card = None
-                _read((path.parent / target.strip('"')) if not Path(target).is_absolute() else Path(target),
-                      cards, stack)
-                continue
-            card = Card(name, params, path, first, line)
-            cards.append(card)
-        else:
-            if card is None:
-                raise DeckError(f"{path}:{n}: a data line before any keyword (a missing *NODE or *ELEMENT line?)")
-            card.data.append(line)
-            card.lines.append((path, n))
+        first = i + 1
+        j = i + 1
+        while line.endswith(",") and j < end and raw[j].strip():
+            line += raw[j].strip()  # a keyword line continued
+            j += 1
+        name, params = _params(line, path, first)
+        if name == "INCLUDE":
+            target = params.get("INPUT")
+            if not target:
+                raise DeckError(f"{path}:{first}: *INCLUDE needs INPUT=file")
+            target = target.strip('"')
+            _read((path.parent / target) if not Path(target).is_absolute() else Path(target), cards, stack)
+            card = None
+            _data(card, raw, j, end, path)
+            continue
+        card = Card(name, params, path, first, line)
+        cards.append(card)
+        _data(card, raw, j, end, path)
     stack.pop()
 
 
-def numbers(card: Card, width: int | None = None, what: str = "entries") -> np.ndarray:
+def _data(card: Card | None, raw: list[str], a: int, b: int, path: Path) -> None:
+    """Lines a .. b - 1 of ``raw`` (0-based) as data lines of ``card`` (blank lines skipped)."""
+    if b <= a:
+        return
+    chunk = [ln.strip() for ln in raw[a:b]]
+    if all(chunk):
+        numbers_ = range(a + 1, b + 1)
+    else:
+        numbers_ = [a + 1 + t for t, ln in enumerate(chunk) if ln]
+        chunk = [ln for ln in chunk if ln]
+        if not chunk:
+            return
+    if card is None:
+        raise DeckError(f"{path}:{numbers_[0]}: a data line before any keyword (a missing *NODE or *ELEMENT line?)")
+    card.data += chunk
+    card.lines += numbers_
+
+
+def numbers(card: Card, width: int | None = None, what: str = "entries", integer: bool = False) -> np.ndarray:
     """All data lines of ``card`` as one float array of rows of ``width`` numbers (lines ending with a comma
-    continue on the next one, as element lines of 20-node bricks do); a malformed line is named."""
+    continue on the next one, as element lines of 20-node bricks do); a malformed line is named. ``integer``: try
+    whole numbers first (int64, else float)."""
+    if width is not None and card.data and not any(ln.endswith(",") for ln in card.data):
+        try:  # one entry per line: numpy's text reader
+            values = np.loadtxt(card.data, delimiter=",", ndmin=2, dtype=np.int64 if integer else float)
+            if values.shape[1] == width:
+                return values
+        except ValueError:
+            pass  # (not all numbers, or lines of different lengths: found below)
     text = ",".join(card.data)
     flat = text.replace(" ", "").replace("\t", "").split(",")
     flat = [f for f in flat if f != ""]

@@ -390,11 +390,13 @@ class _Writer:
             else:  # a node surface: the law's value per node (unit area, as CalculiX takes it); faces: per area
                 entry["weighting"] = "nodal" if sk == "NODE" else "area"
             if it.behavior == "tied":
-                entry.update({"law": "tied", "penalty": "auto"})
+                entry.update({"law": "tied", "penalty": "auto" if sk != "NODE" else self._hard_penalty(mb)})
             elif it.behavior == "linear":
                 entry["penalty"] = it.values[0]
             elif it.behavior == "exponential":
                 entry.update({"law": "exponential", "clearance": it.values[0], "pressure": it.values[1]})
+            elif sk == "NODE":  # hard contact, node slaves: augmented Lagrange with 10 E h per node
+                entry.update({"penalty": self._hard_penalty(mb), "method": "augmented"})
             else:
                 entry.update({"penalty": "auto", "method": "augmented"})
             if it.friction is not None and it.friction[0] > 0 and it.behavior != "tied":
@@ -403,6 +405,15 @@ class _Writer:
                     entry["tangential_penalty"] = it.friction[1]
             text += _table("[[contact]]", entry)
         return text
+
+    def _hard_penalty(self, body: int) -> float:
+        """10 E h of the master body (its smallest Young's modulus, h its mean element size), a force per length."""
+        labels = self.b.el_labels[self.b.of_element == body]
+        mods = [self.m.materials[mat].get("E", 0.0) for s, mat, _ in self.m.sections
+                if np.intersect1d(self.m.elsets.get(s, np.zeros(0, np.int64)), labels).size]
+        X = self.m.X[self.b.of_node == body]
+        h = float(np.prod(np.maximum(X.max(axis=0) - X.min(axis=0), 1e-300)) / max(labels.size, 1)) ** (1.0 / 3.0)
+        return 10.0 * min(mods) * h
 
     def _surface_body(self, name: str, refs, where: str) -> int:
         bodies = np.unique(np.concatenate([self.b.elements_body(els) for els, _, _ in refs]))

@@ -248,13 +248,17 @@ class _Reader:
     @staticmethod
     def _add(sets: dict, name: str, labels: np.ndarray) -> None:
         name = name.upper()
-        sets[name] = np.unique(np.concatenate([sets[name], labels])) if name in sets else np.unique(labels)
+        if name in sets:
+            labels = np.concatenate([sets[name], labels])
+        ordered = labels.size < 2 or bool(np.all(labels[1:] > labels[:-1]))
+        sets[name] = labels if ordered else np.unique(labels)
 
     def _nodes(self, c: Card) -> tuple[np.ndarray, np.ndarray]:
-        widths = {len([f for f in line.split(",") if f.strip()]) for line in c.data}
-        if widths == {4}:
-            a = numbers(c, 4, "a node (label, x, y, z)")
-        else:
+        try:
+            a = numbers(c, 4, "a node (label, x, y, z)") if c.data else np.zeros((0, 4))
+        except DeckError:  # (2D nodes, or a malformed line: line by line below)
+            a = None
+        if a is None or len(a) != len(c.data):
             a = np.zeros((len(c.data), 4))
             for k, row in enumerate(c.rows()):
                 if not 2 <= len(row) <= 4:
@@ -274,10 +278,11 @@ class _Reader:
                                       f"{', '.join(ELEMENTS)})")
             return
         cell = ELEMENTS[etype][0]
-        a = numbers(c, 1 + NNODE[cell], f"a {etype} element (label and {NNODE[cell]} nodes)")
-        if np.any(a != np.round(a)):
-            raise c.fail("element and node labels are whole numbers")
-        a = a.astype(np.int64)
+        a = numbers(c, 1 + NNODE[cell], f"a {etype} element (label and {NNODE[cell]} nodes)", integer=True)
+        if a.dtype != np.int64:
+            if np.any(a != np.round(a)):
+                raise c.fail("element and node labels are whole numbers")
+            a = a.astype(np.int64)
         self.m.blocks.append((etype, cell, a[:, 0], a[:, 1:]))
         self.m.block_where.append(c.where())
         if "ELSET" in c.params:

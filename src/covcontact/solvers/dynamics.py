@@ -209,17 +209,33 @@ class Dynamic(QuasiStatic):
         """A time step: Newton on the dynamic model. With ``reuse_factorization = "auto"`` a dynamic step reuses its
         first factorisation for its later corrections (GMRES preconditioned by it): the mass term dominates a
         dynamic tangent, which then changes little within a step (benchmarks/dynamics.py: one factorisation per
-        step instead of 2.2, the same iterations)."""
+        step instead of 2.2, the same iterations).
+
+        With a frictional pair switched on, Newton's corrections get the secant line search (``Newton._searched``)
+        whatever ``line_search`` says. A slave node that comes to rest while slipping has no tangential stiffness
+        along its slip (the return mapping's slip tangent, exact) but the inertia and its elements', and its stick
+        band, the slip of width 2 kappa / eps_T in which the trial traction lies inside the cone, is far narrower
+        than the correction M^-1 beta dt^2 kappa that the slip traction kappa drives: full Newton corrections
+        then jump over the band from slip one way to slip the other way and back (a two-cycle of the
+        piecewise-linear equation c (u - u*) + f(u) = 0, slopes c outside the band, c + eps_T inside it, which the
+        status codes do not see: slip stays slip). The search halves such a jump (the secant of the two-cycle)
+        and lands in the band; a correction that reduces du . R keeps its full length, at no extra evaluation.
+        Measured (tests/verification/test_friction_stop.py: a block sliding to rest on a rigid plane): 20 to 190
+        iterations per step with cutbacks after the stop without it, at most 7 to 10 with it."""
         newton = self.newton
         opt = newton.opt
         self._before = state
         newton.model = self.dynamic_model
         if opt.reuse_factorization == "auto":
             newton.opt = replace(opt, reuse_factorization=True)
+        contact = getattr(self.model, "contact", None)
+        newton.search_friction = contact is not None and any(
+            p.mu > 0.0 and on for p, on in zip(contact.passes, contact.enabled))
         try:
             inc = super().advance(u, state, step, lam)
         finally:
             newton.model, newton.opt = self.model, opt
+            newton.search_friction = False
         return inc
 
     def _error(self, before: State, after: State) -> float:

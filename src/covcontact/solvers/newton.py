@@ -145,6 +145,9 @@ class Newton:
         #: load factors, the committed state it started from and its converged trial (check-tangent's probe)
         self.on_converged = None
         self.converged_increments: list[tuple[float, float]] = []  # of the last advance
+        #: the line search whatever ``line_search`` says (a dynamic stage with friction sets it, see
+        #: covcontact.solvers.dynamics.Dynamic.advance)
+        self.search_friction = False
 
     def _contact_codes(self, trial) -> np.ndarray:
         """The model's contact status codes of ``trial`` (an empty array for a model without contact)."""
@@ -276,25 +279,37 @@ class Newton:
                 eta *= 0.5
         raise AssertionError("unreachable")
 
-    def _line_search(self, u, du, lam, R0, committed, trial):
-        s0 = float(du @ R0)
-        R1, _, _ = self._evaluate(u + du, lam, committed, trial, want_K=False)
-        s1 = float(du @ R1)
-        if s0 == 0.0 or abs(s1) <= 0.8 * abs(s0):
-            return 1.0
+    def _searched(self, u, du, lam, R0, committed, trial):
+        """The correction ``du`` with a secant line search on s(eta) = du . R(u + eta du) (``R0`` the residual at
+        u, zero on the constrained dofs): the full correction is evaluated first, with its tangent, as without the
+        search, and kept where |s(1)| <= 0.8 |s(0)|; otherwise up to 6 secant steps on eta in [0.1, 1] (residuals
+        only) until |s| <= 0.8 |s(0)|, and the evaluation with the tangent is made there. A full correction that
+        inverts an element is shortened by ``_backtrack`` alone (no search then). Returns (eta, the evaluation at
+        u + eta du); ``u`` is moved there. (The full correction's evaluation serves both the test and the next
+        iteration, so a search that keeps eta = 1 costs nothing.)"""
+        base = u.copy()
+        eta, ev = self._backtrack(u, du, 1.0, lam, committed, trial)
+        s0, s1 = float(du @ R0), float(du @ ev[0])
+        if eta < 1.0 or s0 == 0.0 or abs(s1) <= 0.8 * abs(s0):
+            return eta, ev
         a0, a1, f0, f1 = 0.0, 1.0, s0, s1
-        eta = 1.0
-        for _ in range(6):
-            if f1 == f0:
-                break
-            eta = a1 - f1 * (a1 - a0) / (f1 - f0)
-            eta = float(np.clip(eta, 0.1, 1.0))
-            Rt, _, _ = self._evaluate(u + eta * du, lam, committed, trial, want_K=False)
-            ft = float(du @ Rt)
-            if abs(ft) <= 0.8 * abs(s0):
-                break
-            a0, f0, a1, f1 = a1, f1, eta, ft
-        return eta
+        try:
+            for _ in range(6):
+                if f1 == f0:
+                    break
+                eta = float(np.clip(a1 - f1 * (a1 - a0) / (f1 - f0), 0.1, 1.0))
+                Rt, _, _ = self._evaluate(base + eta * du, lam, committed, trial, want_K=False)
+                ft = float(du @ Rt)
+                if abs(ft) <= 0.8 * abs(s0):
+                    break
+                a0, f0, a1, f1 = a1, f1, eta, ft
+        except InvertedElementError:  # a shorter correction inverts an element: half of it (backtracked below)
+            eta = 0.5
+        if eta == 1.0:
+            return eta, ev
+        self.stats["line_searches"] = self.stats.get("line_searches", 0) + 1
+        u[:] = base
+        return self._backtrack(u, du, eta, lam, committed, trial)
 
     def _extrapolates_from(self, lam_a: float, lam_b: float) -> bool:
         """Whether the step from lam_a to lam_b starts from the extrapolating predictor (``_predict``): it
@@ -388,14 +403,11 @@ class Newton:
             du = self._solve(K, rhs, eta, loose)
             inexact = self.stats["factorizations"] == n_fact
             du[~free] = du_d[~free] if it == 1 else 0.0
-            eta = 1.0
-            if opt.line_search and it > 1:
-                try:
-                    eta = self._line_search(u, du, lam_b, -rhs, committed, trial)
-                except InvertedElementError:  # the full correction inverts an element: backtrack below
-                    eta = 0.5
             out.iterations = it
-            eta, (R, K, trial) = self._backtrack(u, du, eta, lam_b, committed, trial)
+            if (opt.line_search or self.search_friction) and it > 1:
+                eta, (R, K, trial) = self._searched(u, du, lam_b, -rhs, committed, trial)
+            else:
+                eta, (R, K, trial) = self._backtrack(u, du, 1.0, lam_b, committed, trial)
             energy = abs(float(du[free] @ rhs[free])) * eta
             if e0 is None:
                 e0 = max(energy, 1e-300)

@@ -282,6 +282,9 @@ class QuasiStatic:
         backtracks = newton.stats.get("backtracks", 0) - stats0.get("backtracks", 0)
         if backtracks:  # Newton corrections shortened because their full length inverted an element
             entry["backtracks"] = backtracks
+        searches = newton.stats.get("line_searches", 0) - stats0.get("line_searches", 0)
+        if searches:  # Newton corrections the line search shortened
+            entry["line_searches"] = searches
         if newton.stats.get("stabilised", 0) > stats0.get("stabilised", 0):  # a body held by contact alone
             entry["stabilised"] = True
         if inc.cutbacks:
