@@ -48,8 +48,8 @@ class DatTable(Observer):
         for blk in sysm.blocks:
             labels = self.info["bodies"].get(blk.name, [])
             where.update(zip(labels, range(blk.offset, blk.offset + len(labels))))
-        R, _, _ = model.evaluate(run.u, inc.lam, run.state, want_K=False)
-        forces = (R + model.external(inc.lam)).reshape(-1, 3)  # internal and contact forces
+        R, _, _ = model.evaluate(run.u, inc.lam, run.state, want_K=False, raw=True)
+        forces = (R + model.external(inc.lam)).reshape(-1, 3)  # internal and contact forces at each node
         U = run.u.reshape(-1, 3)
         time = sum(self.info["periods"][:stage]) + self.info["periods"][stage] * inc.lam
         text = []

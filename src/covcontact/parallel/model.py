@@ -318,9 +318,10 @@ class DistributedModel(Model):
         return self.system.layout
 
     def evaluate(self, u: np.ndarray, lam: float, committed, guess=None, want_K: bool = True,
-                 timing: dict | None = None):
+                 timing: dict | None = None, raw: bool = False):
         """Residual R = f_int + f_contact - lam f_ext (replicated), the tangent share (or None) and the
-        trial state of this rank's elements and slaves."""
+        trial state of this rank's elements and slaves (``raw``: as ``Model.evaluate``; distributed runs have no
+        multi-point constraints)."""
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
         r, data, etrial = self.system.local_internal(u, committed.elements, guess.elements, want_K=want_K)

@@ -162,11 +162,13 @@ class Model:
 
     # evaluation -------------------------------------------------------------------------------
     def evaluate(self, u: np.ndarray, lam: float, committed: State, guess: State | None = None,
-                 want_K: bool = True, timing: dict | None = None):
+                 want_K: bool = True, timing: dict | None = None, raw: bool = False):
         """Residual R = f_int + f_contact - f_ext(lam), its tangent (CSR or None) and the trial state.
 
         ``committed`` gives the history, ``guess`` (default ``committed``) the starting point of the local
-        iterations (EAS parameters, contact points, Uzawa multipliers). Neither is changed.
+        iterations (EAS parameters, contact points, Uzawa multipliers). Neither is changed. With multi-point
+        constraints the residual and tangent are those of the independent dofs (``constraints.transform``), unless
+        ``raw``: then R at every dof (the nodal forces before the constraints hand them over).
         """
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
@@ -190,7 +192,7 @@ class Model:
             timing["assembly"] += t2 - t1
             timing["contact"] += (t1 - t0) + (t3 - t2)
         r = r - self.external(lam)
-        if self.constraints is not None:
+        if self.constraints is not None and not raw:
             r, K = self.constraints.transform(r, K)
         return r, K, committed.but(elements=etrial, contact=ctrial, lam=lam)
 

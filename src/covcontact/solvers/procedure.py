@@ -308,7 +308,8 @@ class QuasiStatic:
 
 def reactions(model, u: np.ndarray, lam: float, state: State, R: np.ndarray | None = None) -> dict:
     """The resultant reaction of every Dirichlet condition in force (released ones are left out): the residual ``R``
-    (default the quasi-static one at ``u``) summed over its nodes."""
+    (default the quasi-static one at ``u``) summed over its nodes, on its components; conditions on different
+    components of one node set share its entry."""
     if R is None:
         R, _, _ = model.evaluate(u, lam, state, want_K=False)
     out = {}
@@ -320,5 +321,6 @@ def reactions(model, u: np.ndarray, lam: float, state: State, R: np.ndarray | No
         total = R.reshape(-1, 3)[nodes].sum(axis=0)
         comp = np.zeros(3, dtype=bool)
         comp[list(bc.components)] = True
-        out[f"{bc.body}.{bc.set}"] = np.where(comp, total, 0.0).tolist()
+        key = f"{bc.body}.{bc.set}"  # (conditions on one set, each on its components: one entry of them all)
+        out[key] = np.where(comp, total, out.get(key, 0.0)).tolist()
     return out
