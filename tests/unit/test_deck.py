@@ -233,6 +233,25 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
             assert np.allclose(p.bodies[1].mesh.points[np.unique(p.bodies[1].mesh.face_sets[pr.set]), 2], 1.5)
 
 
+def test_dynamic_steps(tmp_path):
+    """*DYNAMIC (ALPHA, increment, period) becomes a dynamic stage with HHT, rho_inf = (1 + alpha) / (1 - alpha); a
+    deck without *DENSITY is then refused naming the density."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text().replace("*STATIC\n0.5, 1.0\n",
+                                                                    "*DYNAMIC, ALPHA=-0.1\n0.05, 0.5, 0.01, 0.1\n")
+    deck = tmp_path / "dyn.inp"
+    deck.write_text(text.replace("1000.0, 0.3\n", "1000.0, 0.3\n*DENSITY\n1.0\n"))
+    p = load_problem(import_deck(deck, tmp_path / "d" / "p.toml").problem)
+    d = p.dynamics
+    assert (d.method, d.dt, d.t_end, d.dt_min, d.dt_max) == ("hht", 0.05, 0.5, 0.01, 0.1)
+    assert d.rho_inf == pytest.approx(0.9 / 1.1)
+    deck.write_text(text)
+    with pytest.raises(InputError, match="density"):
+        load_problem(import_deck(deck, tmp_path / "e" / "p.toml").problem)
+    deck.write_text(text.replace("ALPHA=-0.1", "ALPHA=-0.5"))
+    with pytest.raises(DeckError, match=r"ALPHA must lie in \[-1/3, 0\], got -0.5"):
+        import_deck(deck, tmp_path / "f" / "p.toml")
+
+
 def test_deck_run_equals_the_problem_file_and_writes_the_dat_table(tmp_path):
     """The deck and the same model as a problem file (generated meshes) give the same reactions; the .dat table prints
     the deck's labels with U and RF, and the forces on the support sum to the reaction."""
@@ -277,7 +296,7 @@ def test_steps_become_stages(tmp_path):
 def test_unsupported_keywords_are_listed_with_their_lines(tmp_path):
     deck = two_block_deck(tmp_path / "tb.inp")
     text = deck.read_text().replace("*STEP, NLGEOM", "*ORIENTATION, NAME=OR1\n1, 0, 0, 0, 1, 0\n*STEP, NLGEOM")
-    text = text.replace("*STATIC\n", "*STATIC, SOLVER=SPOOLES\n*DYNAMIC, ALPHA=-0.05\n0.1, 1.0\n")
+    text = text.replace("*STATIC\n", "*STATIC, SOLVER=SPOOLES, TIME RESET\n")
     deck.write_text(text)
     proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
                            "--quiet"], capture_output=True, text=True, timeout=600)
@@ -285,7 +304,7 @@ def test_unsupported_keywords_are_listed_with_their_lines(tmp_path):
     lines = proc.stderr.splitlines()
     orient = text.splitlines().index("*ORIENTATION, NAME=OR1") + 1
     assert f"covcontact: unsupported: {deck}:{orient}: *ORIENTATION is not supported" in lines
-    assert any("*DYNAMIC is not supported" in ln for ln in lines)
+    assert any("*STATIC, TIME RESET is not supported" in ln for ln in lines)
     assert lines[-1].startswith(f"covcontact: error: {deck}: 2 unsupported") and "Traceback" not in proc.stderr
     out = tmp_path / "imported.toml"
     proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "import", str(deck), "--out", str(out)],

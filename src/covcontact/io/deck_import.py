@@ -291,7 +291,7 @@ class _Writer:
                         targets[names[key]] = self._load_value(key, v)
             loads = cur
             if s > 0:
-                st = {"name": f"step{s + 1}", "steps": self._steps(step)}
+                st = {"name": f"step{s + 1}", **self._timing(step)}
                 if release:
                     st["release"] = release
                 if targets:
@@ -303,11 +303,23 @@ class _Writer:
         for key, entry in first.items():
             kind = "dirichlet" if key[0] not in ("cload", "dload") else ("force" if key[0] == "cload" else "pressure")
             conds += _table(f"[[{kind}]]", entry)
-        text = _table("[steps]", self._steps(m.steps[0]))
+        text = "" if m.steps[0].dynamic else _table("[steps]", self._steps(m.steps[0]))
         for st in stages:
-            steps = st.pop("steps")
+            steps = st.pop("steps", None)
             text += _table("[[stages]]", {**st, "steps": steps})
         return conds, text
+
+    def _timing(self, step) -> dict:
+        """A stage's steps (``steps``) or, for *DYNAMIC, its dynamic keys: HHT with rho_inf = (1 + alpha) / (1 -
+        alpha), the deck's increment as dt (automatic within its min and max unless DIRECT)."""
+        if not step.dynamic:
+            return {"steps": self._steps(step)}
+        a, period, lo, hi = step.increments
+        out = {"procedure": "dynamic", "dt": min(a, period), "t_end": period, "method": "hht",
+               "rho_inf": (1.0 + step.alpha) / (1.0 - step.alpha)}
+        if not step.direct and lo and hi:
+            out.update({"dt_min": min(lo, a), "dt_max": max(min(hi, period), a)})
+        return out
 
     def _boundary_keys(self, b: Boundary, where: dict) -> dict:
         out = {}
@@ -440,7 +452,9 @@ class _Writer:
         bodies = self._bodies_toml()
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
-        head = _table("[problem]", {"name": _name(self.deck.stem)})
+        first = self.m.steps[0]
+        head = _table("[problem]", {"name": _name(self.deck.stem), **({k: v for k, v in self._timing(first).items()}
+                                                                      if first.dynamic else {})})
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
                             + conds + stages)

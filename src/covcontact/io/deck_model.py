@@ -27,7 +27,7 @@ NFACES = {"hex8": 6, "hex20": 6, "tet10": 4, "tet4": 4, "wedge6": 5}
 
 #: the keywords read (everything else is unsupported); output requests are read for the .dat table
 SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL", "ELASTIC", "PLASTIC", "DENSITY",
-             "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "END STEP", "CONTACT PAIR",
+             "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART")
@@ -73,6 +73,8 @@ class Step:
     nlgeom: bool
     increments: tuple[float, float, float | None, float | None]   # initial, period, min, max
     direct: bool
+    dynamic: bool = False     # *DYNAMIC (implicit): the increments are times
+    alpha: float = -0.05      # its HHT parameter (ALPHA=, in [-1/3, 0])
     boundary: list[Boundary] = field(default_factory=list)
     boundary_new: bool = False
     loads: list[Load] = field(default_factory=list)
@@ -188,8 +190,17 @@ class _Reader:
                     raise c.fail(f"INC must be a whole number, got {inc!r}")
                 self.step = Step(c.where(), "NLGEOM" in c.params and c.params["NLGEOM"].upper() != "NO",
                                  (1.0, 1.0, None, None), False)
-            elif c.name == "STATIC":
+            elif c.name in ("STATIC", "DYNAMIC"):
                 st = self._in_step(c)
+                if c.name == "DYNAMIC":
+                    st.dynamic = True
+                    alpha = c.param("ALPHA", "-0.05")
+                    try:
+                        st.alpha = float(alpha)
+                    except ValueError:
+                        raise c.fail(f"ALPHA must be a number, got {alpha!r}") from None
+                    if not -1.0 / 3.0 <= st.alpha <= 0.0:
+                        raise c.fail(f"ALPHA must lie in [-1/3, 0], got {st.alpha}")
                 row = c.rows()[0] if c.data else []
                 vals = [c.number(0, j, row, w, d) for j, (w, d) in
                         enumerate((("the initial increment", 1.0), ("the step's period", 1.0)))]
@@ -219,7 +230,7 @@ class _Reader:
     # -- helpers ---------------------------------------------------------------------------------
     def _check_params(self, c: Card) -> None:
         for p in c.params:
-            if p in _HARMLESS:
+            if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
