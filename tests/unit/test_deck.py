@@ -252,6 +252,33 @@ def test_dynamic_steps(tmp_path):
         import_deck(deck, tmp_path / "f" / "p.toml")
 
 
+def test_amplitudes_cut_a_step_into_stages(tmp_path):
+    """A *CLOAD with a tabular amplitude 0 -> 1 -> 0.5 at step times 0, 0.4, 1 (period 1): two stages, the force
+    reaching a(0.4) F at the first cut and a(1) F at the end; the punch's prescribed motion (no amplitude) ramped
+    over the step: 0.4 and 1 of it; the requests printed at the step's end only; an unknown amplitude is one line."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    text = text.replace("*STEP, NLGEOM", "*AMPLITUDE, NAME=A1\n0., 0., 0.4, 1.0, 1.0, 0.5\n*STEP, NLGEOM")
+    text = text.replace("*NODE PRINT", "*CLOAD, AMPLITUDE=A1\n1001, 1, 2.0\n*NODE PRINT")
+    deck = tmp_path / "amp.inp"
+    deck.write_text(text)
+    imp = import_deck(deck, tmp_path / "a" / "p.toml")
+    assert imp.unsupported == []
+    p = load_problem(imp.problem)
+    (force,) = p.forces
+    assert force.value == pytest.approx((2.0, 0.0, 0.0))          # a(0.4) F at the end of the first stage
+    (st,) = p.stages
+    assert st.targets[force.name] == pytest.approx([1.0, 0.0, 0.0])  # a(1) F
+    moved = next(d for d in p.dirichlet if d.set == "TOP" and d.components == (2,))
+    assert moved.values == pytest.approx((-0.02 * 0.4,)) and st.targets[moved.name] == pytest.approx([-0.02])
+    import json
+
+    info = json.loads(imp.labels.read_text())
+    assert info["periods"] == pytest.approx([0.4, 0.6]) and info["node_print"][0] == []  # printed at the step's end
+    deck.write_text(text.replace("AMPLITUDE=A1", "AMPLITUDE=A2"))
+    with pytest.raises(DeckError, match="AMPLITUDE=A2: no \\*AMPLITUDE of that name .defined: A1."):
+        import_deck(deck, tmp_path / "b" / "p.toml")
+
+
 def test_deck_run_equals_the_problem_file_and_writes_the_dat_table(tmp_path):
     """The deck and the same model as a problem file (generated meshes) give the same reactions; the .dat table prints
     the deck's labels with U and RF, and the forces on the support sum to the reaction."""

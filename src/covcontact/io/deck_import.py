@@ -231,94 +231,146 @@ class _Writer:
         return f"{self.body_names[body]}.{set_name}"
 
     # -- conditions and steps ---------------------------------------------------------------------
+    def _amplitude(self, name: str | None, where: str):
+        """The table (times, values, total time?) of amplitude ``name`` (None: none)."""
+        if name is None:
+            return None
+        amp = self.m.amplitudes.get(name.upper())
+        if amp is None:
+            raise DeckError(f"{where}: AMPLITUDE={name}: no *AMPLITUDE of that name (defined: "
+                            f"{', '.join(sorted(self.m.amplitudes)) or 'none'})")
+        return amp
+
     def _conditions(self) -> tuple[str, str]:
-        """The [[dirichlet]], [[force]], [[pressure]] entries (their first-stage values) and the [[stages]]."""
+        """The [[dirichlet]], [[force]], [[pressure]] entries (their first-stage values) and the [[stages]]: one
+        stage per step, a step whose loads or conditions follow amplitudes cut at their points (everything is
+        linear in time between them, so the stages reproduce the tables exactly)."""
         m = self.m
         if not m.steps:
             raise DeckError(f"{self.deck}: no *STEP")
         names: dict[tuple, str] = {}      # key -> condition name
         first: dict[tuple, object] = {}   # key -> first-stage entry (dict)
         stages: list[dict] = []
-        active: dict[tuple, float] = {}   # boundary key (body, set, dof) -> value held now
-        loads: dict[tuple, float] = {}    # load key -> value now
+        self.stage_steps: list[tuple[int, float]] = []   # per covcontact stage: (deck step, duration)
+        active: dict[tuple, float] = {}   # boundary key (body, set, dof) -> value held at the end of the last step
+        loads: dict[tuple, float] = {}    # load key -> value at the end of the last step
         where: dict[tuple, str] = {}
-        model = {}
+        model: dict[tuple, tuple] = {}
         for b in m.model_boundary:
-            model.update(self._boundary_keys(b, where))
+            amp = self._amplitude(b.amplitude, b.where)
+            for key, v in self._boundary_keys(b, where).items():
+                model[key] = (v, amp)
+        total = 0.0
         for s, step in enumerate(m.steps):
-            targets, release, remove = {}, [], []
+            period = step.increments[1]
+            # (start value, end magnitude, amplitude) of every condition and load in force in this step
             if step.boundary_new:
-                now: dict[tuple, float] = {}
+                bspec: dict[tuple, tuple] = {}
+            elif s == 0:
+                bspec = {k: (0.0, v, a) for k, (v, a) in model.items()}
             else:
-                now = dict(model) if s == 0 else dict(active)
+                bspec = {k: (v, v, None) for k, v in active.items()}
             for b in step.boundary:
-                now.update(self._boundary_keys(b, where))
-            for key, v in now.items():
-                if key not in names:
-                    if s > 0:
-                        self.unsupported.append(f"{where[key]}: *BOUNDARY on dofs that were free in the steps before "
-                                                f"(covcontact adds no condition after the first step)")
-                        continue
-                    names[key] = f"bc{len(names) + 1}"
-                    first[key] = {"name": names[key], "set": self._ref(key[0], key[1]), "components": _COMP[key[2]],
-                                  "value": v}
-                elif key not in active:
-                    self.unsupported.append(f"{where[key]}: *BOUNDARY again on dofs released in an earlier step")
-                    continue
-                elif active[key] != v:
-                    targets[names[key]] = v
-            release = [names[key] for key in active if key not in now]
-            active = {k: v for k, v in now.items() if k in names and (s == 0 or k in active)}
-            # loads
-            cur: dict[tuple, float] = dict(loads)
-            for kind in step.loads_new:
-                for key in list(cur):
+                amp = self._amplitude(b.amplitude, b.where)
+                for key, v in self._boundary_keys(b, where).items():
+                    bspec[key] = (0.0 if s == 0 else active.get(key, 0.0), v, amp)
+            lspec: dict[tuple, tuple] = {k: (v, v, None) for k, v in loads.items()}
+            for kind in step.loads_new:  # loads not restated go to zero over the step
+                for key, v in loads.items():
                     if key[0] == kind:
-                        cur[key] = 0.0
+                        lspec[key] = (v, 0.0, None)
             for ld in step.loads:
+                amp = self._amplitude(ld.amplitude, ld.where)
                 for key in self._load_keys(ld):
-                    cur[key] = ld.value
-            for key, v in cur.items():
-                if key not in names:
-                    names[key] = f"{'f' if key[0] == 'cload' else 'p'}{len(names) + 1}"
-                    first[key] = self._load_entry(key, names[key], v if s == 0 else 0.0)
-                    if s > 0:
+                    lspec[key] = (loads.get(key, 0.0), ld.value, amp)
+            for key in list(bspec):
+                if key not in names and s > 0:
+                    self.unsupported.append(f"{where[key]}: *BOUNDARY on dofs that were free in the steps before "
+                                            f"(covcontact adds no condition after the first step)")
+                    del bspec[key]
+                elif key in names and key not in active:
+                    self.unsupported.append(f"{where[key]}: *BOUNDARY again on dofs released in an earlier step")
+                    del bspec[key]
+            release = [names[key] for key in active if key not in bspec]
+            breaks = {period}
+            for _, _, amp in list(bspec.values()) + list(lspec.values()):
+                if amp is not None:
+                    times = np.asarray(amp[0]) - (total if amp[2] else 0.0)
+                    breaks |= {float(t) for t in times if 0.0 < t < period * (1 - 1e-12)}
+            breaks = sorted(breaks)
+            prev_b = {k: spec[0] for k, spec in bspec.items()}
+            prev_l = {k: spec[0] for k, spec in lspec.items()}
+            for j, tau in enumerate(breaks):
+                targets = {}
+
+                def at(spec, tau=tau, period=period, total=total):
+                    v0, M, amp = spec
+                    if amp is None:
+                        return v0 + (M - v0) * tau / period
+                    return float(np.interp(tau + (total if amp[2] else 0.0), amp[0], amp[1])) * M
+
+                for key, spec in bspec.items():
+                    v = at(spec)
+                    if key not in names:
+                        names[key] = f"bc{len(names) + 1}"
+                        first[key] = {"name": names[key], "set": self._ref(key[0], key[1]),
+                                      "components": _COMP[key[2]], "value": v}
+                    elif v != prev_b[key]:
+                        targets[names[key]] = v
+                    prev_b[key] = v
+                for key, spec in lspec.items():
+                    v = at(spec)
+                    if key not in names:
+                        names[key] = f"{'f' if key[0] == 'cload' else 'p'}{len(names) + 1}"
+                        first[key] = self._load_entry(key, names[key], v if (s, j) == (0, 0) else 0.0)
+                        if (s, j) != (0, 0):
+                            targets[names[key]] = self._load_value(key, v)
+                    elif v != prev_l[key]:
                         targets[names[key]] = self._load_value(key, v)
-                elif s > 0 and loads.get(key) != v:
-                    if v == 0.0:
-                        remove.append(names[key])
-                    else:
-                        targets[names[key]] = self._load_value(key, v)
-            loads = cur
-            if s > 0:
-                st = {"name": f"step{s + 1}", **self._timing(step)}
-                if release:
+                    prev_l[key] = v
+                duration = tau - (breaks[j - 1] if j else 0.0)
+                self.stage_steps.append((s, duration))
+                if (s, j) == (0, 0):
+                    continue
+                st = {"name": f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else ""),
+                      **self._timing(step, duration)}
+                if release and j == 0:
                     st["release"] = release
                 if targets:
                     st["targets"] = targets
-                if remove:
-                    st["remove"] = remove
                 stages.append(st)
+            active = dict(prev_b)
+            loads = dict(prev_l)
+            total += period
         conds = ""
         for key, entry in first.items():
             kind = "dirichlet" if key[0] not in ("cload", "dload") else ("force" if key[0] == "cload" else "pressure")
             conds += _table(f"[[{kind}]]", entry)
-        text = "" if m.steps[0].dynamic else _table("[steps]", self._steps(m.steps[0]))
+        text = "" if m.steps[0].dynamic else _table("[steps]",
+                                                    self._timing(m.steps[0], self.stage_steps[0][1])["steps"])
         for st in stages:
             steps = st.pop("steps", None)
             text += _table("[[stages]]", {**st, "steps": steps})
         return conds, text
 
-    def _timing(self, step) -> dict:
-        """A stage's steps (``steps``) or, for *DYNAMIC, its dynamic keys: HHT with rho_inf = (1 + alpha) / (1 -
-        alpha), the deck's increment as dt (automatic within its min and max unless DIRECT)."""
+    def _timing(self, step, duration: float) -> dict:
+        """The steps (``steps``) of a stage that makes ``duration`` of the deck's step or, for *DYNAMIC, its dynamic
+        keys: HHT with rho_inf = (1 + alpha) / (1 - alpha), the deck's increment as dt (automatic within its min and
+        max unless DIRECT)."""
+        a, _, lo, hi = step.increments
         if not step.dynamic:
-            return {"steps": self._steps(step)}
-        a, period, lo, hi = step.increments
-        out = {"procedure": "dynamic", "dt": min(a, period), "t_end": period, "method": "hht",
+            if step.direct:
+                return {"steps": {"count": max(1, round(duration / a))}}
+            out = {"initial": min(1.0, a / duration)}
+            if lo is not None and lo > 0:
+                out["min"] = min(out["initial"], lo / duration)
+            if hi is not None and hi > 0:
+                out["max"] = min(1.0, hi / duration)
+            return {"steps": out}
+        out = {"procedure": "dynamic", "dt": min(a, duration), "t_end": duration, "method": "hht",
                "rho_inf": (1.0 + step.alpha) / (1.0 - step.alpha)}
         if not step.direct and lo and hi:
-            out.update({"dt_min": min(lo, a), "dt_max": max(min(hi, period), a)})
+            out.update({"dt_min": min(lo, a, duration), "dt_max": max(min(hi, duration), min(a, duration))})
         return out
 
     def _boundary_keys(self, b: Boundary, where: dict) -> dict:
@@ -357,18 +409,6 @@ class _Writer:
             vec[key[3]] = float(v)
             return vec
         return float(v)
-
-    @staticmethod
-    def _steps(step) -> dict:
-        a, period, lo, hi = step.increments
-        if step.direct:
-            return {"count": max(1, int(round(period / a)))}
-        out = {"initial": min(1.0, a / period)}
-        if lo is not None and lo > 0:
-            out["min"] = min(out["initial"], lo / period)
-        if hi is not None and hi > 0:
-            out["max"] = min(1.0, hi / period)
-        return out
 
     # -- contact ------------------------------------------------------------------------------------
     def _contacts(self) -> str:
@@ -453,7 +493,7 @@ class _Writer:
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
         first = self.m.steps[0]
-        head = _table("[problem]", {"name": _name(self.deck.stem), **({k: v for k, v in self._timing(first).items()}
+        head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(first, self.stage_steps[0][1])
                                                                       if first.dynamic else {})})
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
@@ -463,14 +503,17 @@ class _Writer:
         per_body = {}
         for k, name in enumerate(self.body_names):
             per_body[name] = self.m.node_labels[self.b.of_node == k].tolist()
-        prints = [[[nset, list(v)] for nset, v, _ in st.node_print] for st in self.m.steps]
+        ends = [k for k, (s, _) in enumerate(self.stage_steps) if k + 1 == len(self.stage_steps)
+                or self.stage_steps[k + 1][0] != s]  # the stages that end a deck step print its requests
+        prints = [[[nset, list(v)] for nset, v, _ in self.m.steps[s].node_print] if k in ends else []
+                  for k, (s, _) in enumerate(self.stage_steps)]
         wanted = {p[0] for per_step in prints for p in per_step}
         missing = sorted(wanted - set(self.m.nsets))
         if missing:
             raise DeckError(f"{self.deck}: *NODE PRINT names the node set {missing[0]!r}, which no *NSET defines")
         labels.write_text(json.dumps({"bodies": per_body, "node_print": prints,
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
-                                      "periods": [st.increments[1] for st in self.m.steps]}))
+                                      "periods": [d for _, d in self.stage_steps]}))
         meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
         return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)))
 

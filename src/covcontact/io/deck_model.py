@@ -30,7 +30,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
-             "CONTACT OUTPUT", "OUTPUT", "RESTART")
+             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE")
 #: output requests: accepted, only *NODE PRINT's U and RF are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
@@ -50,6 +50,7 @@ class Boundary:
     value: float | None
     where: str
     name: str            # the set name or node label as written
+    amplitude: str | None = None
 
 
 @dataclass
@@ -63,6 +64,7 @@ class Load:
     where: str
     nodes: np.ndarray | None = None
     elements: np.ndarray | None = None
+    amplitude: str | None = None
 
 
 @dataclass
@@ -111,6 +113,8 @@ class DeckModel:
     interactions: dict[str, Interaction] = field(default_factory=dict)
     pairs: list[tuple[str, str, str, str, str]] = field(default_factory=list)  # (interaction, type, slave, master, where)
     equations: list[tuple[list[tuple[int, int, float]], str]] = field(default_factory=list)
+    #: name -> (times, values, on the total time?) of a tabular *AMPLITUDE
+    amplitudes: dict[str, tuple[np.ndarray, np.ndarray, bool]] = field(default_factory=dict)
     model_boundary: list[Boundary] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
@@ -182,6 +186,8 @@ class _Reader:
                                     row[1].upper(), c.where(j)))
             elif c.name == "EQUATION":
                 self._equation(c)
+            elif c.name == "AMPLITUDE":
+                self._amplitude(c)
             elif c.name == "STEP":
                 if self.step is not None:
                     raise c.fail("a *STEP inside a step (a missing *END STEP?)")
@@ -230,7 +236,9 @@ class _Reader:
     # -- helpers ---------------------------------------------------------------------------------
     def _check_params(self, c: Card) -> None:
         for p in c.params:
-            if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA"):
+            if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (
+                    p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
+                    c.name == "AMPLITUDE" and p == "TIME"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
@@ -439,6 +447,22 @@ class _Reader:
                 raise c.fail("the first coefficient of an equation (its dependent term) must not be zero", start)
             self.m.equations.append((terms, c.where(start)))
 
+    def _amplitude(self, c: Card) -> None:
+        """A tabular amplitude: pairs (time, value), on the step time or (TIME=TOTAL TIME) the total time."""
+        name = c.param("NAME", required=True).upper()
+        if set(c.params) - {"NAME", "TIME"}:  # (USER, DEFINITION=..., VALUE=ABSOLUTE, SHIFT: listed as unsupported)
+            return
+        time = " ".join(c.param("TIME", "STEP TIME").upper().split())
+        if time not in ("STEP TIME", "TOTAL TIME"):
+            raise c.fail(f"TIME must be STEP TIME or TOTAL TIME, got {c.params['TIME']!r}")
+        v = numbers(c, None, "the amplitude's pairs (time, value)")
+        if v.size < 2 or v.size % 2:
+            raise c.fail("needs pairs 'time, value' (an even number of fields, at least one pair)")
+        t, a = v[0::2], v[1::2]
+        if np.any(np.diff(t) <= 0):
+            raise c.fail("the times of an amplitude must increase")
+        self.m.amplitudes[name] = (t, a, time == "TOTAL TIME")
+
     def _resolve_nodes(self, c: Card, k: int, ref: str) -> np.ndarray:
         if ref.isdigit():
             return np.array([int(ref)], dtype=np.int64)
@@ -458,7 +482,8 @@ class _Reader:
             if any(d > 3 for d in range(first, last + 1)):
                 self.m.unsupported.append(f"{c.where(k)}: *BOUNDARY on dofs above 3 (rotations, temperature)")
             if dofs:
-                out.append(Boundary(self._resolve_nodes(c, k, row[0]), dofs, value, c.where(k), row[0].upper()))
+                out.append(Boundary(self._resolve_nodes(c, k, row[0]), dofs, value, c.where(k), row[0].upper(),
+                                    c.param("AMPLITUDE")))
         if self.step is None:  # (model data: in force from the first step on, a value reached over it)
             if c.params.get("OP", "MOD").upper() == "NEW":
                 raise c.fail("OP=NEW belongs inside a *STEP")
@@ -481,7 +506,7 @@ class _Reader:
                     self.m.unsupported.append(f"{c.where(k)}: *CLOAD on dof {dof} (only forces 1..3)")
                     continue
                 st.loads.append(Load("cload", row[0].upper(), dof, c.number(k, 2, row, "the magnitude"), c.where(k),
-                                     nodes=self._resolve_nodes(c, k, row[0])))
+                                     nodes=self._resolve_nodes(c, k, row[0]), amplitude=c.param("AMPLITUDE")))
             else:
                 if len(row) < 3:
                     raise c.fail("a *DLOAD line is 'element or set, Pn, magnitude'", k)
@@ -497,4 +522,4 @@ class _Reader:
                 else:
                     raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
                 st.loads.append(Load("dload", ref, int(lab[1:]), c.number(k, 2, row, "the magnitude"), c.where(k),
-                                     elements=els))
+                                     elements=els, amplitude=c.param("AMPLITUDE")))

@@ -28,6 +28,9 @@ class Model:
     rank = 0
     size = 1
 
+    #: linear multi-point constraints (``covcontact.solvers.constraints.LinearConstraints``), None without
+    constraints = None
+
     def __init__(self, problem, tangent: str | None = None):
         self.problem = problem
         self.system = System(problem.bodies, problem.rigid, problem.loads, problem.dirichlet)
