@@ -198,6 +198,8 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
         "tied": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TIED"),
         "friction": ("1.0e6\n", "1.0e6\n*FRICTION\n0.2, 5.0e5\n"),
         "plastic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC\n5.0, 0.0\n6.0, 0.1\n*DENSITY\n2.0\n"),
+        "tie": ("*CONTACT PAIR, INTERACTION=SI1, TYPE=NODE TO SURFACE\nSSLAV, SMAST",
+                "*TIE, NAME=T1, POSITION TOLERANCE=0.01\nSSLAV, SMAST"),
         "sts-dload": ("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE", "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
                       "*SURFACE, NAME=SSLAV\nPBOT, S1"),
     }
@@ -219,6 +221,8 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
             assert c.method == "augmented" and c.penalty == pytest.approx(1.0e4)
         elif name == "tied":
             assert c.law == "tied"
+        elif name == "tie":
+            assert c.law == "tied" and c.tie_tolerance == 0.01 and c.slave == ("PUNCH", "SSLAV")
         elif name == "friction":
             assert c.friction == 0.2 and c.tangential_penalty == 5.0e5
         elif name == "plastic":

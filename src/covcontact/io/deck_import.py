@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .deck import DeckError
-from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Load, read_model
+from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 
 _COMP = "xyz"
 
@@ -413,8 +413,10 @@ class _Writer:
     # -- contact ------------------------------------------------------------------------------------
     def _contacts(self) -> str:
         text = ""
-        for k, (inter, kind, slave, master, where) in enumerate(self.m.pairs):
-            it = self.m.interactions.get(inter)
+        pairs = list(self.m.pairs) + [("*TIE", "TIE", slave, master, where) for _, slave, master, _, where in self.m.ties]
+        ties = {where: tol for _, _, _, tol, where in self.m.ties}
+        for k, (inter, kind, slave, master, where) in enumerate(pairs):
+            it = Interaction("*TIE", behavior="tied") if kind == "TIE" else self.m.interactions.get(inter)
             if it is None:
                 raise DeckError(f"{where}: *CONTACT PAIR names the interaction {inter!r}, which no *SURFACE "
                                 f"INTERACTION defines")
@@ -426,7 +428,7 @@ class _Writer:
                 raise DeckError(f"{where}: the master surface {master} must be an element surface (faces)")
             mb = self._surface_body(master, mrefs, where)
             sk, sref = self.m.surfaces[slave]
-            sts = kind == "SURFACE TO SURFACE" and sk == "ELEMENT"
+            sts = kind in ("SURFACE TO SURFACE", "TIE") and sk == "ELEMENT"
             if sk == "NODE":
                 targets = self._node_targets(slave, sref, where)
                 if len(targets) > 1:
@@ -443,6 +445,8 @@ class _Writer:
                 entry["weighting"] = "nodal" if sk == "NODE" else "area"
             if it.behavior == "tied":
                 entry.update({"law": "tied", "penalty": "auto" if sk != "NODE" else self._hard_penalty(mb)})
+                if ties.get(where):
+                    entry["tie_tolerance"] = ties[where]
             elif it.behavior == "linear":
                 entry["penalty"] = it.values[0]
             elif it.behavior == "exponential":

@@ -30,7 +30,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
-             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE")
+             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE")
 #: output requests: accepted, only *NODE PRINT's U and RF are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
@@ -112,6 +112,8 @@ class DeckModel:
     sections: list[tuple[str, str, str]] = field(default_factory=list)   # (elset, material, where)
     interactions: dict[str, Interaction] = field(default_factory=dict)
     pairs: list[tuple[str, str, str, str, str]] = field(default_factory=list)  # (interaction, type, slave, master, where)
+    #: *TIE: (name, slave, master, position tolerance or None, where)
+    ties: list[tuple[str, str, str, float | None, str]] = field(default_factory=list)
     equations: list[tuple[list[tuple[int, int, float]], str]] = field(default_factory=list)
     #: name -> (times, values, on the total time?) of a tabular *AMPLITUDE
     amplitudes: dict[str, tuple[np.ndarray, np.ndarray, bool]] = field(default_factory=dict)
@@ -188,6 +190,17 @@ class _Reader:
                 self._equation(c)
             elif c.name == "AMPLITUDE":
                 self._amplitude(c)
+            elif c.name == "TIE":
+                tol = c.param("POSITION TOLERANCE")
+                try:
+                    tol = float(tol) if tol not in (None, "") else None
+                except ValueError:
+                    raise c.fail(f"POSITION TOLERANCE must be a number, got {tol!r}") from None
+                for j, row in enumerate(c.rows()):
+                    if len(row) < 2:
+                        raise c.fail("a tie is 'slave surface, master surface'", j)
+                    m.ties.append((c.param("NAME", required=True).upper(), row[0].upper(), row[1].upper(), tol,
+                                   c.where(j)))
             elif c.name == "STEP":
                 if self.step is not None:
                     raise c.fail("a *STEP inside a step (a missing *END STEP?)")
@@ -237,6 +250,7 @@ class _Reader:
     def _check_params(self, c: Card) -> None:
         for p in c.params:
             if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (
+                    c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
                     p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
                     c.name == "AMPLITUDE" and p == "TIME"):
                 continue
