@@ -7,7 +7,8 @@ Install the decks and their references first (they are not downloaded here):
 Each deck named (default: every deck in that folder whose keywords covcontact reads) is run with
 ``covcontact run DECK.inp`` in a folder of its own; the ``.dat`` table it writes is compared with the deck's
 ``.dat.ref``: for every block of displacements (U) and forces (RF) that both print at the same time, the largest
-difference over the largest value of the reference block. covcontact is always geometrically nonlinear; a deck
+difference over the largest value of the reference block (a deck that prints no displacements there: those of its
+``.frd.ref`` at the end of each step, against covcontact's VTU of that step). covcontact is always geometrically nonlinear; a deck
 whose steps are linear (no NLGEOM) is also run by CalculiX itself (``ccx``, ``apt-get install calculix-ccx``) with
 NLGEOM added to its steps, and the displacements compared with that run as well. Decks that covcontact refuses (unsupported keywords, one
 line each) or that fail are listed with the reason. Results: a JSON file and a markdown table
@@ -59,6 +60,78 @@ def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]
         except (ValueError, IndexError):
             key = None
     return {k: v for k, v in out.items() if v}
+
+
+def frd_displacements(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]:
+    """The DISP blocks of a CalculiX .frd result file (ASCII): ("displacements", "FRD", time) -> node -> (3,)."""
+    out: dict = {}
+    lines = text.splitlines()
+    time = None
+    k = 0
+    while k < len(lines):
+        ln = lines[k]
+        if ln.startswith("  100C"):
+            time = float(ln[12:24])
+        elif ln.startswith(" -4  DISP") and time is not None:
+            block = {}
+            k += 1
+            while k < len(lines) and not lines[k].startswith(" -3"):
+                row = lines[k]
+                if row.startswith(" -1"):
+                    block[int(row[3:13])] = np.array([float(row[13 + 12 * i: 25 + 12 * i]) for i in range(3)])
+                k += 1
+            out[("displacements", "FRD", time)] = block
+        k += 1
+    return out
+
+
+def ours_at_step_ends(run: Path) -> dict[tuple[str, str, float], dict[int, np.ndarray]]:
+    """covcontact's displacements at the end of each deck step (the VTU of the last step of the stage that ends it),
+    by the deck's node labels: ("displacements", "FRD", total time) -> node -> (3,)."""
+    import meshio
+
+    name = next(run.glob("deck/*.nodes.json"))
+    info = json.loads(name.read_text())
+    summary = json.loads((run / "summary.json").read_text())
+    order: list[str] = []
+    last: dict[str, int] = {}
+    for st in summary["steps"]:
+        stage = st.get("stage", "")
+        if stage not in last:
+            order.append(stage)
+        last[stage] = st["step"]
+    labels = [lab for body in info["bodies"].values() for lab in body]
+    out = {}
+    ends = info.get("deck_step", list(range(len(info["periods"]))))
+    for k, stage in enumerate(order):
+        if k + 1 < len(ends) and ends[k + 1] == ends[k]:
+            continue  # (a stage that does not end a deck step)
+        vtu = run / f"step_{last[stage]:04d}.vtu"
+        if not vtu.is_file():
+            continue
+        u = meshio.read(vtu).point_data["displacement"][: len(labels)]
+        time = float(sum(info["periods"][: k + 1]))
+        out[("displacements", "FRD", time)] = dict(zip(labels, u))
+    return out
+
+
+def compare_blocks(a: dict, b: dict) -> list[dict]:
+    """The blocks of ``b`` (reference) that ``a`` has at the same time: max |difference| / max |reference|."""
+    rows = []
+    for key, rb in b.items():
+        match = [k for k in a if k[0] == key[0] and k[1] == key[1] and abs(k[2] - key[2]) <= 1e-6 * max(1, key[2])]
+        if not match:
+            continue
+        ab = a[match[0]]
+        nodes = sorted(set(rb) & set(ab))
+        if not nodes:
+            continue
+        R = np.array([rb[n] for n in nodes])
+        A = np.array([ab[n] for n in nodes])
+        scale = float(np.abs(R).max())
+        rows.append({"kind": key[0], "set": key[1], "time": key[2], "nodes": len(nodes), "max_ref": scale,
+                     "rel_diff": float(np.abs(A - R).max() / scale) if scale > 0 else 0.0})
+    return rows
 
 
 def compare(ours: str, ref: str) -> list[dict]:
@@ -122,6 +195,9 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
         row["why"] = (proc.stderr.strip().splitlines() or ["no output"])[-1][:300]
         return row
     blocks = compare(dat.read_text(), ref or "")
+    frd = _text(folder / f"{name}.frd.ref")
+    if frd and not any(b["kind"] == "displacements" for b in blocks):  # only the .frd holds displacements
+        blocks += compare_blocks(ours_at_step_ends(work / "run"), frd_displacements(frd))
     row["blocks"] = blocks
     for kind in ("displacements", "forces"):
         vals = [b["rel_diff"] for b in blocks if b["kind"] == kind]
@@ -141,6 +217,9 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
         subprocess.run([ccx, "-i", name], cwd=nl, capture_output=True, timeout=1800, check=False)
         if (nl / f"{name}.dat").is_file():
             nb = compare(dat.read_text(), (nl / f"{name}.dat").read_text())
+            if not any(b["kind"] == "displacements" for b in nb) and (nl / f"{name}.frd").is_file():
+                nb += compare_blocks(ours_at_step_ends(work / "run"),
+                                     frd_displacements((nl / f"{name}.frd").read_text(errors="replace")))
             for kind in ("displacements", "forces"):
                 vals = [b["rel_diff"] for b in nb if b["kind"] == kind]
                 if vals:

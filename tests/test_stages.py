@@ -466,3 +466,27 @@ def test_resume_inside_a_pair_release_is_exact(tmp_path, monkeypatch, stop_at):
     assert [s["iterations"] for s in a["steps"]] == [s["iterations"] for s in b["steps"]]
     assert [s["reactions"]["block.zmin"][2] for s in a["steps"]] == pytest.approx(
         [s["reactions"]["block.zmin"][2] for s in b["steps"]], rel=1e-9, abs=1e-12)
+
+
+def test_stage_changes_the_friction_coefficient(tmp_path):
+    """A block pressed and dragged across a rigid floor while sliding: the tangential contact force is mu N with mu =
+    0.3 in the first stage and mu = 0.1 from the stage that changes it on (the stick history carries over)."""
+    from covcontact.io.loader import load_problem
+
+    text = (Path(__file__).resolve().parents[1] / "examples" / "friction" / "block_sliding.toml").read_text()
+    assert 'friction = 0.3\n' in text and "[steps]\ncount = 10" in text
+    text = text.replace('friction = 0.3\n', 'friction = 0.3\nname = "slide"\n').replace(
+        "[[dirichlet]]\n", '[[dirichlet]]\nname = "drag"\n', 1)
+    text += ('\n[[stages]]\nname = "slippery"\nsteps = { count = 4 }\ntargets = { drag = [0.3, 0.0, -0.01] }\n'
+             'friction = { slide = 0.1 }\n')
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    for s, mu in ((steps[9], 0.3), (steps[-1], 0.1)):
+        fx, _, fz = s["contact_force"]
+        assert abs(fx) == pytest.approx(mu * abs(fz), rel=5e-4)
+    path.write_text(text.replace("friction = { slide = 0.1 }", "friction = { slid = 0.1 }"))
+    with pytest.raises(InputError, match="no frictional contact pair named 'slid'; did you mean 'slide'"):
+        load_problem(path)

@@ -210,6 +210,7 @@ class Stage:
         the pose the earlier stages left (``covcontact.motion.StagedMotion``).
     contacts: pair name -> True (switched on) or False (switched off) at the start of the stage.
     dynamics: the time stepping of a dynamic stage (None: quasi-static load stepping).
+    friction: pair name -> the Coulomb coefficient of a frictional pair from the start of this stage on.
     """
 
     name: str
@@ -220,6 +221,7 @@ class Stage:
     motions: dict = field(default_factory=dict)
     contacts: dict = field(default_factory=dict)
     dynamics: Dynamics | None = None  # a dynamic stage (None: quasi-static)
+    friction: dict = field(default_factory=dict)
 
 
 @dataclass

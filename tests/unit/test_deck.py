@@ -324,6 +324,16 @@ def test_steps_become_stages(tmp_path):
     assert force.value == (0.0, 0.0, 0.0) and st.targets[force.name] == pytest.approx([0.5, 0.0, 0.0])
 
 
+def test_change_friction_becomes_a_stage_coefficient(tmp_path):
+    step2 = "*STEP\n*STATIC\n0.5, 1.0\n*CHANGE FRICTION, INTERACTION=SI1\n*FRICTION\n0.1, 5.0e5\n*END STEP\n"
+    text = two_block_deck(tmp_path / "tb.inp", extra_step=step2).read_text().replace("1.0e6\n", "1.0e6\n*FRICTION\n"
+                                                                                     "0.3, 5.0e5\n", 1)
+    deck = tmp_path / "cf.inp"
+    deck.write_text(text)
+    p = load_problem(import_deck(deck, tmp_path / "cf" / "p.toml").problem)
+    assert p.contacts[0].friction == 0.3 and p.stages[0].friction == {"pair1": 0.1}
+
+
 def test_unsupported_keywords_are_listed_with_their_lines(tmp_path):
     deck = two_block_deck(tmp_path / "tb.inp")
     text = deck.read_text().replace("*STEP, NLGEOM", "*ORIENTATION, NAME=OR1\n1, 0, 0, 0, 1, 0\n*STEP, NLGEOM")

@@ -89,9 +89,13 @@ class ContactManager:
         """A new load step: search every pass from scratch at its first evaluation."""
         self._cache = [None] * len(self.passes)
 
-    def set_stage(self, motions: dict, pairs: dict[str, bool]) -> None:
-        """The rigid bodies' motions and the pairs switched on in the current stage."""
+    def set_stage(self, motions: dict, pairs: dict[str, bool], friction: dict | None = None) -> None:
+        """The rigid bodies' motions, the pairs switched on and the Coulomb coefficients of the frictional pairs in
+        the current stage."""
         self.num.motions = dict(motions)
+        for p in self.passes:
+            if friction and p.pair in friction:
+                p.mu = float(friction[p.pair])
         for p in self.passes:
             if p.analytic is not None:
                 p.analytic.motion = motions[p.rigid]

@@ -336,6 +336,10 @@ class _Writer:
                       **self._timing(step, duration)}
                 if release and j == 0:
                     st["release"] = release
+                changed = {f"pair{k + 1}": mu for k, (inter, *_rest) in enumerate(m.pairs)
+                           for name, mu in step.friction.items() if inter == name}
+                if changed and j == 0:
+                    st["friction"] = changed
                 if targets:
                     st["targets"] = targets
                 stages.append(st)
@@ -517,7 +521,8 @@ class _Writer:
             raise DeckError(f"{self.deck}: *NODE PRINT names the node set {missing[0]!r}, which no *NSET defines")
         labels.write_text(json.dumps({"bodies": per_body, "node_print": prints,
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
-                                      "periods": [d for _, d in self.stage_steps]}))
+                                      "periods": [d for _, d in self.stage_steps],
+                                      "deck_step": [k for k, _ in self.stage_steps]}))
         meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
         return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)))
 

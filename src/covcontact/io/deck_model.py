@@ -30,7 +30,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
-             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE")
+             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION")
 #: output requests: accepted, only *NODE PRINT's U and RF are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
@@ -82,6 +82,7 @@ class Step:
     loads: list[Load] = field(default_factory=list)
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
+    friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
 
 
 @dataclass
@@ -140,6 +141,7 @@ class _Reader:
         self.material: str | None = None
         self.interaction: str | None = None
         self.step: Step | None = None
+        self.changing: str | None = None  # the interaction of the step's *CHANGE FRICTION
         nodes, coords = [], []
         k = 0
         while k < len(cards):
@@ -174,6 +176,18 @@ class _Reader:
             elif c.name == "SURFACE INTERACTION":
                 self.interaction = c.param("NAME", required=True).upper()
                 m.interactions[self.interaction] = Interaction(self.interaction, where=c.where())
+            elif c.name == "CHANGE FRICTION":
+                st = self._in_step(c)
+                self.changing = c.param("INTERACTION", required=True).upper()
+                if self.changing not in m.interactions:
+                    raise c.fail(f"no *SURFACE INTERACTION named {self.changing!r}")
+            elif c.name == "FRICTION" and self.step is not None:
+                if self.changing is None:
+                    raise c.fail("*FRICTION inside a step belongs after *CHANGE FRICTION")
+                rows = c.rows()
+                if not rows:
+                    raise c.fail("needs 'friction coefficient[, stick slope]'")
+                self.step.friction[self.changing] = c.number(0, 0, rows[0], "the friction coefficient")
             elif c.name in ("SURFACE BEHAVIOR", "FRICTION"):
                 self._interaction(c)
             elif c.name == "CONTACT PAIR":
@@ -234,6 +248,7 @@ class _Reader:
                     raise c.fail("*END STEP without a *STEP")
                 m.steps.append(self.step)
                 self.step = None
+                self.changing = None
             elif c.name == "BOUNDARY":
                 self._boundary(c)
             elif c.name in ("CLOAD", "DLOAD"):
@@ -249,7 +264,7 @@ class _Reader:
     # -- helpers ---------------------------------------------------------------------------------
     def _check_params(self, c: Card) -> None:
         for p in c.params:
-            if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (
+            if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (c.name == "CONTROLS") or (
                     c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
                     p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
                     c.name == "AMPLITUDE" and p == "TIME"):

@@ -142,5 +142,16 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                 csec.fail(f"no contact pair named {n!r}{suggest(n, pairs)} (known: {', '.join(sorted(pairs)) or 'none'})", n)
             switch[n] = csec.get(n, "bool")
         csec.done()
+    friction = {}
+    fsec = st.get("friction", "table", None)
+    if fsec is not None:  # a new Coulomb coefficient of a frictional pair (its stick history carries on)
+        frictional = {c.name for c in contacts if c.friction > 0.0}
+        for n in list(fsec.data):
+            if n not in frictional:
+                known = ", ".join(sorted(frictional)) or "none"
+                fsec.fail(f"no frictional contact pair named {n!r}{suggest(n, frictional)} (a pair's friction changes "
+                          f"only where it has friction from the start; frictional pairs: {known})", n)
+            friction[n] = fsec.get(n, "float", nonnegative=True)
+        fsec.done()
     st.done()
-    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch, dynamics)
+    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch, dynamics, friction)

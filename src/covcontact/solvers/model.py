@@ -55,7 +55,7 @@ class Model:
                                state.forces.get("parked"))
         held = spec.constrained if self.constraints is None else spec.constrained | self.constraints.mask
         self.system.set_constraints(held)
-        self.contact.set_stage(spec.motions, spec.contacts)
+        self.contact.set_stage(spec.motions, spec.contacts, spec.friction)
 
     def enter_stage(self, u: np.ndarray, committed: State) -> State:
         """The committed state at the start of the next stage, which is then prescribed: the reactions of

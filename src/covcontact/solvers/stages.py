@@ -91,6 +91,8 @@ class StageSpec:
     parked_moves: list = field(default_factory=list, repr=False)
     #: contact pairs released at the start of this stage: switched off, their forces ramped to zero
     released_pairs: tuple[str, ...] = ()
+    #: pair name -> Coulomb coefficient in this stage (the frictional pairs)
+    friction: dict = field(default_factory=dict)
 
     @property
     def lam_end(self) -> float:
@@ -128,6 +130,7 @@ class StagePlan:
         self.stages: list[StageSpec] = []
         self.stages.append(self._spec(0, problem.stage_name, problem.steps.factors, conds, np.zeros(0, np.int64),
                                       loads, values, targets, motions, contacts, ()))
+        self.stages[0].friction = {c.name: c.friction for c in problem.contacts if c.friction > 0.0}
         zero = np.zeros(3)
         self.stages[0].rigid_loads = {ref.name: (zero, ref.force, zero, ref.moment)
                                       for ref in getattr(system, "reference", [])}
@@ -157,6 +160,7 @@ class StagePlan:
             spec = self._spec(k, st.name, st.steps.factors, new_conds, rel, loads, values, targets,
                               new_motions, new_contacts, tuple(st.release), st.motions, pairs_released)
             spec.rigid_loads = _carried_rigid_loads(prev, st)
+            spec.friction = {**prev.friction, **getattr(st, "friction", {})}
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
