@@ -233,7 +233,7 @@ class _Writer:
     # -- conditions and steps ---------------------------------------------------------------------
     def _amplitude(self, name: str | None, where: str):
         """The table (times, values, total time?) of amplitude ``name`` (None: none)."""
-        if name is None:
+        if name is None or name.upper() in self.m.skipped_amplitudes:
             return None
         amp = self.m.amplitudes.get(name.upper())
         if amp is None:

@@ -118,6 +118,8 @@ class DeckModel:
     equations: list[tuple[list[tuple[int, int, float]], str]] = field(default_factory=list)
     #: name -> (times, values, on the total time?) of a tabular *AMPLITUDE
     amplitudes: dict[str, tuple[np.ndarray, np.ndarray, bool]] = field(default_factory=dict)
+    #: amplitudes of a kind not read (listed as unsupported): the loads that use them are left as they are
+    skipped_amplitudes: set[str] = field(default_factory=set)
     model_boundary: list[Boundary] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
@@ -201,7 +203,8 @@ class _Reader:
                     m.pairs.append((c.param("INTERACTION", required=True).upper(), kind, row[0].upper(),
                                     row[1].upper(), c.where(j)))
             elif c.name == "EQUATION":
-                self._equation(c)
+                if not c.params:  # (REMOVE, REMOVE ALL: listed as unsupported)
+                    self._equation(c)
             elif c.name == "AMPLITUDE":
                 self._amplitude(c)
             elif c.name == "TIE":
@@ -480,6 +483,7 @@ class _Reader:
         """A tabular amplitude: pairs (time, value), on the step time or (TIME=TOTAL TIME) the total time."""
         name = c.param("NAME", required=True).upper()
         if set(c.params) - {"NAME", "TIME"}:  # (USER, DEFINITION=..., VALUE=ABSOLUTE, SHIFT: listed as unsupported)
+            self.m.skipped_amplitudes.add(name)
             return
         time = " ".join(c.param("TIME", "STEP TIME").upper().split())
         if time not in ("STEP TIME", "TOTAL TIME"):
