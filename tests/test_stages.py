@@ -490,3 +490,65 @@ def test_stage_changes_the_friction_coefficient(tmp_path):
     path.write_text(text.replace("friction = { slide = 0.1 }", "friction = { slid = 0.1 }"))
     with pytest.raises(InputError, match="no frictional contact pair named 'slid'; did you mean 'slide'"):
         load_problem(path)
+
+
+LATE = """
+[problem]
+name = "late"
+[[bodies]]
+name = "bar"
+element = "hex8"
+material = { model = "svk", E = 100.0, nu = 0.0 }
+mesh = { generator = "block", lx = 2.0, ly = 1.0, lz = 1.0, nx = 2, ny = 1, nz = 1 }
+[[dirichlet]]
+set = "bar.xmin"
+components = "x"
+[[dirichlet]]
+set = "bar.ymin"
+components = "y"
+[[dirichlet]]
+set = "bar.zmin"
+components = "z"
+[[force]]
+name = "pull"
+set = "bar.xmax"
+value = [3.0, 0.0, 0.0]
+distribution = "total"
+[[dirichlet]]
+name = "hold"
+set = "bar.xmax"
+components = "x"
+value = VALUE
+stage = "holding"
+[steps]
+count = 2
+[[stages]]
+name = "holding"
+steps = { count = 2 }
+remove = ["pull"]
+"""
+
+
+@pytest.mark.parametrize("value", ['"held"', "0.1"])
+def test_condition_that_starts_in_a_later_stage(tmp_path, value):
+    """A bar pulled by a force (uniaxial SVK, nu = 0: F / A = E l (l^2 - 1) / 2); in the next stage the force goes
+    and a condition that starts there holds its end: "held" keeps the end where the force left it (the reaction
+    takes the force over), a value moves it there from where it was."""
+    path = tmp_path / "p.toml"
+    path.write_text(LATE.replace("VALUE", value))
+    res = load_problem(path).run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0
+    lam = np.roots([50.0, 0.0, -50.0, -3.0])
+    lam = float(lam[np.isreal(lam) & (lam.real > 1)].real[0])
+    steps = res.summary["steps"]
+    u = meshio.read(sorted((tmp_path / "o").glob("step_*.vtu"))[-1]).point_data["displacement"]
+    end = meshio.read(sorted((tmp_path / "o").glob("step_*.vtu"))[-1]).points[:, 0] > 2.0 - 1e-9
+    if value == '"held"':
+        assert steps[1]["reactions"].get("bar.xmax") is None
+        np.testing.assert_allclose(u[end, 0], 2.0 * (lam - 1.0), rtol=1e-8)
+        assert steps[-1]["reactions"]["bar.xmax"][0] == pytest.approx(3.0, rel=1e-8)  # the force, now the support's
+    else:
+        np.testing.assert_allclose(u[end, 0], 0.1, rtol=1e-12)
+    path.write_text(LATE.replace("VALUE", value).replace('stage = "holding"', 'stage = "holdin"'))
+    with pytest.raises(InputError, match="no later stage named 'holdin'; did you mean 'holding'"):
+        load_problem(path)

@@ -22,6 +22,10 @@ class Dirichlet:
     values: tuple[float, ...]
     name: str = ""
     motion: RigidMotion | None = None
+    #: the stage from which the condition holds (None: from the start); its dofs are free before, and in that stage
+    #: they go from the displacement they have when it starts to ``values`` (or, ``held``, keep it)
+    stage: str | None = None
+    held: bool = False
 
 
 @dataclass

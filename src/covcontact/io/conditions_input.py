@@ -55,16 +55,25 @@ def read_dirichlet(top: Section, sets: SetRefs) -> list[Dirichlet]:
             d.fail(f"must be a non-empty combination of x, y, z, got {comps!r}", "components")
         dname = d.get("name", "str", "")
         motion = None
+        held = False
         if d.has("motion"):
             if d.has("value"):
                 d.fail("give either 'value' or 'motion', not both", "motion")
             motion = read_motion(d.get("motion", "table"))
             values = (0.0,) * len(comps)
         else:
-            values = dirichlet_values(d, "value", len(comps))
+            held = d.has("value") and d.data.get("value") == "held"
+            values = (0.0,) * len(comps) if held and d.get("value", "str") else \
+                dirichlet_values(d, "value", len(comps))
+        start = d.get("stage", "str", None)
+        if held and start is None:
+            d.fail('value = "held" (the displacement the dofs have when the condition starts) needs a later '
+                   '\'stage\' to start in', "value")
+        if start is not None and motion is not None:
+            d.fail("a condition with a motion holds from the first stage: leave out 'stage'", "stage")
         d.done()
         dirichlet.append(Dirichlet(bname, sname, tuple(COMPONENTS[c] for c in comps), tuple(values), dname,
-                                   motion))
+                                   motion, start, held))
     return dirichlet
 
 

@@ -273,7 +273,10 @@ class _Writer:
             for b in step.boundary:
                 amp = self._amplitude(b.amplitude, b.where)
                 for key, v in self._boundary_keys(b, where).items():
-                    bspec[key] = (0.0 if s == 0 else active.get(key, 0.0), v, amp)
+                    if b.fixed:  # held where the step finds it: a held dof stays, a free one starts held
+                        bspec[key] = (active[key], active[key], None) if key in active else (0.0, None, None)
+                    else:
+                        bspec[key] = (0.0 if s == 0 else active.get(key, 0.0), v, amp)
             lspec: dict[tuple, tuple] = {k: (v, v, None) for k, v in loads.items()}
             for kind in step.loads_new:  # loads not restated go to zero over the step
                 for key, v in loads.items():
@@ -283,14 +286,9 @@ class _Writer:
                 amp = self._amplitude(ld.amplitude, ld.where)
                 for key in self._load_keys(ld):
                     lspec[key] = (loads.get(key, 0.0), ld.value, amp)
-            for key in list(bspec):
-                if key not in names and s > 0:
-                    self.unsupported.append(f"{where[key]}: *BOUNDARY on dofs that were free in the steps before "
-                                            f"(covcontact adds no condition after the first step)")
-                    del bspec[key]
-                elif key in names and key not in active:
-                    self.unsupported.append(f"{where[key]}: *BOUNDARY again on dofs released in an earlier step")
-                    del bspec[key]
+            # conditions on dofs free before (new ones, or released in an earlier step): they start in this step
+            # from the displacement their dofs have then (FIXED: keep it)
+            late = {key for key in bspec if s > 0 and (key not in names or key not in active)}
             release = [names[key] for key in active if key not in bspec]
             breaks = {period}
             for _, _, amp in list(bspec.values()) + list(lspec.values()):
@@ -309,7 +307,28 @@ class _Writer:
                         return v0 + (M - v0) * tau / period
                     return float(np.interp(tau + (total if amp[2] else 0.0), amp[0], amp[1])) * M
 
+                stage_name = f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else "")
                 for key, spec in bspec.items():
+                    if key in late:
+                        if j == 0:
+                            names[key] = f"bc{len(names) + 1}"
+                            entry = {"name": names[key], "set": self._ref(key[0], key[1]),
+                                     "components": _COMP[key[2]], "stage": stage_name}
+                            if spec[1] is None:  # *BOUNDARY, FIXED
+                                entry["value"] = "held"
+                            elif spec[2] is None and len(breaks) > 1:
+                                self.unsupported.append(f"{where[key]}: a *BOUNDARY that starts in a step cut by "
+                                                        f"amplitudes without an amplitude of its own")
+                            else:
+                                entry["value"] = at((0.0, spec[1], spec[2]))
+                            first[(*key, s)] = entry
+                            prev_b[key] = entry.get("value")
+                        elif spec[1] is not None and prev_b[key] != "held":
+                            v = at((0.0, spec[1], spec[2]))
+                            if v != prev_b[key]:
+                                targets[names[key]] = v
+                            prev_b[key] = v
+                        continue
                     v = at(spec)
                     if key not in names:
                         names[key] = f"bc{len(names) + 1}"
@@ -332,8 +351,7 @@ class _Writer:
                 self.stage_steps.append((s, duration))
                 if (s, j) == (0, 0):
                     continue
-                st = {"name": f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else ""),
-                      **self._timing(step, duration)}
+                st = {"name": stage_name, **self._timing(step, duration)}
                 if release and j == 0:
                     st["release"] = release
                 changed = {f"pair{k + 1}": mu for k, (inter, *_rest) in enumerate(m.pairs)
@@ -343,12 +361,14 @@ class _Writer:
                 if targets:
                     st["targets"] = targets
                 stages.append(st)
-            active = dict(prev_b)
+            active = {k: (v if isinstance(v, float) else 0.0) for k, v in prev_b.items()}
             loads = dict(prev_l)
             total += period
         conds = ""
         for key, entry in first.items():
             kind = "dirichlet" if key[0] not in ("cload", "dload") else ("force" if key[0] == "cload" else "pressure")
+            if kind == "dirichlet" and entry.get("value", 0.0) is None:
+                continue  # (a late condition the step cannot give: listed as unsupported)
             conds += _table(f"[[{kind}]]", entry)
         text = "" if m.steps[0].dynamic else _table("[steps]",
                                                     self._timing(m.steps[0], self.stage_steps[0][1])["steps"])

@@ -51,6 +51,7 @@ class Boundary:
     where: str
     name: str            # the set name or node label as written
     amplitude: str | None = None
+    fixed: bool = False  # *BOUNDARY, FIXED: held at the displacement the step finds
 
 
 @dataclass
@@ -270,6 +271,7 @@ class _Reader:
             if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (c.name == "CONTROLS") or (
                     c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
                     p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
+                    p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
                     c.name == "AMPLITUDE" and p == "TIME"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
@@ -516,7 +518,7 @@ class _Reader:
                 self.m.unsupported.append(f"{c.where(k)}: *BOUNDARY on dofs above 3 (rotations, temperature)")
             if dofs:
                 out.append(Boundary(self._resolve_nodes(c, k, row[0]), dofs, value, c.where(k), row[0].upper(),
-                                    c.param("AMPLITUDE")))
+                                    c.param("AMPLITUDE"), "FIXED" in c.params))
         if self.step is None:  # (model data: in force from the first step on, a value reached over it)
             if c.params.get("OP", "MOD").upper() == "NEW":
                 raise c.fail("OP=NEW belongs inside a *STEP")

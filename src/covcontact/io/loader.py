@@ -83,6 +83,11 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     for st in top.get("stages", "array", []):
         stages.append(stage(st, named, dirichlet, rigid, contacts, stages, stage_name))
 
+    later = [st.name for st in stages]
+    for i, bc in enumerate(dirichlet):  # conditions that start in a later stage
+        if bc.stage is not None and bc.stage not in later:
+            top.fail(f"no later stage named {bc.stage!r}{suggest(bc.stage, later)} (the stages after the first: "
+                     f"{', '.join(later) or 'none'})", f"dirichlet[{i}].stage")
     dynamic = dynamics is not None or any(st.dynamics is not None for st in stages)
     if dynamic or gravity is not None:
         check_densities(top, bodies, "a dynamic stage" if dynamic else "gravity")

@@ -42,6 +42,9 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
         if value not in named or named[value][0] not in kinds:
             known = sorted(n for n, (k, _) in named.items() if k in kinds)
             sec.fail(f"no {what} named {value!r}{suggest(value, known)} (named ones: {', '.join(known) or 'none'})", key)
+        starts = getattr(named[value][1], "stage", None)
+        if starts is not None and starts != name and starts not in [x.name for x in earlier]:
+            sec.fail(f"{value!r} holds from stage {starts!r} on, which comes later", key)
         if value in released_before:
             sec.fail(f"{value!r} was released in stage {released_before[value]!r}; a released condition "
                      f"stays free", key)

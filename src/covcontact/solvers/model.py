@@ -52,7 +52,7 @@ class Model:
         """Prescribe what ``state``'s stage prescribes (after a stage change or a resume)."""
         spec = self.stages[state.stage]
         self.loading = Loading(spec, self.system.X, state.forces.get("release"), state.forces.get("held"),
-                               state.forces.get("parked"))
+                               state.forces.get("parked"), state.forces.get("applied"))
         held = spec.constrained if self.constraints is None else spec.constrained | self.constraints.mask
         self.system.set_constraints(held)
         self.contact.set_stage(spec.motions, spec.contacts, spec.friction)
@@ -77,6 +77,13 @@ class Model:
             parked = np.zeros(self.n_dofs)
             parked[spec.parked] = u[spec.parked]
             forces["parked"] = parked
+        applied = committed.forces.get("applied")
+        if spec.applied_names or (applied is not None and any(c.from_state for c in spec.conditions)):
+            applied = np.zeros(self.n_dofs) if applied is None else applied.copy()
+            for c in spec.conditions:  # conditions that start now: from the displacement their dofs have
+                if c.name in spec.applied_names:
+                    applied[c.dofs] = u[c.dofs]
+            forces["applied"] = applied
         new = committed.but(stage=committed.stage + 1, lam=0.0, forces=forces)
         self.set_stage(new)
         return new.but(contact=self.contact.switch(new.contact))

@@ -38,6 +38,10 @@ class _Condition:
     target: np.ndarray | None    # (ncomp,) value at lam = 1
     motion: object = None        # RigidMotion / StagedMotion (motion conditions)
     rigid: object = None         # the ReferenceBody of a rigid body's prescribed components
+    #: the condition starts from the displacement its dofs had when it began (``Loading.applied``): to ``target``,
+    #: or (``held``) staying there
+    from_state: bool = False
+    held: bool = False
 
     @property
     def dofs(self) -> np.ndarray:
@@ -61,7 +65,10 @@ class _Condition:
         return (self.motion.apply(Xn, lam) - Xn)[:, list(self.components)].ravel()
 
     def end(self, lam_end: float) -> tuple:
-        """(start value, pose) this condition leaves for the next stage."""
+        """(start value, pose) this condition leaves for the next stage (a condition from the state: its target,
+        reached at the end of the stage, or None while it holds the state's values)."""
+        if self.from_state:
+            return (None if self.held else self.target), None
         if self.motion is None:
             return self.start + lam_end * (self.target - self.start), None
         return None, self.motion.pose(lam_end)
@@ -93,6 +100,8 @@ class StageSpec:
     released_pairs: tuple[str, ...] = ()
     #: pair name -> Coulomb coefficient in this stage (the frictional pairs)
     friction: dict = field(default_factory=dict)
+    #: conditions that start in this stage, from the displacement their dofs have then
+    applied_names: tuple[str, ...] = ()
 
     @property
     def lam_end(self) -> float:
@@ -117,8 +126,14 @@ class StagePlan:
         targets = {k: np.atleast_1d(np.asarray(ld.value, dtype=float)) for k, ld in loads.items()}
 
         conds: list[_Condition] = []
+        late: dict[str, list[_Condition]] = {}  # stage name -> the conditions that start there
         for i, bc in enumerate(problem.dirichlet):
             nodes = system.global_nodes(bc.body, bc.set)
+            if getattr(bc, "stage", None) is not None:
+                late.setdefault(bc.stage, []).append(_Condition(
+                    bc.name or f"#{i}", nodes, bc.components, None, np.asarray(bc.values, dtype=float),
+                    from_state=True, held=bc.held))
+                continue
             if bc.motion is not None:
                 conds.append(_Condition(bc.name or f"#{i}", nodes, bc.components, None, None, bc.motion))
             else:
@@ -138,6 +153,14 @@ class StagePlan:
             prev = self.stages[-1]
             lam_end = prev.lam_end
             new_conds, released = _carried_conditions(prev, st)
+            starting = []
+            for c in late.get(st.name, []):
+                target = st.targets.get(c.name)
+                starting.append(_Condition(c.name, c.nodes, c.components, None,
+                                           c.target if target is None else np.broadcast_to(
+                                               np.asarray(target, dtype=float), c.target.shape).astype(float),
+                                           from_state=True, held=c.held and target is None))
+            new_conds += starting
             values = {key: values[key] + lam_end * (targets[key] - values[key]) for key in loads}
             targets = dict(values)
             for key in loads:
@@ -161,6 +184,7 @@ class StagePlan:
                               new_motions, new_contacts, tuple(st.release), st.motions, pairs_released)
             spec.rigid_loads = _carried_rigid_loads(prev, st)
             spec.friction = {**prev.friction, **getattr(st, "friction", {})}
+            spec.applied_names = tuple(c.name for c in starting)
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
@@ -220,6 +244,13 @@ def _carried_conditions(prev: StageSpec, st) -> tuple[list[_Condition], list[np.
             released.append(c.dofs)
             continue
         start, pose = c.end(lam_end)
+        if c.from_state and start is None:  # held at the state's values, unless given a target now
+            if c.name in st.targets:
+                new_conds.append(_Condition(c.name, c.nodes, c.components, None, np.broadcast_to(np.asarray(
+                    st.targets[c.name], dtype=float), (len(c.components),)).astype(float), from_state=True))
+            else:
+                new_conds.append(c)
+            continue
         if c.motion is None:
             target = np.asarray(st.targets.get(c.name, start), dtype=float)
             if target.shape != start.shape:
@@ -257,10 +288,12 @@ class Loading:
     """The prescribed displacements and external forces of one stage as functions of its load factor."""
 
     def __init__(self, spec: StageSpec, X: np.ndarray, release: np.ndarray | None = None,
-                 held: np.ndarray | None = None, parked: np.ndarray | None = None):
+                 held: np.ndarray | None = None, parked: np.ndarray | None = None, applied: np.ndarray | None = None):
         self.spec = spec
         self.X = X
         n = len(spec.load_start)
+        #: the displacements the dofs of conditions that started in a later stage had when they started
+        self.applied = np.zeros(n) if applied is None else applied
         self.release = np.zeros(n) if release is None else release
         self.held = np.zeros(n) if held is None else held
         self.parked = np.zeros(n) if parked is None else parked  # displacements of the parked dofs
@@ -274,7 +307,11 @@ class Loading:
         conditions win where sets overlap)."""
         u = np.zeros(len(self.constrained))
         for c, dofs in zip(self.spec.conditions, self._dofs):
-            u[dofs] = c.values(self.X, lam)
+            if c.from_state:
+                u0 = self.applied[dofs]
+                u[dofs] = u0 if c.held else u0 + lam * (np.tile(c.target, len(c.nodes)) - u0)
+            else:
+                u[dofs] = c.values(self.X, lam)
         if self.spec.parked.size:
             u[self.spec.parked] = self.parked[self.spec.parked]
             for dofs, motion, comps in self.spec.parked_moves:
