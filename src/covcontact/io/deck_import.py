@@ -231,6 +231,21 @@ class _Writer:
         return f"{self.body_names[body]}.{set_name}"
 
     # -- conditions and steps ---------------------------------------------------------------------
+    def _gravity(self) -> dict:
+        """``gravity`` of the problem from *DLOAD GRAV: covcontact's weight acts on every body in full from the start,
+        so a GRAV of the first step on every element, one vector (kept in the later steps), maps exactly (a static
+        step's answer does not depend on the ramp); anything else is listed as unsupported."""
+        loads = [(s, els, g, where) for s, st in enumerate(self.m.steps) for els, g, where in st.gravity]
+        if not loads:
+            return {}
+        g0 = loads[0][2]
+        for s, els, g, where in loads:
+            if s > 0 or not np.allclose(g, g0) or np.setdiff1d(self.b.el_labels, els).size:
+                self.unsupported.append(f"{where}: a *DLOAD GRAV other than one gravity on every element in the first "
+                                        f"step (covcontact's gravity acts on every body from the start)")
+                return {}
+        return {"gravity": [float(v) for v in g0]}
+
     def _amplitude(self, name: str | None, where: str):
         """The table (times, values, total time?) of amplitude ``name`` (None: none)."""
         if name is None or name.upper() in self.m.skipped_amplitudes:
@@ -522,7 +537,8 @@ class _Writer:
         contacts = self._contacts() + self._equations()
         first = self.m.steps[0]
         head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(first, self.stage_steps[0][1])
-                                                                      if first.dynamic else {})})
+                                                                      if first.dynamic else {}),
+                                    **self._gravity()})
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
                             + conds + stages)

@@ -84,6 +84,7 @@ class Step:
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
+    gravity: list[tuple[np.ndarray, np.ndarray, str]] = field(default_factory=list)  # *DLOAD GRAV: (elements, g)
 
 
 @dataclass
@@ -546,6 +547,19 @@ class _Reader:
                 if len(row) < 3:
                     raise c.fail("a *DLOAD line is 'element or set, Pn, magnitude'", k)
                 lab = row[1].upper()
+                if lab == "GRAV":  # gravity: magnitude, direction
+                    if len(row) < 6:
+                        raise c.fail("a GRAV load is 'element set, GRAV, magnitude, nx, ny, nz'", k)
+                    ref = row[0].upper()
+                    els = self.m.elsets.get(ref) if not ref.isdigit() else np.array([int(ref)])
+                    if els is None:
+                        raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
+                    g = c.number(k, 2, row, "the magnitude")
+                    n = np.array([c.number(k, 3 + i, row, "the direction") for i in range(3)])
+                    if not np.linalg.norm(n) > 0:
+                        raise c.fail("the direction of GRAV must not be zero", k)
+                    st.gravity.append((els, g * n / np.linalg.norm(n), c.where(k)))
+                    continue
                 if not (lab.startswith("P") and lab[1:].isdigit()):
                     self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (only face pressures P1..P6)")
                     continue
