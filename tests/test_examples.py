@@ -42,3 +42,15 @@ def test_header_true_to_the_file(path):
 def test_long_examples_have_a_ci_size_test(name):
     test = ROOT / LONG[name]
     assert (ROOT / "examples" / f"{name}.toml").exists() and f"{name}.toml" in test.read_text()
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "examples" / "decks").glob("*.inp")), ids=lambda p: p.stem)
+def test_deck_example_runs(tmp_path, path):
+    """Every example deck runs as it is (`covcontact run DECK.inp`) and prints its requests to the .dat table."""
+    code = main(["run", str(path), "--out", str(tmp_path), "--quiet"])
+    assert code == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["converged"] and all(s["converged"] for s in summary["steps"])
+    dat = (tmp_path / f"{path.stem}.dat").read_text()
+    requests = path.read_text().upper().count("*NODE PRINT")
+    assert dat.count(" for set ") >= requests > 0
