@@ -81,8 +81,8 @@ def run(tmp_path, method: str, mass: str):
 def test_block_stops_at_the_coulomb_time(tmp_path):
     """rho_inf = 0: every bottom node slips with the friction force mu N and N = m g (to 2 %, the start's ringing
     decays) until the stop at v0 / (mu g) (the first step in which a node sticks; within 2 dt, the start loses
-    half a step of friction), then the block is at rest after v0^2 / (2 mu g); at most 8 Newton iterations per
-    step and no cutback."""
+    half a step of friction), then the block is at rest after v0^2 / (2 mu g), the kinetic energy m v0^2 / 2 gone
+    into frictional dissipation; at most 8 Newton iterations per step and no cutback."""
     res, steps, t, force = run(tmp_path, 'method = "generalized-alpha"\nrho_inf = 0.0', "consistent")
     slip = np.array([s["pairs"]["contact1"]["slip"] for s in steps])
     t_stop = t[np.argmax(slip < 16)]
@@ -101,6 +101,10 @@ def test_block_stops_at_the_coulomb_time(tmp_path):
     assert np.ptp(u[:, 0]) < 1e-3 * DISTANCE  # (it moved as a whole)
     assert sum(s["cutbacks"] for s in steps) == 0
     assert max(s["iterations"] for s in steps) <= 8
+    # the energy account: the contact took the kinetic energy m v0^2 / 2 out as frictional dissipation
+    energy = steps[-1]["energy"]
+    assert energy["contact_dissipation"] == pytest.approx(0.5 * M * V0 ** 2, rel=5e-3)
+    assert abs(energy["balance_error"]) < 2e-3
 
 
 @pytest.mark.parametrize("mass", ["consistent", "lumped", "redistributed"])

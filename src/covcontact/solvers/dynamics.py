@@ -125,11 +125,17 @@ class DynamicModel:
         if K is not None:
             K.data *= 1.0 - g.alpha_f
             K = add_into(K, self.M, g.mass_factor(dt), self._cache)
-        # the work of the applied forces over the step (trapezoidal rule)
+        # the work of the applied forces and of the contact forces on the bodies over the step (trapezoidal rule)
         f = applied_forces(self.model, Rd, lam)
-        work = float(d["work"]) + 0.5 * float((d["f"] + f) @ (u - d["u"]))
+        du = u - d["u"]
+        work = float(d["work"]) + 0.5 * float((d["f"] + f) @ du)
+        rc = getattr(self.model, "last_contact_residual", None)
+        rc = np.zeros_like(R) if rc is None else rc.copy()
+        rc0 = d["rc"] if "rc" in d else np.zeros_like(R)
+        wc = float(d["wc"]) if "wc" in d else 0.0
         dyn = dict(d)
-        dyn.update(u=u.copy(), v=v, a=a, r=R, rd=Rd, f=f, work=np.array(work), time=np.array(float(d["time"]) + dt))
+        dyn.update(u=u.copy(), v=v, a=a, r=R, rd=Rd, f=f, work=np.array(work), time=np.array(float(d["time"]) + dt),
+                   rc=rc, wc=np.array(wc - 0.5 * float((rc0 + rc) @ du)))
         return Rd, K, trial.but(dynamics=dyn)
 
 
@@ -200,9 +206,13 @@ class Dynamic(QuasiStatic):
         if np.any(R[inert]):
             a[inert] = sla.spsolve(self.M[inert][:, inert].tocsc(), -R[inert])
         Rd = R + self.M @ a  # the supports' forces at rest or with the initial velocities' inertia
+        rc = getattr(model, "last_contact_residual", None)
         dyn = {"u": u.copy(), "u0": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
-               "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam)}
-        dyn["e0"] = np.array(self._energies(u, state.but(dynamics=dyn))["mechanical"])
+               "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam),
+               "rc": np.zeros_like(R) if rc is None else rc.copy(), "wc": np.array(0.0)}
+        e = self._energies(u, state.but(dynamics=dyn))
+        dyn["e0"] = np.array(e["mechanical"])
+        dyn["ec0"] = np.array(e["contact"])
         return state.but(dynamics=dyn)
 
     def advance(self, u: np.ndarray, state: State, step: int, lam: float) -> Increment:
@@ -277,12 +287,15 @@ class Dynamic(QuasiStatic):
         d = state.dynamics
         e = self._energies(u, state)
         dissipation = float(entry.get("plastic_work", 0.0))
-        balance = e["mechanical"] + dissipation - float(d["e0"]) - float(d["work"])
+        # what the contact took out of the bodies and does not hold as penalty energy: the frictional dissipation
+        # (and the contact law's numerical losses; a moving rigid tool's work counts against it)
+        contact_loss = -float(d.get("wc", 0.0)) - (e["contact"] - float(d.get("ec0", 0.0)))
+        balance = e["mechanical"] + dissipation + contact_loss - float(d["e0"]) - float(d["work"])
         scale = max(e["mechanical"], float(d["e0"]), abs(float(d["work"])), 1e-300)
         entry["time"] = float(d["time"])
         entry["energy"] = {"kinetic": e["kinetic"], "strain": e["strain"], "contact": e["contact"],
                            "external_work": float(d["work"]), "dissipation": dissipation,
-                           "balance_error": balance / scale}
+                           "contact_dissipation": contact_loss, "balance_error": balance / scale}
         return entry
 
     def _reactions(self, u: np.ndarray, lam: float, state: State) -> dict:

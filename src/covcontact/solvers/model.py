@@ -192,7 +192,10 @@ class Model:
         t1 = time.perf_counter()
         r, K, etrial = self.system.internal(u, committed.elements, guess.elements, want_K, pattern)
         t2 = time.perf_counter()
-        r += ev.blocks.residual()
+        rc = ev.blocks.residual()
+        r += rc
+        #: the contact forces' share of the last residual (the dynamic energy account reads it)
+        self.last_contact_residual = rc
         if want_K:
             CouplingPattern.scatter(K.data, pattern, triples)
         t3 = time.perf_counter()
