@@ -60,6 +60,18 @@ class Pressure:
 
 
 @dataclass
+class BodyForce:
+    """Dead body force ``lam * value`` on the cells of ``body`` (of its element set ``cells``, "" all of them): per unit
+    reference volume, or (``per_mass``) an acceleration times the material's density (a weight on part of a body)."""
+
+    body: str
+    cells: str
+    value: tuple[float, float, float]
+    name: str = ""
+    per_mass: bool = False
+
+
+@dataclass
 class Traction:
     """Dead traction ``lam * value`` (force per reference area) on a face set."""
 

@@ -42,6 +42,8 @@ class Problem:
     forces: list[NodalForce] = field(default_factory=list)
     pressures: list[Pressure] = field(default_factory=list)
     tractions: list[Traction] = field(default_factory=list)
+    #: body forces (``covcontact.loads.BodyForce``)
+    body_forces: list = field(default_factory=list)
     rigid: list[RigidBody] = field(default_factory=list)
     contacts: list[ContactPair] = field(default_factory=list)
     steps: Steps = field(default_factory=lambda: Steps.equal(1))
@@ -66,8 +68,8 @@ class Problem:
 
     @property
     def loads(self) -> list:
-        """Every nodal force, pressure and traction, in that order."""
-        return [*self.forces, *self.pressures, *self.tractions]
+        """Every nodal force, pressure, traction and body force, in that order."""
+        return [*self.forces, *self.pressures, *self.tractions, *self.body_forces]
 
     def body(self, name: str) -> Body:
         for b in self.bodies:

@@ -206,6 +206,8 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
     for name, (old, new) in variants.items():
         assert old in text, name
         body = text.replace(old, new)
+        if name == "plastic":
+            body = body.replace("*NODE PRINT", "*DLOAD\nBASE, GRAV, 9.81, 0., 0., -2.\n*NODE PRINT")
         if name == "sts-dload":
             body = body.replace("NODE TO SURFACE", "SURFACE TO SURFACE").replace(
                 "*NODE PRINT", "*DLOAD\nPUNCH, P2, 0.5\n*NODE PRINT")
@@ -229,6 +231,9 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
             mat = p.bodies[0].material
             assert mat.kind == 2 and mat.density == 2.0
             assert tuple(mat.hardening.stress) == (5.0, 6.0) and tuple(mat.hardening.strain) == (0.0, 0.1)
+            (g,) = p.body_forces  # GRAV: an acceleration on the element set (a unit direction times the magnitude)
+            assert (g.body, g.cells, g.per_mass) == ("BASE", "BASE", True)
+            assert g.value == pytest.approx((0.0, 0.0, -9.81))
         else:
             assert c.slave == ("PUNCH", "SSLAV") and c.type == "sts" and c.weighting == "area"
             assert p.bodies[1].mesh.face_sets["SSLAV"].shape == (4, 4)

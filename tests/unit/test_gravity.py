@@ -60,3 +60,56 @@ def test_gravity_needs_densities(tmp_path):
     with pytest.raises(InputError) as err:
         load_problem(path)
     assert "bodies[0].material.density" in str(err.value) and "gravity needs the mass density" in str(err.value)
+
+
+BODY_FORCE = """
+[problem]
+name = "loaded"
+[[bodies]]
+name = "col"
+element = "CELL"
+material = { model = "svk", E = 1.0e5, nu = 0.3, density = 2.0 }
+mesh = { generator = "block", lx = 1.0, ly = 0.5, lz = 2.0, nx = 2, ny = 1, nz = 4 }
+[bodies.cells]
+top = { box = [[-1.0, -1.0, 1.0], [2.0, 2.0, 3.0]] }
+[[dirichlet]]
+set = "col.zmin"
+[[body_force]]
+name = "own"
+body = "col"
+value = [0.0, 0.0, -3.0]
+[[body_force]]
+name = "upper"
+body = "col"
+cells = "top"
+acceleration = [1.0, 0.0, 0.0]
+[steps]
+count = 2
+[[stages]]
+name = "unload"
+steps = { count = 1 }
+remove = ["own"]
+targets = { upper = [2.0, 0.0, 0.0] }
+"""
+
+
+@pytest.mark.parametrize("cell", ["hex8", "tet10"])
+def test_body_forces(tmp_path, cell):
+    """A body force per unit volume on the whole column (b V) and an acceleration on its upper half (rho a V / 2),
+    ramped with the load factor like every load; a later stage removes the first and doubles the second: the
+    support carries exactly their sum at every step."""
+    path = tmp_path / "b.toml"
+    path.write_text(BODY_FORCE.replace("CELL", cell))
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    V = 1.0 * 0.5 * 2.0
+    expected = [[-0.5 * 2.0 * 0.5 * V, 0.0, 0.5 * 3.0 * V], [-2.0 * 0.5 * V, 0.0, 3.0 * V], [-2.0 * 2.0 * 0.5 * V,
+                                                                                             0.0, 0.0]]
+    for s, r in zip(res.summary["steps"], expected):
+        np.testing.assert_allclose(s["reactions"]["col.zmin"], r, atol=1e-9)
+    path.write_text(BODY_FORCE.replace("CELL", cell).replace('cells = "top"', 'cells = "tops"'))
+    with pytest.raises(InputError, match="body 'col' has no element set 'tops'; did you mean 'top'"):
+        load_problem(path)
+    path.write_text(BODY_FORCE.replace("CELL", cell).replace(", density = 2.0", ""))
+    with pytest.raises(InputError, match="an acceleration needs the density"):
+        load_problem(path)

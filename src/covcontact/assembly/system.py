@@ -15,7 +15,7 @@ from numba import njit
 from ..elements.base import NNODES
 from ..elements.solid import SolidBody
 from ..fem.cells import any_face
-from ..loads import NodalForce, Pressure
+from ..loads import BodyForce, NodalForce, Pressure
 from .pattern import Pattern
 
 
@@ -208,6 +208,8 @@ class System:
                 value = value / len(nodes)
             np.add.at(f, nodes, value[None, :])
             return f.ravel()
+        if isinstance(load, BodyForce):
+            return self._body_force(load, value)
         mesh = self.bodies[load.body].mesh
         faces = mesh.face_sets[load.set]
         off = self.offset(load.body)
@@ -216,6 +218,26 @@ class System:
         else:
             f[off: off + mesh.n_nodes] += face_load_vector(mesh.points, faces, area_only=True) * value[None, :]
         return f.ravel()
+
+    def _body_force(self, load, value: np.ndarray) -> np.ndarray:
+        """int N_a b dV0 over the load's cells: the row sums of the consistent mass matrix of unit density (or the
+        material's, ``per_mass``) times b."""
+        from ..elements.mass import element_masses
+
+        body = self.bodies[load.body]
+        chosen = body.mesh.element_sets[load.cells] if load.cells else np.arange(body.mesh.n_cells)
+        weight = np.zeros(self.n_nodes)
+        off = self.offset(load.body)
+        for _, idx, material, cell_type in body.material_parts(chosen):
+            rho = 1.0
+            if load.per_mass:
+                rho = getattr(material, "density", None)
+                if rho is None:
+                    raise ValueError(f"body {body.name!r}: a body force per mass needs the density of its material")
+            cells = body.mesh.cells_of(chosen[idx])[1]
+            me = element_masses(cell_type, body.mesh.points, cells, rho)
+            np.add.at(weight, cells.ravel() + off, me.sum(axis=2).ravel())
+        return (weight[:, None] * value[None, :]).ravel()
 
     def _build_loads(self) -> None:
         f = np.zeros(self.n_dofs)

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from ..description import COMPONENTS
-from ..loads import Dirichlet, Equation, NodalForce, Pressure, Traction
+from ..loads import BodyForce, Dirichlet, Equation, NodalForce, Pressure, Traction
 from .fields import dirichlet_values, read_motion, split_ref
 from .validate import Section, suggest
 
@@ -170,4 +170,35 @@ def read_equations(top: Section, sets: SetRefs, dirichlet: list[Dirichlet]) -> l
                 top.fail(f"the dof {'xyz'[comp]} of node {node} of {bname!r} is the eliminated (first) term of "
                          f"{where} and held by this condition: put another dof of the equation first",
                          f"dirichlet[{i}]")
+    return out
+
+
+def read_body_forces(top: Section, bodies: list) -> list[BodyForce]:
+    """Every ``[[body_force]]``: ``body``, optional ``cells`` (an element set of it), and ``value`` (force per unit
+    reference volume) or ``acceleration`` (times the density)."""
+    out = []
+    names = [b.name for b in bodies]
+    for i, b in enumerate(top.get("body_force", "array", [])):
+        bname = b.get("body", "str")
+        if bname not in names:
+            b.fail(f"no deformable body named {bname!r}{suggest(bname, names)} (bodies: {', '.join(names) or 'none'})",
+                   "body")
+        body = bodies[names.index(bname)]
+        cells = b.get("cells", "str", "")
+        if cells and cells not in body.mesh.element_sets:
+            known = ", ".join(sorted(body.mesh.element_sets)) or "none"
+            b.fail(f"body {bname!r} has no element set {cells!r}{suggest(cells, body.mesh.element_sets)} (known: "
+                   f"{known})", "cells")
+        if b.has("value") == b.has("acceleration"):
+            b.fail("give exactly one of 'value' (force per unit volume) or 'acceleration' (times the density)")
+        per_mass = b.has("acceleration")
+        value = b.get("acceleration" if per_mass else "value", "vector")
+        if per_mass:
+            for _, _, material, _ in body.material_parts(body.mesh.element_sets[cells] if cells else None):
+                if getattr(material, "density", None) is None:
+                    b.fail(f"missing: an acceleration needs the density of the material of body {bname!r}",
+                           "acceleration")
+        name = b.get("name", "str", "")
+        b.done()
+        out.append(BodyForce(bname, cells, value, name, per_mass))
     return out

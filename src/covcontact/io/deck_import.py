@@ -134,6 +134,7 @@ class _Writer:
         self.b = _Bodies(m)
         self.body_names = self._body_names()
         self.extra_nsets: dict[str, np.ndarray] = {}
+        self.extra_elsets: dict[str, np.ndarray] = {}
         self.extra_surfaces: dict[str, list[tuple[np.ndarray, int]]] = {}
         cell_of = np.concatenate([np.full(len(b[2]), b[1], dtype=object) for b in m.blocks])
         faces = [(els, face, where, "S") for kind, refs in m.surfaces.values() if kind == "ELEMENT"
@@ -231,21 +232,6 @@ class _Writer:
         return f"{self.body_names[body]}.{set_name}"
 
     # -- conditions and steps ---------------------------------------------------------------------
-    def _gravity(self) -> dict:
-        """``gravity`` of the problem from *DLOAD GRAV: covcontact's weight acts on every body in full from the start,
-        so a GRAV of the first step on every element, one vector (kept in the later steps), maps exactly (a static
-        step's answer does not depend on the ramp); anything else is listed as unsupported."""
-        loads = [(s, els, g, where) for s, st in enumerate(self.m.steps) for els, g, where in st.gravity]
-        if not loads:
-            return {}
-        g0 = loads[0][2]
-        for s, els, g, where in loads:
-            if s > 0 or not np.allclose(g, g0) or np.setdiff1d(self.b.el_labels, els).size:
-                self.unsupported.append(f"{where}: a *DLOAD GRAV other than one gravity on every element in the first "
-                                        f"step (covcontact's gravity acts on every body from the start)")
-                return {}
-        return {"gravity": [float(v) for v in g0]}
-
     def _amplitude(self, name: str | None, where: str):
         """The table (times, values, total time?) of amplitude ``name`` (None: none)."""
         if name is None or name.upper() in self.m.skipped_amplitudes:
@@ -355,7 +341,7 @@ class _Writer:
                 for key, spec in lspec.items():
                     v = at(spec)
                     if key not in names:
-                        names[key] = f"{'f' if key[0] == 'cload' else 'p'}{len(names) + 1}"
+                        names[key] = f"{ {'cload': 'f', 'dload': 'p'}.get(key[0], 'g') }{len(names) + 1}"
                         first[key] = self._load_entry(key, names[key], v if (s, j) == (0, 0) else 0.0)
                         if (s, j) != (0, 0):
                             targets[names[key]] = self._load_value(key, v)
@@ -381,7 +367,7 @@ class _Writer:
             total += period
         conds = ""
         for key, entry in first.items():
-            kind = "dirichlet" if key[0] not in ("cload", "dload") else ("force" if key[0] == "cload" else "pressure")
+            kind = {"cload": "force", "dload": "pressure", "grav": "body_force"}.get(key[0], "dirichlet")
             if kind == "dirichlet" and entry.get("value", 0.0) is None:
                 continue  # (a late condition the step cannot give: listed as unsupported)
             conds += _table(f"[[{kind}]]", entry)
@@ -433,16 +419,27 @@ class _Writer:
             if np.any(bodies < 0):
                 raise DeckError(f"{ld.where}: element {int(ld.elements[bodies < 0][0])} is not defined")
             for body in np.unique(bodies):
+                if ld.kind == "grav":  # an acceleration on the element set (times the density): a body force
+                    name = _name(ld.target) if not ld.target.isdigit() else f"_E{ld.target}"
+                    if ld.target.isdigit():
+                        self.extra_elsets[name] = ld.elements
+                    yield ("grav", int(body), name, ld.direction)
+                    continue
                 name = f"_P{_name(ld.target)}_{ld.dof}"
                 self.extra_surfaces[name] = [(ld.elements[bodies == body], ld.dof)]
                 yield ("dload", int(body), name, ld.dof)
 
     def _load_entry(self, key: tuple, name: str, v: float) -> dict:
+        if key[0] == "grav":
+            return {"name": name, "body": self.body_names[key[1]], "cells": key[2],
+                    "acceleration": self._load_value(key, v)}
         return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v)} | (
             {"distribution": "per_node"} if key[0] == "cload" else {})
 
     @staticmethod
     def _load_value(key: tuple, v: float):
+        if key[0] == "grav":
+            return [float(v) * d for d in key[3]]
         if key[0] == "cload":
             vec = [0.0, 0.0, 0.0]
             vec[key[3]] = float(v)
@@ -537,8 +534,7 @@ class _Writer:
         contacts = self._contacts() + self._equations()
         first = self.m.steps[0]
         head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(first, self.stage_steps[0][1])
-                                                                      if first.dynamic else {}),
-                                    **self._gravity()})
+                                                                      if first.dynamic else {})})
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
                             + conds + stages)
@@ -591,7 +587,7 @@ class _Writer:
         def own_nodes(labels):
             return labels[self.b.nodes_body(labels) == k]
 
-        for name, labels in m.elsets.items():
+        for name, labels in {**m.elsets, **self.extra_elsets}.items():
             labels = own_elements(labels)  # (GENERATE ranges may name labels no element has)
             if labels.size:
                 lines.append(f"*ELSET, ELSET={_name(name)}")

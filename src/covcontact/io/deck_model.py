@@ -58,7 +58,7 @@ class Boundary:
 class Load:
     """*CLOAD (node labels, dof, magnitude per node) or *DLOAD (element faces, pressure)."""
 
-    kind: str            # "cload" | "dload"
+    kind: str            # "cload" | "dload" | "grav"
     target: str          # set name or label as written
     dof: int             # CLOAD: 1..3; DLOAD: face number 1..6
     value: float
@@ -66,6 +66,7 @@ class Load:
     nodes: np.ndarray | None = None
     elements: np.ndarray | None = None
     amplitude: str | None = None
+    direction: tuple[float, float, float] | None = None   # GRAV: the unit direction (value: the magnitude)
 
 
 @dataclass
@@ -84,7 +85,6 @@ class Step:
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
-    gravity: list[tuple[np.ndarray, np.ndarray, str]] = field(default_factory=list)  # *DLOAD GRAV: (elements, g)
 
 
 @dataclass
@@ -558,7 +558,8 @@ class _Reader:
                     n = np.array([c.number(k, 3 + i, row, "the direction") for i in range(3)])
                     if not np.linalg.norm(n) > 0:
                         raise c.fail("the direction of GRAV must not be zero", k)
-                    st.gravity.append((els, g * n / np.linalg.norm(n), c.where(k)))
+                    st.loads.append(Load("grav", ref, 0, g, c.where(k), elements=els, amplitude=c.param("AMPLITUDE"),
+                                         direction=tuple(n / np.linalg.norm(n))))
                     continue
                 if not (lab.startswith("P") and lab[1:].isdigit()):
                     self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (only face pressures P1..P6)")

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..problem import Problem
 from .bodies_input import read_bodies
-from .conditions_input import SetRefs, read_dirichlet, read_equations, read_loads
+from .conditions_input import SetRefs, read_body_forces, read_dirichlet, read_equations, read_loads
 from .contact_input import read_contacts
 from .dynamics_input import check_densities, read_dynamics, read_initial_velocities
 from .fields import read_steps
@@ -38,8 +38,8 @@ def load_problem(path: str | Path) -> Problem:
     return problem_from_dict(raw, path)
 
 
-_TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "contact", "equation",
-              "steps", "stages", "initial_velocity", "solver", "output")
+_TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "body_force", "contact",
+              "equation", "steps", "stages", "initial_velocity", "solver", "output")
 
 
 def problem_from_dict(raw: dict, path: Path) -> Problem:
@@ -62,6 +62,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     sets = SetRefs(bodies, rigid)
     dirichlet = read_dirichlet(top, sets)
     forces, pressures, tractions = read_loads(top, sets)
+    body_forces = read_body_forces(top, bodies)
     contacts = read_contacts(top, sets, rigid)
     equations = read_equations(top, sets, dirichlet)
 
@@ -74,7 +75,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     steps = dynamics.steps() if dynamics is not None else read_steps(top.get("steps", "table", None))
     velocities = read_initial_velocities(top, sets)
 
-    named = named_conditions(top, dirichlet, forces, pressures, tractions)
+    named = named_conditions(top, dirichlet, forces, pressures, tractions, body_forces)
     for r in rigid:  # rigid bodies with free components: their force is a load later stages may change
         if r.free and r.name not in named:
             named[r.name] = ("rigid", r)
@@ -109,4 +110,5 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     return Problem(name=name, description=description, bodies=bodies, dirichlet=dirichlet, forces=forces,
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
-                   units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity, equations=equations)
+                   units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity, equations=equations,
+                   body_forces=body_forces)

@@ -10,11 +10,11 @@ from .fields import COMPONENT_NAMES, dirichlet_values, names, read_motion, read_
 from .validate import Section, suggest
 
 
-def named_conditions(top: Section, dirichlet, forces, pressures, tractions) -> dict:
+def named_conditions(top: Section, dirichlet, forces, pressures, tractions, body_forces=()) -> dict:
     """Name -> (kind, object) of the named Dirichlet conditions and loads (one namespace)."""
     named: dict = {}
     for kind, items in (("dirichlet", dirichlet), ("force", forces), ("pressure", pressures),
-                        ("traction", tractions)):
+                        ("traction", tractions), ("body_force", body_forces)):
         for i, obj in enumerate(items):
             if not obj.name:
                 continue
@@ -78,12 +78,12 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
         st.fail("names a condition twice", "release")
     remove = names(st, "remove")
     for n in remove:
-        check_name(st, "remove", n, ("force", "pressure", "traction", "rigid"), "load")
+        check_name(st, "remove", n, ("force", "pressure", "traction", "body_force", "rigid"), "load")
     targets = {}
     tsec = st.get("targets", "table", None)
     if tsec is not None:
         for n in list(tsec.data):
-            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction", "rigid"),
+            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction", "body_force", "rigid"),
                                    "Dirichlet condition or load")
             if n in release or n in remove:
                 tsec.fail(f"{n!r} is {'released' if n in release else 'removed'} and given a target in the "

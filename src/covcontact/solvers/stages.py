@@ -118,7 +118,8 @@ class StagePlan:
         loads = {}   # name -> (vector of the load at value 1 per component: a function value -> (n_dofs,))
         values = {}  # load name -> current value (np.ndarray)
         all_loads = [("force", f) for f in problem.forces] + [("pressure", p) for p in problem.pressures] \
-            + [("traction", t) for t in problem.tractions]
+            + [("traction", t) for t in problem.tractions] \
+            + [("body_force", b) for b in getattr(problem, "body_forces", [])]
         for i, (kind, load) in enumerate(all_loads):
             key = load.name or f"#{i}"
             loads[key] = load
