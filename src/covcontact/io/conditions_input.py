@@ -116,7 +116,7 @@ def read_equations(top: Section, sets: SetRefs, dirichlet: list[Dirichlet]) -> l
     out: list[Equation] = []
     dependent: dict[tuple, str] = {}   # (body, node, component) of each eliminated dof -> its equation
     refs: dict[tuple, list[tuple]] = {}  # eliminated dof -> the dofs of its other terms
-    for k, e in enumerate(top.get("equation", "array", [])):
+    for e in top.get("equation", "array", []):
         raw = e.get("terms", "any")
         name = e.get("name", "str", "")
         e.done()
@@ -178,7 +178,7 @@ def read_body_forces(top: Section, bodies: list) -> list[BodyForce]:
     reference volume) or ``acceleration`` (times the density)."""
     out = []
     names = [b.name for b in bodies]
-    for i, b in enumerate(top.get("body_force", "array", [])):
+    for b in top.get("body_force", "array", []):
         bname = b.get("body", "str")
         if bname not in names:
             b.fail(f"no deformable body named {bname!r}{suggest(bname, names)} (bodies: {', '.join(names) or 'none'})",
