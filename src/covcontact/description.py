@@ -211,6 +211,7 @@ class Stage:
     contacts: pair name -> True (switched on) or False (switched off) at the start of the stage.
     dynamics: the time stepping of a dynamic stage (None: quasi-static load stepping).
     friction: pair name -> the Coulomb coefficient of a frictional pair from the start of this stage on.
+    ramp: the loads go linearly to their targets (True) or take them at once (False, as a step load).
     """
 
     name: str
@@ -222,6 +223,7 @@ class Stage:
     contacts: dict = field(default_factory=dict)
     dynamics: Dynamics | None = None  # a dynamic stage (None: quasi-static)
     friction: dict = field(default_factory=dict)
+    ramp: bool = True  # False: the loads take their targets at once (the prescribed displacements still ramp)
 
 
 @dataclass

@@ -44,6 +44,8 @@ class Problem:
     tractions: list[Traction] = field(default_factory=list)
     #: body forces (``covcontact.loads.BodyForce``)
     body_forces: list = field(default_factory=list)
+    #: the first stage's loads ramp with the load factor (False: they act in full at once)
+    ramp: bool = True
     rigid: list[RigidBody] = field(default_factory=list)
     contacts: list[ContactPair] = field(default_factory=list)
     steps: Steps = field(default_factory=lambda: Steps.equal(1))

@@ -113,3 +113,20 @@ def test_body_forces(tmp_path, cell):
     path.write_text(BODY_FORCE.replace("CELL", cell).replace(", density = 2.0", ""))
     with pytest.raises(InputError, match="an acceleration needs the density"):
         load_problem(path)
+
+
+def test_step_load_in_a_dynamic_stage(tmp_path):
+    """``ramp = false``: the loads act in full from the stage's first instant (the initial acceleration included), so
+    an unsupported column under a body force falls as -b t^2 / (2 rho) from the start, exactly (a constant
+    acceleration, which the trapezoidal rule integrates exactly)."""
+    text = BODY_FORCE.replace("CELL", "hex8").replace('[[dirichlet]]\nset = "col.zmin"\n', "")
+    text = text.split("[steps]")[0].replace('[problem]\nname = "loaded"', '[problem]\nname = "drop"\nprocedure = '
+                                             '"dynamic"\ndt = 0.05\nt_end = 0.5\nmethod = "newmark"\nramp = false')
+    text = text.replace('value = [0.0, 0.0, -3.0]', 'value = [0.0, 0.0, -4.0]').replace(
+        'acceleration = [1.0, 0.0, 0.0]', 'acceleration = [0.0, 0.0, 0.0]')
+    path = tmp_path / "d.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    u = res.u.reshape(-1, 3)
+    np.testing.assert_allclose(u[:, 2], -0.5 * (4.0 / 2.0) * 0.5 ** 2, rtol=1e-10)  # b / rho = 2

@@ -19,7 +19,7 @@ from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
 from ..fem.shapes import shape_functions
 from ..materials.hyperelastic import VOIGT, Material, material_energy
 from ..materials.hyperelastic import VOIGT_PAIRS as _PAIRS
-from ..materials.update import material_update
+from ..materials.update import material_update_h
 from .base import BLOCKS_PER_THREAD, ElementBody, SolidStress, add_cauchy_pk2, block_range, gather, inverse3
 
 __all__ = ["BLOCKS_PER_THREAD", "SOLID_CELLS", "SolidBody", "SolidStress", "solid_chunk", "solid_gauss_fields"]
@@ -50,6 +50,18 @@ def _deformation_gradient(ue, G, F, node_last):
             for a in range(ue.shape[0]):
                 s += ue[a, i] * (G[j, a] if node_last else G[a, j])
             F[i, j] = s
+
+
+@njit(cache=True, inline="always")
+def _displacement_gradient(ue, G, F, H, node_last):
+    """H = sum_a u_a (x) G_a (from the displacements: every digit of a small strain) and F = I + H."""
+    for i in range(3):
+        for j in range(3):
+            s = 0.0
+            for a in range(ue.shape[0]):
+                s += ue[a, i] * (G[j, a] if node_last else G[a, j])
+            H[i, j] = s
+            F[i, j] = s + (1.0 if i == j else 0.0)
 
 
 @njit(cache=True, inline="always")
@@ -118,6 +130,7 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, Gt, F, S, D
     """
     nen = Xe.shape[0]
     nd = 3 * nen
+    H = np.empty((3, 3))
     for r in range(nd):
         fe[r] = 0.0
     if want_K:
@@ -134,7 +147,8 @@ def _element(kind, params, Xe, ue, dNdxi, w, want_K, Ke, fe, J0, Ji, Gt, F, S, D
             flag = 2
             continue
         _gradients_t(dNg, Ji, ue, Gt, F)
-        if material_update(kind, params, F, hist_n[g], hist[g], S, D) != 0 and flag == 0:
+        _displacement_gradient(ue, Gt, F, H, True)
+        if material_update_h(kind, params, F, H, hist_n[g], hist[g], S, D) != 0 and flag == 0:
             flag = 1
         wd = w[g] * det
         # P = F S (scaled by the integration weight)
@@ -224,6 +238,7 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, 
     for t in prange(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe, ue, G, J0, Ji, F, S, D = _work(nen)
+        H = np.empty((3, 3))
         hscr = np.empty(hist_n.shape[2])
         for e in range(lo, hi):
             gather(X, u, conn, e, Xe, ue)
@@ -245,13 +260,14 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, 
                 if mode == 0:
                     out[e, 0] += wd * material_energy(kind, params, F)
                     continue
-                material_update(kind, params, F, hist_n[e, g], hscr, S, D)
+                _displacement_gradient(ue, G, F, H, False)
+                material_update_h(kind, params, F, H, hist_n[e, g], hscr, S, D)
                 add_cauchy_pk2(F, S, wd, out[e])
                 for I in range(6):
                     i = _PAIRS[I, 0]
                     j = _PAIRS[I, 1]
-                    c = F[0, i] * F[0, j] + F[1, i] * F[1, j] + F[2, i] * F[2, j]
-                    out[e, 12 + I] += wd * 0.5 * (c - (1.0 if i == j else 0.0))
+                    cm = H[i, j] + H[j, i] + H[0, i] * H[0, j] + H[1, i] * H[1, j] + H[2, i] * H[2, j]
+                    out[e, 12 + I] += wd * 0.5 * cm
             if mode == 2 and vol > 0.0:
                 for r in range(18):
                     out[e, r] /= vol

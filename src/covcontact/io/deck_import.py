@@ -302,11 +302,18 @@ class _Writer:
             for j, tau in enumerate(breaks):
                 targets = {}
 
-                def at(spec, tau=tau, period=period, total=total):
+                def at(spec, tau=tau, period=period, total=total, dynamic=step.dynamic):
                     v0, M, amp = spec
-                    if amp is None:
-                        return v0 + (M - v0) * tau / period
+                    if amp is None:  # a static step ramps its changes, a dynamic one applies them at once
+                        return M if dynamic else v0 + (M - v0) * tau / period
                     return float(np.interp(tau + (total if amp[2] else 0.0), amp[0], amp[1])) * M
+
+                # a dynamic stage whose loads are constant over it (no amplitude, or a flat piece of one) takes them
+                # at once (CalculiX's and Abaqus' step amplitude of *DYNAMIC); else they go linearly between the cuts
+                t0 = breaks[j - 1] if j else 0.0
+                jump = step.dynamic and all(amp is None or at((0.0, 1.0, amp), t0) == at((0.0, 1.0, amp))
+                                            for _, _, amp in list(lspec.values()))
+                self.stage_jump = getattr(self, "stage_jump", []) + [jump]
 
                 stage_name = f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else "")
                 for key, spec in bspec.items():
@@ -352,7 +359,7 @@ class _Writer:
                 self.stage_steps.append((s, duration))
                 if (s, j) == (0, 0):
                     continue
-                st = {"name": stage_name, **self._timing(step, duration)}
+                st = {"name": stage_name, **self._timing(step, duration, jump)}
                 if release and j == 0:
                     st["release"] = release
                 changed = {f"pair{k + 1}": mu for k, (inter, *_rest) in enumerate(m.pairs)
@@ -378,7 +385,7 @@ class _Writer:
             text += _table("[[stages]]", {**st, "steps": steps})
         return conds, text
 
-    def _timing(self, step, duration: float) -> dict:
+    def _timing(self, step, duration: float, jump: bool = False) -> dict:
         """The steps (``steps``) of a stage that makes ``duration`` of the deck's step or, for *DYNAMIC, its dynamic
         keys: HHT with rho_inf = (1 + alpha) / (1 - alpha), the deck's increment as dt (automatic within its min and
         max unless DIRECT)."""
@@ -394,6 +401,8 @@ class _Writer:
             return {"steps": out}
         out = {"procedure": "dynamic", "dt": min(a, duration), "t_end": duration, "method": "hht",
                "rho_inf": (1.0 + step.alpha) / (1.0 - step.alpha)}
+        if jump:
+            out["ramp"] = False
         if not step.direct and lo and hi:
             out.update({"dt_min": min(lo, a, duration), "dt_max": max(min(hi, duration), min(a, duration))})
         return out
@@ -533,8 +542,8 @@ class _Writer:
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
         first = self.m.steps[0]
-        head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(first, self.stage_steps[0][1])
-                                                                      if first.dynamic else {})})
+        head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(
+            first, self.stage_steps[0][1], self.stage_jump[0]) if first.dynamic else {})})
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
                             + conds + stages)

@@ -55,6 +55,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     units = meta.get("units", "str", "")
     dynamics = read_dynamics(meta)
     gravity = meta.get("gravity", "vector", None)
+    ramp = meta.get("ramp", "bool", True)
     meta.done()
 
     bodies = read_bodies(top, base)
@@ -111,4 +112,4 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
                    units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity, equations=equations,
-                   body_forces=body_forces)
+                   body_forces=body_forces, ramp=ramp)

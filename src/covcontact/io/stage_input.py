@@ -156,5 +156,6 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                           f"only where it has friction from the start; frictional pairs: {known})", n)
             friction[n] = fsec.get(n, "float", nonnegative=True)
         fsec.done()
+    ramp = st.get("ramp", "bool", True)
     st.done()
-    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch, dynamics, friction)
+    return Stage(name, steps, tuple(release), targets, tuple(remove), motions, switch, dynamics, friction, ramp)

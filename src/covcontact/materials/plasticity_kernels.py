@@ -96,6 +96,16 @@ def _hardening(params, alpha):
 
 @njit(cache=True)
 def j2_response(params, F, hist_n, hist, S, D):
+    """``j2_response_h`` with H = F - I formed from F."""
+    H = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            H[i, j] = F[i, j] - (1.0 if i == j else 0.0)
+    return j2_response_h(params, F, H, hist_n, hist, S, D)
+
+
+@njit(cache=True)
+def j2_response_h(params, F, H, hist_n, hist, S, D):
     """Second Piola-Kirchhoff stress S (6,), algorithmic tangent D = dS/dE (6, 6) and trial history hist
     (NHIST,) at the deformation gradient F (3, 3) from the committed history hist_n (read only).
 
@@ -115,16 +125,17 @@ def j2_response(params, F, hist_n, hist, S, D):
     sq2 = 1.4142135623730951
     isq2 = 0.7071067811865476
 
-    # Green-Lagrange strain from H = F - I (accurate at small strain) and its spectral decomposition
-    h00 = F[0, 0] - 1.0
-    h11 = F[1, 1] - 1.0
-    h22 = F[2, 2] - 1.0
-    h01 = F[0, 1]
-    h02 = F[0, 2]
-    h10 = F[1, 0]
-    h12 = F[1, 2]
-    h20 = F[2, 0]
-    h21 = F[2, 1]
+    # Green-Lagrange strain from the displacement gradient H (F = I + H; formed from the displacements, H keeps
+    # every digit of a small strain) and its spectral decomposition
+    h00 = H[0, 0]
+    h11 = H[1, 1]
+    h22 = H[2, 2]
+    h01 = H[0, 1]
+    h02 = H[0, 2]
+    h10 = H[1, 0]
+    h12 = H[1, 2]
+    h20 = H[2, 0]
+    h21 = H[2, 1]
     g00 = h00 + 0.5 * (h00 * h00 + h10 * h10 + h20 * h20)
     g11 = h11 + 0.5 * (h01 * h01 + h11 * h11 + h21 * h21)
     g22 = h22 + 0.5 * (h02 * h02 + h12 * h12 + h22 * h22)

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from numba import njit
 
-from .hyperelastic import material_response
-from .plasticity_kernels import J2, j2_response
+from .hyperelastic import material_response, material_response_h
+from .plasticity_kernels import J2, j2_response, j2_response_h
 
 
 @njit(cache=True)
@@ -23,3 +23,14 @@ def material_update(kind, params, F, hist_n, hist, S, D):
     for k in range(hist.shape[0]):
         hist[k] = hist_n[k]
     return material_response(kind, params, F, S, D)
+
+
+@njit(cache=True)
+def material_update_h(kind, params, F, H, hist_n, hist, S, D):
+    """``material_update`` with the displacement gradient H = F - I as the element formed it from the displacements
+    (every digit of a small strain kept)."""
+    if kind == J2:
+        return j2_response_h(params, F, H, hist_n, hist, S, D)
+    for k in range(hist.shape[0]):
+        hist[k] = hist_n[k]
+    return material_response_h(kind, params, F, H, S, D)

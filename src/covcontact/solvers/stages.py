@@ -102,6 +102,8 @@ class StageSpec:
     friction: dict = field(default_factory=dict)
     #: conditions that start in this stage, from the displacement their dofs have then
     applied_names: tuple[str, ...] = ()
+    #: the loads go linearly to their targets (False: they take them at once, a step load)
+    ramp: bool = True
 
     @property
     def lam_end(self) -> float:
@@ -147,6 +149,7 @@ class StagePlan:
         self.stages.append(self._spec(0, problem.stage_name, problem.steps.factors, conds, np.zeros(0, np.int64),
                                       loads, values, targets, motions, contacts, ()))
         self.stages[0].friction = {c.name: c.friction for c in problem.contacts if c.friction > 0.0}
+        self.stages[0].ramp = bool(getattr(problem, "ramp", True))
         zero = np.zeros(3)
         self.stages[0].rigid_loads = {ref.name: (zero, ref.force, zero, ref.moment)
                                       for ref in getattr(system, "reference", [])}
@@ -186,6 +189,7 @@ class StagePlan:
             spec.rigid_loads = _carried_rigid_loads(prev, st)
             spec.friction = {**prev.friction, **getattr(st, "friction", {})}
             spec.applied_names = tuple(c.name for c in starting)
+            spec.ramp = bool(getattr(st, "ramp", True))
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
@@ -322,7 +326,8 @@ class Loading:
     def external(self, lam: float) -> np.ndarray:
         """External force vector at lam: loads, the released reactions' ramp, the held forces."""
         s = self.spec
-        f = s.load_start + lam * (s.load_target - s.load_start)
+        w = lam if s.ramp else 1.0  # (a step load: the target from the stage's first instant, at lam = 0 already)
+        f = s.load_start + w * (s.load_target - s.load_start)
         if s.released.size or s.released_pairs or np.any(self.held):
             f = f + max(0.0, 1.0 - lam) * self.release + self.held
         return f
