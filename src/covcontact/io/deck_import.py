@@ -79,7 +79,10 @@ class _Bodies:
         top = int(self.el_labels.max()) + 1 if self.el_labels.size else 1
         self.el_index = np.full(top, -1, dtype=np.int64)
         if np.unique(self.el_labels).size != self.el_labels.size:
-            raise DeckError("an element label is used twice")
+            order = np.sort(self.el_labels)
+            dup = int(order[1:][order[1:] == order[:-1]][0])
+            where = [w for (_, _, labels, _), w in zip(m.blocks, m.block_where) if dup in labels][-1]
+            raise DeckError(f"{where}: *ELEMENT: element {dup} is defined twice (element labels are unique in a deck)")
         self.el_index[self.el_labels] = np.arange(self.el_labels.size)
         rows = np.concatenate([np.repeat(np.arange(len(c)) + off, c.shape[1]) for c, off in
                                zip(conn, np.cumsum([0] + [len(c) for c in conn])[:-1])]) if conn else np.zeros(0, int)

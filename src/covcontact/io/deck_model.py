@@ -146,6 +146,7 @@ class _Reader:
         self.interaction: str | None = None
         self.step: Step | None = None
         self.changing: str | None = None  # the interaction of the step's *CHANGE FRICTION
+        self.node_cards: list[str] = []
         nodes, coords = [], []
         k = 0
         while k < len(cards):
@@ -158,6 +159,7 @@ class _Reader:
             if c.name == "HEADING":
                 m.heading = " ".join(c.data)[:200]
             elif c.name == "NODE":
+                self.node_cards.append(c.where())
                 lab, xyz = self._nodes(c)
                 nodes.append(lab)
                 coords.append(xyz)
@@ -293,7 +295,8 @@ class _Reader:
             lab, xyz = lab[order], xyz[order]
             if lab.size > 1 and np.any(lab[1:] == lab[:-1]):
                 dup = int(lab[1:][lab[1:] == lab[:-1]][0])
-                raise DeckError(f"node {dup} is defined twice")
+                raise DeckError(f"*NODE: node {dup} is defined twice (node labels are unique in a deck; the file and "
+                                f"line of each *NODE card: {', '.join(self.node_cards)})")
             self.m.node_labels, self.m.X = lab, xyz
         elif nodes:
             nodes.clear()
