@@ -170,6 +170,9 @@ def _run_deck(args) -> int:
     imported = _import(deck, out / "deck" / f"{deck.stem}.toml", args.ignore_unsupported)
     if imported is None:
         return 2
+    from .io.bodies_input import preload
+
+    preload(imported.read)  # (the meshes the import built: not read back from its files)
     problem = load_problem(imported.problem)
     _check_solver(args.solver or problem.solver.linear)
     table = DatTable(imported.labels, out / f"{deck.stem}.dat")

@@ -476,3 +476,28 @@ def test_equation_input_errors(tmp_path):
         with pytest.raises(InputError) as err:
             load_problem(path)
         assert words in str(err.value) and "\n" not in str(err.value), (words, str(err.value))
+
+
+def test_imported_meshes_equal_their_files(tmp_path):
+    """The meshes an import builds while writing its mesh files (what `covcontact run DECK.inp` hands the loader)
+    equal those files read back: nodes, blocks, node, element and face sets."""
+    from covcontact.mesh import read_mesh
+
+    text = two_block_deck(tmp_path / "tb.inp").read_text().replace("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE",
+                                                                    "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
+                                                                    "*SURFACE, NAME=SSLAV\nPBOT, S1")
+    deck = tmp_path / "sts.inp"
+    deck.write_text(text.replace("*NODE PRINT", "*DLOAD\nPUNCH, P2, 0.5\n*NODE PRINT"))
+    imp = import_deck(deck, tmp_path / "m" / "p.toml")
+    assert sorted(imp.read) == sorted(imp.meshes) and len(imp.meshes) == 2
+    for path, mesh in imp.read.items():
+        ref = read_mesh(path)
+        np.testing.assert_array_equal(mesh.points, ref.points)
+        assert [(b.cell_type, b.cells.tolist()) for b in mesh.blocks] == [(b.cell_type, b.cells.tolist())
+                                                                           for b in ref.blocks]
+        for ours, theirs in ((mesh.node_sets, ref.node_sets), (mesh.element_sets, ref.element_sets),
+                             (mesh.face_sets, ref.face_sets)):
+            assert sorted(ours) == sorted(theirs)
+            for k in ours:
+                np.testing.assert_array_equal(ours[k], theirs[k])
+    assert imp.read[imp.meshes[1]].face_sets["SSLAV"].shape == (4, 4)

@@ -28,6 +28,18 @@ def mesh_generators() -> dict:
 _MESH_FILES: dict = {}
 
 
+#: meshes already read, by resolved path and modification time (``preload``): the files an import just wrote
+_PRELOADED: dict = {}
+
+
+def preload(meshes: dict) -> None:
+    """Hand the loader meshes it would read from these files (path -> Mesh; the files as they are now)."""
+    _PRELOADED.clear()
+    for path, mesh in meshes.items():
+        p = Path(path)
+        _PRELOADED[(str(p.resolve()), p.stat().st_mtime_ns)] = mesh
+
+
 def _read_once(path: Path, element: str | None = None):
     """A mesh file read once per problem file for all the bodies that take parts of it (keyed by path and
     modification time); callers copy or select from it, never change it. A file of cell types that do not mix
@@ -35,6 +47,8 @@ def _read_once(path: Path, element: str | None = None):
     from ..mesh.io import MixedTypesError, read_mesh
 
     key = (str(path.resolve()), path.stat().st_mtime_ns)
+    if key in _PRELOADED:
+        return _PRELOADED[key]
     if key not in _MESH_FILES:
         _MESH_FILES.clear()  # one file at a time: a problem's bodies come one after the other
         try:

@@ -32,6 +32,8 @@ class Imported:
     meshes: list[Path]
     labels: Path
     unsupported: list[str] = field(default_factory=list)
+    #: each mesh file's Mesh, built while writing it (``bodies_input.preload`` spares reading them back)
+    read: dict = field(default_factory=dict, repr=False)
 
 
 def _name(text: str) -> str:
@@ -568,30 +570,25 @@ class _Writer:
                                       "periods": [d for _, d in self.stage_steps],
                                       "deck_step": [k for k, _ in self.stage_steps]}))
         meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
-        return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)))
+        return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)), self.meshes)
 
     def _write_mesh(self) -> None:
         """One mesh file per body (its nodes, elements, sets and surfaces): bodies of cell types that do not mix
-        (a hex20 part and a tet10 part) each read on their own."""
+        (a hex20 part and a tet10 part) each read on their own. ``self.meshes``: each file's Mesh, built from the
+        same content without reading the file back (``covcontact run DECK.inp`` hands them to the loader)."""
+        from ..mesh.io import mesh_from_meshio
+
+        self.meshes = {}
         for k in range(self.b.n):
-            self._write_body_mesh(k, self.mesh_path.with_suffix(f".{k + 1}.inp"))
+            path = self.mesh_path.with_suffix(f".{k + 1}.inp")
+            content = self._body_content(k)
+            path.write_text(self._body_text(content))
+            self.meshes[path] = mesh_from_meshio(self._body_meshio(content), path, surfaces=(
+                {n: [(es, face) for es, face in refs] for n, refs in content["surfaces"].items()}, {}))
 
-    def _write_body_mesh(self, k: int, path: Path) -> None:
+    def _body_content(self, k: int) -> dict:
+        """Body k's nodes, element blocks, element and node sets and element surfaces, by deck labels."""
         m = self.m
-        meshio_type = {"hex8": "C3D8", "hex20": "C3D20", "tet10": "C3D10", "tet4": "C3D4", "wedge6": "C3D6"}
-        mine = self.b.of_node == k
-        lines = ["*NODE"]
-        lines += [f"{lab}, {x!r}, {y!r}, {z!r}" for lab, (x, y, z) in zip(m.node_labels[mine].tolist(),
-                                                                             m.X[mine].tolist())]
-        for j, (_, cell, labels, conn) in enumerate(m.blocks):
-            sel = self.b.of_element[self._block_range(j)] == k
-            if sel.any():
-                lines.append(f"*ELEMENT, TYPE={meshio_type[cell]}")
-                lines += [", ".join(map(str, row)) for row in np.column_stack([labels[sel], conn[sel]]).tolist()]
-
-        def label_lines(values) -> list[str]:
-            v = np.asarray(values).tolist()
-            return [", ".join(map(str, v[i:i + 16])) for i in range(0, len(v), 16)]
 
         def own_elements(labels):
             return labels[self.b.elements_body(labels) == k]
@@ -599,31 +596,89 @@ class _Writer:
         def own_nodes(labels):
             return labels[self.b.nodes_body(labels) == k]
 
+        mine = self.b.of_node == k
+        blocks = []
+        for j, (_, cell, labels, conn) in enumerate(m.blocks):
+            sel = self.b.of_element[self._block_range(j)] == k
+            if sel.any():
+                blocks.append((cell, labels[sel], conn[sel]))
+        elsets = {}
         for name, labels in {**m.elsets, **self.extra_elsets}.items():
             labels = own_elements(labels)  # (GENERATE ranges may name labels no element has)
             if labels.size:
-                lines.append(f"*ELSET, ELSET={_name(name)}")
-                lines += label_lines(labels)
+                elsets[_name(name)] = labels
         node_sets = {**{_name(n): v for n, v in m.nsets.items()}, **self.extra_nsets}
         node_sets.update({_name(n): v for n, (kind, v) in m.surfaces.items() if kind == "NODE" and _name(n) not in
                           node_sets})
+        nsets = {}
         for name, labels in node_sets.items():
             labels = own_nodes(labels)  # (nodes of no element carry no unknowns)
             if labels.size:
-                lines.append(f"*NSET, NSET={name}")
-                lines += label_lines(labels)
-        surfaces = {_name(n): [(els, face) for els, face, _ in refs] for n, (kind, refs) in m.surfaces.items()
-                    if kind == "ELEMENT"}
-        surfaces.update(self.extra_surfaces)
-        for name, refs in surfaces.items():
+                nsets[name] = labels
+        all_surfaces = {_name(n): [(els, face) for els, face, _ in refs] for n, (kind, refs) in m.surfaces.items()
+                        if kind == "ELEMENT"}
+        all_surfaces.update(self.extra_surfaces)
+        surfaces = {}
+        for name, refs in all_surfaces.items():
             rows = []
             for j, (els, face) in enumerate(refs):
                 els = own_elements(els)
                 if els.size:
-                    lines.append(f"*ELSET, ELSET=__{name}_{j + 1}")
-                    lines += label_lines(els)
-                    rows.append(f"__{name}_{j + 1}, S{face}")
+                    elsets[f"__{name}_{j + 1}"] = els
+                    rows.append((f"__{name}_{j + 1}", face))
             if rows:
-                lines.append(f"*SURFACE, NAME={name}, TYPE=ELEMENT")
-                lines += rows
-        path.write_text("\n".join(lines) + "\n")
+                surfaces[name] = rows
+        return {"labels": m.node_labels[mine], "X": m.X[mine], "blocks": blocks, "elsets": elsets, "nsets": nsets,
+                "surfaces": surfaces}
+
+    @staticmethod
+    def _body_text(c: dict) -> str:
+        """The body's mesh file: *NODE, *ELEMENT per block, *ELSET, *NSET, *SURFACE (Abaqus, as covcontact reads it)."""
+        abaqus_type = {"hex8": "C3D8", "hex20": "C3D20", "tet10": "C3D10", "tet4": "C3D4", "wedge6": "C3D6"}
+
+        def label_lines(values) -> list[str]:
+            v = np.asarray(values).tolist()
+            return [", ".join(map(str, v[i:i + 16])) for i in range(0, len(v), 16)]
+
+        lines = ["*NODE"]
+        lines += [f"{lab}, {x!r}, {y!r}, {z!r}" for lab, (x, y, z) in zip(c["labels"].tolist(), c["X"].tolist())]
+        for cell, labels, conn in c["blocks"]:
+            lines.append(f"*ELEMENT, TYPE={abaqus_type[cell]}")
+            lines += [", ".join(map(str, row)) for row in np.column_stack([labels, conn]).tolist()]
+        for name, labels in c["elsets"].items():
+            if not name.startswith("__") or not any(name.startswith(f"__{s}_") for s in c["surfaces"]):
+                lines.append(f"*ELSET, ELSET={name}")
+                lines += label_lines(labels)
+        for name, labels in c["nsets"].items():
+            lines.append(f"*NSET, NSET={name}")
+            lines += label_lines(labels)
+        for name, rows in c["surfaces"].items():
+            for es, _ in rows:
+                lines.append(f"*ELSET, ELSET={es}")
+                lines += label_lines(c["elsets"][es])
+            lines.append(f"*SURFACE, NAME={name}, TYPE=ELEMENT")
+            lines += [f"{es}, S{face}" for es, face in rows]
+        return "\n".join(lines) + "\n"
+
+    @staticmethod
+    def _body_meshio(c: dict):
+        """The meshio mesh the body's file reads as (points in file order, a block per *ELEMENT card, the sets as
+        indices), built without the text."""
+        import meshio
+
+        vtk = {"hex8": "hexahedron", "hex20": "hexahedron20", "tet10": "tetra10", "tet4": "tetra", "wedge6": "wedge"}
+        labels = c["labels"]
+        cells = [(vtk[cell], np.searchsorted(labels, conn)) for cell, _, conn in c["blocks"]]
+        el_labels = [lab for _, lab, _ in c["blocks"]]
+        cell_sets = {}
+        for name, labs in c["elsets"].items():
+            per_block = []
+            for lab in el_labels:
+                order = np.argsort(lab, kind="stable")
+                pos = np.searchsorted(lab[order], labs)
+                pos = np.clip(pos, 0, max(lab.size - 1, 0))
+                hit = lab[order][pos] == labs if lab.size else np.zeros(labs.size, dtype=bool)
+                per_block.append(order[pos[hit]].astype(np.int64))
+            cell_sets[name] = per_block
+        point_sets = {name: np.searchsorted(labels, labs).astype(np.int32) for name, labs in c["nsets"].items()}
+        return meshio.Mesh(c["X"].copy(), cells, point_sets=point_sets, cell_sets=cell_sets)

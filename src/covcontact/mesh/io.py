@@ -181,6 +181,14 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         lines = [ln for ln in said.getvalue().splitlines() if ln.strip()]
         why = lines[0] if lines else f"{type(exc).__name__}: {exc}"
         raise _fail(p, f"cannot read mesh ({why})") from exc
+    return mesh_from_meshio(m, p, cell_type)
+
+
+def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,
+                     surfaces: tuple[dict, dict] | None = None) -> Mesh:
+    """The Mesh of a meshio mesh ``m`` read from ``p`` (what ``read_mesh`` does after meshio; an Abaqus file's
+    *SURFACE definitions ``surfaces`` (element, node: as ``abaqus.read_surfaces`` gives them) are read from ``p``
+    unless given)."""
     found = sorted({_VOLUME[b.type] for b in m.cells if b.type in _VOLUME})
     from meshio._mesh import topological_dimension
 
@@ -238,18 +246,18 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
         kept = keep(np.concatenate(nodes))
         if name not in mesh.node_sets and kept.size:
             mesh.add_node_set(name, kept)
-    if p.suffix.lower() == ".inp":
-        _abaqus_surfaces(p, m, mesh, vol, first, keep)
+    if p.suffix.lower() == ".inp" or surfaces is not None:
+        _abaqus_surfaces(p, m, mesh, vol, first, keep, surfaces)
     return mesh
 
 
-def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep) -> None:
+def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep, surfaces=None) -> None:
     """The deck's *SURFACE definitions as face sets (element surfaces: their faces, matched outward) and node
     sets (node surfaces), each element surface also a node set of its nodes."""
     from .abaqus import HEX_FACES, TET_FACES, WEDGE_FACES, read_surfaces
 
     try:
-        elem, node = read_surfaces(p)
+        elem, node = read_surfaces(p) if surfaces is None else surfaces
     except (ValueError, OSError) as exc:
         raise _fail(p, str(exc)) from exc
     for name, refs in elem.items():
