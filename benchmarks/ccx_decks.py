@@ -140,23 +140,26 @@ def compare(ours: str, ref: str) -> list[dict]:
 
 
 def candidates(folder: Path) -> list[str]:
+    """The decks of ``folder`` whose keywords and element types covcontact reads."""
+    import tempfile
+
     from covcontact.io.deck import read_deck
     from covcontact.io.deck_model import ELEMENTS, SUPPORTED
 
     out = []
-    for p in sorted(folder.glob("*.inp")) + sorted(folder.glob("*.inp.gz")):
-        name = p.name.removesuffix(".gz").removesuffix(".inp")
-        try:
-            text = _text(folder / f"{name}.inp")
-            tmp = Path("/tmp") / f"_ccx_{name}.inp"
-            tmp.write_text(text)
-            cards = read_deck(tmp)
-        except Exception:  # noqa: BLE001 (a deck the survey cannot read is simply not a candidate)
-            continue
-        names = {c.name for c in cards}
-        types = {c.params.get("TYPE", "").upper() for c in cards if c.name == "ELEMENT"}
-        if names <= set(SUPPORTED) and types and types <= set(ELEMENTS):
-            out.append(name)
+    with tempfile.TemporaryDirectory() as tmp_dir:
+        for p in sorted(folder.glob("*.inp")) + sorted(folder.glob("*.inp.gz")):
+            name = p.name.removesuffix(".gz").removesuffix(".inp")
+            try:  # (a gzipped deck is read from a plain copy)
+                tmp = Path(tmp_dir) / f"{name}.inp"
+                tmp.write_text(_text(folder / f"{name}.inp"))
+                cards = read_deck(tmp)
+            except Exception:  # noqa: BLE001 (a deck the survey cannot read is simply not a candidate)
+                continue
+            names = {c.name for c in cards}
+            types = {c.params.get("TYPE", "").upper() for c in cards if c.name == "ELEMENT"}
+            if names <= set(SUPPORTED) and types and types <= set(ELEMENTS):
+                out.append(name)
     return sorted(set(out))
 
 

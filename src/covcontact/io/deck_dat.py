@@ -21,7 +21,7 @@ def fortran_e(x: float) -> str:
     m = x / 10.0 ** e
     if abs(round(m, 7)) >= 1.0:
         m, e = m / 10.0, e + 1
-    return f"{m:10.7f}".replace("0.", "0.", 1) + f"E{e:+03d}"
+    return f"{m:10.7f}" + f"E{e:+03d}"
 
 
 class DatTable(Observer):

@@ -12,13 +12,14 @@ that the ``.dat`` table (:class:`DatTable`) can print the deck's labels.
 from __future__ import annotations
 
 import json
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .deck import DeckError
+from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
+from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 
 _COMP = "xyz"
@@ -34,11 +35,6 @@ class Imported:
     unsupported: list[str] = field(default_factory=list)
     #: each mesh file's Mesh, built while writing it (``bodies_input.preload`` spares reading them back)
     read: dict = field(default_factory=dict, repr=False)
-
-
-def _name(text: str) -> str:
-    """A set or condition name covcontact's input takes (letters, digits, '_', '-')."""
-    return re.sub(r"[^A-Za-z0-9_-]", "_", text)
 
 
 def _toml(value) -> str:
@@ -61,68 +57,6 @@ def _table(header: str, entries: dict) -> str:
     return f"{header}\n" + "".join(f"{k} = {_toml(v)}\n" for k, v in entries.items() if v is not None) + "\n"
 
 
-class _Bodies:
-    """The connected parts of the deck's mesh."""
-
-    def __init__(self, m: DeckModel):
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
-
-        self.m = m
-        self.index = m.node_index()
-        self.el_labels = np.concatenate([b[2] for b in m.blocks]) if m.blocks else np.zeros(0, np.int64)
-        conn = [b[3] for b in m.blocks]
-        for (_, _, labels, c), where in zip(m.blocks, m.block_where):
-            bad = self._lookup(c) < 0
-            if bad.any():
-                e = int(np.flatnonzero(bad.any(axis=1))[0])
-                raise DeckError(f"{where}: *ELEMENT: element {int(labels[e])} refers to node {int(c[bad][0])}, which no "
-                                f"*NODE defines")
-        top = int(self.el_labels.max()) + 1 if self.el_labels.size else 1
-        self.el_index = np.full(top, -1, dtype=np.int64)
-        if np.unique(self.el_labels).size != self.el_labels.size:
-            order = np.sort(self.el_labels)
-            dup = int(order[1:][order[1:] == order[:-1]][0])
-            where = [w for (_, _, labels, _), w in zip(m.blocks, m.block_where) if dup in labels][-1]
-            raise DeckError(f"{where}: *ELEMENT: element {dup} is defined twice (element labels are unique in a deck)")
-        self.el_index[self.el_labels] = np.arange(self.el_labels.size)
-        rows = np.concatenate([np.repeat(np.arange(len(c)) + off, c.shape[1]) for c, off in
-                               zip(conn, np.cumsum([0] + [len(c) for c in conn])[:-1])]) if conn else np.zeros(0, int)
-        cols = np.concatenate([self.index[c.ravel()] for c in conn]) if conn else np.zeros(0, int)
-        ne, nn = self.el_labels.size, m.node_labels.size
-        g = coo_matrix((np.ones(rows.size), (rows, ne + cols)), shape=(ne + nn, ne + nn))
-        _, comp = connected_components(g, directed=False)
-        el_comp = comp[:ne]
-        kinds = np.unique(el_comp)
-        self.of_element = np.searchsorted(kinds, el_comp)      # body number of each element (deck order)
-        self.n = kinds.size
-        node_body = np.full(nn, -1, dtype=np.int64)
-        node_body[cols] = np.repeat(self.of_element, np.concatenate([np.full(len(c), c.shape[1]) for c in conn]))
-        self.of_node = node_body                                # body of each node (-1: in no element)
-
-    def _lookup(self, labels: np.ndarray) -> np.ndarray:
-        lab = np.asarray(labels, dtype=np.int64)
-        ok = (lab >= 0) & (lab < self.index.size)
-        out = np.full(lab.shape, -1, dtype=np.int64)
-        out[ok] = self.index[lab[ok]]
-        return out
-
-    def nodes_body(self, labels: np.ndarray) -> np.ndarray:
-        idx = self._lookup(labels)
-        out = np.full(idx.shape, -1, dtype=np.int64)
-        out[idx >= 0] = self.of_node[idx[idx >= 0]]
-        return out
-
-    def elements_body(self, labels: np.ndarray) -> np.ndarray:
-        lab = np.asarray(labels, dtype=np.int64)
-        ok = (lab >= 0) & (lab < self.el_index.size)
-        idx = np.full(lab.shape, -1, dtype=np.int64)
-        idx[ok] = self.el_index[lab[ok]]
-        out = np.full(idx.shape, -1, dtype=np.int64)
-        out[idx >= 0] = self.of_element[idx[idx >= 0]]
-        return out
-
-
 def import_deck(deck: str | Path, out: str | Path) -> Imported:
     """Write the covcontact problem of ``deck`` as ``out`` (a .toml path; the mesh and the labels beside it)."""
     deck, out = Path(deck), Path(out)
@@ -136,7 +70,7 @@ class _Writer:
         self.unsupported = list(m.unsupported)
         if not m.blocks:
             raise DeckError(f"{deck}: no solid elements ({', '.join(ELEMENTS)})")
-        self.b = _Bodies(m)
+        self.b = Parts(m)
         self.body_names = self._body_names()
         self.extra_nsets: dict[str, np.ndarray] = {}
         self.extra_elsets: dict[str, np.ndarray] = {}
@@ -194,7 +128,7 @@ class _Writer:
             mine = self.b.of_element == k
             labels = self.b.el_labels[mine]
             types = {self.m.blocks[j][0] for j in range(len(self.m.blocks))
-                     if np.any(self.b.of_element[self._block_range(j)] == k)}
+                     if np.any(self.b.of_element[self.b.block_range(j)] == k)}
             reduced = {ELEMENTS[t][1].get("integration") == "reduced" for t in types}
             if len(reduced) > 1:
                 self.unsupported.append(f"{self.deck}: body {name} mixes C3D20 and C3D20R elements")
@@ -217,10 +151,6 @@ class _Writer:
                 entries["options"] = {"integration": "reduced"}
             text += _table("[[bodies]]", entries)
         return text
-
-    def _block_range(self, j: int) -> slice:
-        start = sum(len(self.m.blocks[i][2]) for i in range(j))
-        return slice(start, start + len(self.m.blocks[j][2]))
 
     # -- sets per body --------------------------------------------------------------------------
     def _node_targets(self, name: str, labels: np.ndarray, where: str) -> list[tuple[int, str]]:
@@ -258,6 +188,7 @@ class _Writer:
         first: dict[tuple, object] = {}   # key -> first-stage entry (dict)
         stages: list[dict] = []
         self.stage_steps: list[tuple[int, float]] = []   # per covcontact stage: (deck step, duration)
+        self.stage_jump: list[bool] = []                  # per covcontact stage: its loads applied at once
         active: dict[tuple, float] = {}   # boundary key (body, set, dof) -> value held at the end of the last step
         loads: dict[tuple, float] = {}    # load key -> value at the end of the last step
         where: dict[tuple, str] = {}
@@ -318,7 +249,7 @@ class _Writer:
                 t0 = breaks[j - 1] if j else 0.0
                 jump = step.dynamic and all(amp is None or at((0.0, 1.0, amp), t0) == at((0.0, 1.0, amp))
                                             for _, _, amp in list(lspec.values()))
-                self.stage_jump = getattr(self, "stage_jump", []) + [jump]
+                self.stage_jump.append(jump)
 
                 stage_name = f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else "")
                 for key, spec in bspec.items():
@@ -581,104 +512,6 @@ class _Writer:
         self.meshes = {}
         for k in range(self.b.n):
             path = self.mesh_path.with_suffix(f".{k + 1}.inp")
-            content = self._body_content(k)
-            path.write_text(self._body_text(content))
-            self.meshes[path] = mesh_from_meshio(self._body_meshio(content), path, surfaces=(
-                {n: [(es, face) for es, face in refs] for n, refs in content["surfaces"].items()}, {}))
-
-    def _body_content(self, k: int) -> dict:
-        """Body k's nodes, element blocks, element and node sets and element surfaces, by deck labels."""
-        m = self.m
-
-        def own_elements(labels):
-            return labels[self.b.elements_body(labels) == k]
-
-        def own_nodes(labels):
-            return labels[self.b.nodes_body(labels) == k]
-
-        mine = self.b.of_node == k
-        blocks = []
-        for j, (_, cell, labels, conn) in enumerate(m.blocks):
-            sel = self.b.of_element[self._block_range(j)] == k
-            if sel.any():
-                blocks.append((cell, labels[sel], conn[sel]))
-        elsets = {}
-        for name, labels in {**m.elsets, **self.extra_elsets}.items():
-            labels = own_elements(labels)  # (GENERATE ranges may name labels no element has)
-            if labels.size:
-                elsets[_name(name)] = labels
-        node_sets = {**{_name(n): v for n, v in m.nsets.items()}, **self.extra_nsets}
-        node_sets.update({_name(n): v for n, (kind, v) in m.surfaces.items() if kind == "NODE" and _name(n) not in
-                          node_sets})
-        nsets = {}
-        for name, labels in node_sets.items():
-            labels = own_nodes(labels)  # (nodes of no element carry no unknowns)
-            if labels.size:
-                nsets[name] = labels
-        all_surfaces = {_name(n): [(els, face) for els, face, _ in refs] for n, (kind, refs) in m.surfaces.items()
-                        if kind == "ELEMENT"}
-        all_surfaces.update(self.extra_surfaces)
-        surfaces = {}
-        for name, refs in all_surfaces.items():
-            rows = []
-            for j, (els, face) in enumerate(refs):
-                els = own_elements(els)
-                if els.size:
-                    elsets[f"__{name}_{j + 1}"] = els
-                    rows.append((f"__{name}_{j + 1}", face))
-            if rows:
-                surfaces[name] = rows
-        return {"labels": m.node_labels[mine], "X": m.X[mine], "blocks": blocks, "elsets": elsets, "nsets": nsets,
-                "surfaces": surfaces}
-
-    @staticmethod
-    def _body_text(c: dict) -> str:
-        """The body's mesh file: *NODE, *ELEMENT per block, *ELSET, *NSET, *SURFACE (Abaqus, as covcontact reads it)."""
-        abaqus_type = {"hex8": "C3D8", "hex20": "C3D20", "tet10": "C3D10", "tet4": "C3D4", "wedge6": "C3D6"}
-
-        def label_lines(values) -> list[str]:
-            v = np.asarray(values).tolist()
-            return [", ".join(map(str, v[i:i + 16])) for i in range(0, len(v), 16)]
-
-        lines = ["*NODE"]
-        lines += [f"{lab}, {x!r}, {y!r}, {z!r}" for lab, (x, y, z) in zip(c["labels"].tolist(), c["X"].tolist())]
-        for cell, labels, conn in c["blocks"]:
-            lines.append(f"*ELEMENT, TYPE={abaqus_type[cell]}")
-            lines += [", ".join(map(str, row)) for row in np.column_stack([labels, conn]).tolist()]
-        for name, labels in c["elsets"].items():
-            if not name.startswith("__") or not any(name.startswith(f"__{s}_") for s in c["surfaces"]):
-                lines.append(f"*ELSET, ELSET={name}")
-                lines += label_lines(labels)
-        for name, labels in c["nsets"].items():
-            lines.append(f"*NSET, NSET={name}")
-            lines += label_lines(labels)
-        for name, rows in c["surfaces"].items():
-            for es, _ in rows:
-                lines.append(f"*ELSET, ELSET={es}")
-                lines += label_lines(c["elsets"][es])
-            lines.append(f"*SURFACE, NAME={name}, TYPE=ELEMENT")
-            lines += [f"{es}, S{face}" for es, face in rows]
-        return "\n".join(lines) + "\n"
-
-    @staticmethod
-    def _body_meshio(c: dict):
-        """The meshio mesh the body's file reads as (points in file order, a block per *ELEMENT card, the sets as
-        indices), built without the text."""
-        import meshio
-
-        vtk = {"hex8": "hexahedron", "hex20": "hexahedron20", "tet10": "tetra10", "tet4": "tetra", "wedge6": "wedge"}
-        labels = c["labels"]
-        cells = [(vtk[cell], np.searchsorted(labels, conn)) for cell, _, conn in c["blocks"]]
-        el_labels = [lab for _, lab, _ in c["blocks"]]
-        cell_sets = {}
-        for name, labs in c["elsets"].items():
-            per_block = []
-            for lab in el_labels:
-                order = np.argsort(lab, kind="stable")
-                pos = np.searchsorted(lab[order], labs)
-                pos = np.clip(pos, 0, max(lab.size - 1, 0))
-                hit = lab[order][pos] == labs if lab.size else np.zeros(labs.size, dtype=bool)
-                per_block.append(order[pos[hit]].astype(np.int64))
-            cell_sets[name] = per_block
-        point_sets = {name: np.searchsorted(labels, labs).astype(np.int32) for name, labs in c["nsets"].items()}
-        return meshio.Mesh(c["X"].copy(), cells, point_sets=point_sets, cell_sets=cell_sets)
+            content = body_content(self.m, self.b, k, self.extra_nsets, self.extra_elsets, self.extra_surfaces)
+            path.write_text(body_text(content))
+            self.meshes[path] = mesh_from_meshio(body_meshio(content), path, surfaces=(surface_refs(content), {}))

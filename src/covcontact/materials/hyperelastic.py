@@ -145,14 +145,15 @@ def material_response(kind, params, F, S, D):
     """Second Piola-Kirchhoff stress S (6,) and tangent D = dS/dE (6, 6) at deformation gradient F.
 
     Voigt order 11, 22, 33, 12, 23, 13; D acts on engineering shear strains. Returns 0, or 1 when
-    det F <= 0 (then S and D are finite: computed for SVK, zero for Neo-Hooke). ``material_response_h`` with
-    H = F - I formed from F.
+    det F <= 0 (then S and D are finite: computed for SVK, zero for Neo-Hooke).
     """
-    H = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            H[i, j] = F[i, j] - (1.0 if i == j else 0.0)
-    return material_response_h(kind, params, F, H, S, D)
+    J = _det3(F)
+    cm = np.empty(6)  # C - I in Voigt order
+    for I in range(6):
+        i = VOIGT_PAIRS[I, 0]
+        j = VOIGT_PAIRS[I, 1]
+        cm[I] = F[0, i] * F[0, j] + F[1, i] * F[1, j] + F[2, i] * F[2, j] - (1.0 if I < 3 else 0.0)
+    return _hyperelastic(kind, params, J, cm, math.log(J) if J > 0.0 else 0.0, S, D)
 
 
 @njit(cache=True)
@@ -161,17 +162,24 @@ def material_response_h(kind, params, F, H, S, D):
     displacements: C - I = H + H^T + H^T H and ln J = log1p(det F - 1) keep every digit of a small strain (formed
     from F, a strain of 1e-8 keeps 8 digits, and the nodal forces of a stiff body under a small load cancel to a
     residual the convergence test cannot pass)."""
-    lam = params[2]
-    mu = params[3]
     J = _det3(F)
-    # C - I in Voigt order, and C
     cm = np.empty(6)
-    c = np.empty(6)
     for I in range(6):
         i = VOIGT_PAIRS[I, 0]
         j = VOIGT_PAIRS[I, 1]
         cm[I] = H[i, j] + H[j, i] + H[0, i] * H[0, j] + H[1, i] * H[1, j] + H[2, i] * H[2, j]
-        c[I] = cm[I] + (1.0 if I < 3 else 0.0)
+    # ln J from det(I + H) - 1 = tr H + (the second invariant) + det H
+    i2 = (H[0, 0] * H[1, 1] - H[0, 1] * H[1, 0] + H[1, 1] * H[2, 2] - H[1, 2] * H[2, 1]
+          + H[0, 0] * H[2, 2] - H[0, 2] * H[2, 0])
+    lnJ = math.log1p(H[0, 0] + H[1, 1] + H[2, 2] + i2 + _det3(H)) if J > 0.0 else 0.0
+    return _hyperelastic(kind, params, J, cm, lnJ, S, D)
+
+
+@njit(cache=True, inline="always")
+def _hyperelastic(kind, params, J, cm, lnJ, S, D):
+    """S and D of St. Venant-Kirchhoff or Neo-Hooke from J = det F, C - I (``cm``, Voigt) and ln J."""
+    lam = params[2]
+    mu = params[3]
     status = 0
     if not (J > 0.0):
         status = 1
@@ -183,9 +191,9 @@ def material_response_h(kind, params, F, H, S, D):
         S[0] = lam * tr + 2.0 * mu * e0
         S[1] = lam * tr + 2.0 * mu * e1
         S[2] = lam * tr + 2.0 * mu * e2
-        S[3] = mu * c[3]
-        S[4] = mu * c[4]
-        S[5] = mu * c[5]
+        S[3] = mu * cm[3]
+        S[4] = mu * cm[4]
+        S[5] = mu * cm[5]
         for I in range(6):
             for K in range(6):
                 D[I, K] = 0.0
@@ -202,6 +210,9 @@ def material_response_h(kind, params, F, H, S, D):
             for K in range(6):
                 D[I, K] = 0.0
         return status
+    c = np.empty(6)
+    for I in range(6):
+        c[I] = cm[I] + (1.0 if I < 3 else 0.0)
     detC = J * J
     Ci = np.empty((3, 3))
     # inverse of the symmetric C by cofactors
@@ -214,20 +225,12 @@ def material_response_h(kind, params, F, H, S, D):
     Ci[1, 0] = Ci[0, 1]
     Ci[2, 1] = Ci[1, 2]
     Ci[2, 0] = Ci[0, 2]
-    # ln J from det(I + H) - 1 = tr H + (the second invariant) + det H, and mu (I - C^-1) = mu C^-1 (C - I)
-    i2 = (H[0, 0] * H[1, 1] - H[0, 1] * H[1, 0] + H[1, 1] * H[2, 2] - H[1, 2] * H[2, 1]
-          + H[0, 0] * H[2, 2] - H[0, 2] * H[2, 0])
-    lnJ = math.log1p(H[0, 0] + H[1, 1] + H[2, 2] + i2 + _det3(H))
-    Cm = np.empty((3, 3))
+    # mu (I - C^-1) = mu C^-1 (C - I): no cancellation at small strain
     for I in range(6):
         i = VOIGT_PAIRS[I, 0]
         j = VOIGT_PAIRS[I, 1]
-        Cm[i, j] = cm[I]
-        Cm[j, i] = cm[I]
-    for I in range(6):
-        i = VOIGT_PAIRS[I, 0]
-        j = VOIGT_PAIRS[I, 1]
-        S[I] = lam * lnJ * Ci[i, j] + mu * (Ci[i, 0] * Cm[0, j] + Ci[i, 1] * Cm[1, j] + Ci[i, 2] * Cm[2, j])
+        S[I] = lam * lnJ * Ci[i, j] + mu * (Ci[i, 0] * cm[VOIGT[0, j]] + Ci[i, 1] * cm[VOIGT[1, j]]
+                                            + Ci[i, 2] * cm[VOIGT[2, j]])
     m = mu - lam * lnJ
     for I in range(6):
         i = VOIGT_PAIRS[I, 0]
