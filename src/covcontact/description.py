@@ -70,6 +70,7 @@ class RigidBody:
     reference: tuple | None = None      # reference point (default: centre, point, or the mesh's centroid)
     mass: float | None = None           # dynamics: the mass of a body with free translations
     inertia: tuple | None = None        # dynamics: principal moments about the reference point (x, y, z axes)
+    attach: tuple = ()                  # (body, node set) pairs of deformable nodes that move with the body
 
     def reference_point(self) -> np.ndarray:
         if self.reference is not None:

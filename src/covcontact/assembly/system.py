@@ -134,6 +134,9 @@ class System:
             offset += body.mesh.n_nodes
         self.n_deformable = offset
         self.reference = self._reference_nodes(rigid, offset)
+        for ref, rb in zip(self.reference, [rb for rb in rigid if rb.free or rb.attach]):
+            if rb.attach:
+                ref.attached = np.unique(np.concatenate([self.global_nodes(b, s) for b, s in rb.attach]))
         self.n_nodes = offset + 2 * len(self.reference)
         self.n_dofs = 3 * self.n_nodes
         self.X = np.zeros((self.n_nodes, 3))
@@ -178,7 +181,7 @@ class System:
 
         out = []
         for rb in rigid:
-            if rb.free:
+            if rb.free or rb.attach:
                 A = offset + 2 * len(out)
                 out.append(ReferenceBody(rb.name, A, A + 1, rb.reference_point(), tuple(rb.free),
                                          np.asarray(rb.force, dtype=float), np.asarray(rb.moment, dtype=float),

@@ -117,6 +117,8 @@ class ReferenceBody:
     moment: np.ndarray     # applied moment (about the reference point) at load factor 1
     mass: float = 0.0      # dynamics and gravity: the body's mass (on A)
     inertia: np.ndarray = field(default_factory=lambda: np.zeros(3))  # principal moments about X_ref (on B)
+    #: global ids of the deformable nodes attached to the body (``covcontact.solvers.constraints.RigidLinks``)
+    attached: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     def pose(self, x: np.ndarray) -> Pose:
         """The pose at the system positions x (N, 3): A's position is p, B's is theta."""

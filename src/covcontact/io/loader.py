@@ -19,7 +19,7 @@ from .contact_input import read_contacts
 from .dynamics_input import check_densities, read_dynamics, read_initial_velocities
 from .fields import read_steps
 from .options_input import read_output, read_solver
-from .rigid_input import read_rigid
+from .rigid_input import check_attached, read_rigid
 from .stage_input import named_conditions, stage
 from .validate import InputError, Section, suggest
 
@@ -68,7 +68,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     equations = read_equations(top, sets, dirichlet)
 
     for i, r in enumerate(rigid):
-        if r.free and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
+        if r.free and not r.attach and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
             top.fail(f"rigid body {r.name!r} has free components but no contact pair: nothing would restrain "
                      f"it; add a [[contact]] with it or drop 'free'", f"rigid[{i}].free")
     if dynamics is not None and top.has("steps"):
@@ -105,6 +105,10 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     if equations and dynamic:
         top.fail("multi-point constraints ([[equation]]) are for quasi-static stages only, not yet dynamic ones",
                  "equation")
+    for i, r in enumerate(rigid):
+        if r.attach and dynamic:
+            top.fail("attached nodes are for quasi-static stages only, not yet dynamic ones", f"rigid[{i}].attach")
+    check_attached(top, rigid, bodies, dirichlet, equations)
     solver = read_solver(top)
     output = read_output(top)
     top.done()

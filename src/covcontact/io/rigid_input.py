@@ -10,8 +10,8 @@ import numpy as np
 from ..contact.tool_profile import Profile
 from ..description import RigidBody
 from .bodies_input import CELLS, build_mesh, user_faces, user_sets
-from .fields import COMPONENT_NAMES, free_components, read_motion
-from .validate import Section
+from .fields import COMPONENT_NAMES, free_components, names, read_motion, split_ref
+from .validate import Section, suggest
 
 RIGID_SHAPES = ("plane", "cylinder", "sphere", "profile", "mesh")
 
@@ -23,7 +23,8 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         rname = r.get("name", "str")
         if any(x.name == rname for x in rigid) or any(x.name == rname for x in bodies):
             r.fail(f"duplicate body name {rname!r}", "name")
-        shape = r.get("shape", "str", choices=RIGID_SHAPES)
+        attach = _attach(r, bodies)
+        shape = r.get("shape", "str", "", choices=RIGID_SHAPES) if attach else r.get("shape", "str", choices=RIGID_SHAPES)
         params: dict = {}
         mesh = None
         if shape == "plane":
@@ -41,7 +42,7 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
                       "outside": r.get("outside", "bool", True)}
         elif shape == "profile":
             params = _read_profile(r)
-        else:
+        elif shape == "mesh":
             element = r.get("element", "str", None, choices=CELLS)
             mesh = build_mesh(r.get("mesh", "table"), base, element)
             user_sets(r.get("sets", "table", None), mesh)
@@ -51,10 +52,16 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         force = r.get("force", "vector", (0.0, 0.0, 0.0))
         moment = r.get("moment", "vector", (0.0, 0.0, 0.0))
         reference = r.get("reference", "vector", None)
+        if not shape and reference is None:
+            r.fail("missing: a rigid body of attached nodes alone needs its reference point (the centre of its "
+                   "rotation, e.g. reference = [0.0, 0.0, 0.0])", "reference")
         mass = r.get("mass", "float", None, positive=True)
         inertia = r.get("inertia", "vector", None)
         if inertia is not None and not all(v > 0.0 for v in inertia):
             r.fail(f"the principal moments of inertia must be > 0, got {list(inertia)}", "inertia")
+        if attach and (mass is not None or inertia is not None):
+            r.fail("a rigid body with attached nodes takes its mass from their elements (quasi-static stages only); "
+                   "remove mass and inertia", "mass" if mass is not None else "inertia")
         for key, val in (("mass", mass), ("inertia", inertia)):
             if val is not None and not free:
                 r.fail(f"{key} is for a body with free components (its motion follows equilibrium); this one's "
@@ -67,8 +74,29 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
                        key)
         r.done()
         rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params, free=free,
-                               force=force, moment=moment, reference=reference, mass=mass, inertia=inertia))
+                               force=force, moment=moment, reference=reference, mass=mass, inertia=inertia,
+                               attach=attach))
     return rigid
+
+
+def _attach(r: Section, bodies: list) -> tuple:
+    """``attach = ["body.set", ...]``: node sets of deformable bodies that move with the rigid body."""
+    out = []
+    for ref in names(r, "attach"):
+        bname, sname = split_ref(r, "attach", ref)
+        body = next((b for b in bodies if b.name == bname), None)
+        if body is None:
+            known = [b.name for b in bodies]
+            r.fail(f"{ref!r}: no deformable body named {bname!r}{suggest(bname, known)} (bodies: "
+                   f"{', '.join(known) or 'none'})", "attach")
+        if sname not in body.mesh.node_sets or len(body.mesh.node_sets[sname]) == 0:
+            sets = body.mesh.node_sets
+            r.fail(f"{ref!r}: body {bname!r} has no node set {sname!r}{suggest(sname, sets)} (known: "
+                   f"{', '.join(sorted(sets)) or 'none'})", "attach")
+        if (bname, sname) in out:
+            r.fail(f"{ref!r} named twice", "attach")
+        out.append((bname, sname))
+    return tuple(out)
 
 
 def _read_profile(r: Section) -> dict:
@@ -105,3 +133,33 @@ def _read_profile(r: Section) -> dict:
             r.fail(text, key)
         r.fail(msg)
     return params
+
+
+def check_attached(top: Section, rigid: list, bodies: list, dirichlet: list, equations: list) -> None:
+    """Attached nodes follow their rigid body alone: not prescribed by a Dirichlet condition, not the dependent dof
+    of an equation, not attached to two bodies (one line naming both)."""
+    meshes = {b.name: b.mesh for b in bodies}
+    owner: dict = {}
+    for i, r in enumerate(rigid):
+        for bname, sname in r.attach:
+            for node in meshes[bname].node_sets[sname]:
+                prev = owner.setdefault((bname, int(node)), r.name)
+                if prev != r.name:
+                    top.fail(f"node {int(node)} of body {bname!r} is attached to rigid bodies {prev!r} and "
+                             f"{r.name!r}; attach it to one", f"rigid[{i}].attach")
+    if not owner:
+        return
+    for i, bc in enumerate(dirichlet):
+        hit = [int(n) for n in meshes[bc.body].node_sets[bc.set] if (bc.body, int(n)) in owner]
+        if hit:
+            top.fail(f"set {bc.body}.{bc.set} holds node {hit[0]} attached to rigid body "
+                     f"{owner[(bc.body, hit[0])]!r}: an attached node follows its body; prescribe the rigid body's "
+                     f"motion instead", f"dirichlet[{i}].set")
+    for i, eq in enumerate(equations):
+        bname, sname = eq.terms[0][0], eq.terms[0][1]
+        if bname not in meshes:
+            continue
+        node = int(meshes[bname].node_sets[sname][0])
+        if (bname, node) in owner:
+            top.fail(f"its first (dependent) term is node {node} of body {bname!r}, attached to rigid body "
+                     f"{owner[(bname, node)]!r}; put another term first", f"equation[{i}]")

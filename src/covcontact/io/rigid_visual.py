@@ -97,6 +97,8 @@ def rigid_visual(manager, lam: float, fields) -> tuple:
     gaps, press, stats = [], [], []
     body_id = len(manager.problem.bodies)
     for rb in manager.problem.rigid:
+        if not rb.shape:  # (nodes attached to a rigid body: drawn with their own body)
+            continue
         if rb.mesh is not None:
             p = manager.num.motion(rb.name).apply(rb.mesh.points, lam)
             off = manager.num.rigid_offset[rb.name]

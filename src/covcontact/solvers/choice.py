@@ -37,7 +37,7 @@ def auto_amg(problem) -> bool:
     if any(b.formulation != "solid" or not 0.0 <= float(getattr(b.material, "nu", 1.0)) <= AUTO_AMG_NU
            or b.mesh.cell_type not in FACES for b in problem.bodies):
         return False
-    if any(c.friction for c in problem.contacts) or any(rb.free for rb in problem.rigid) or _dynamic(problem) \
+    if any(c.friction for c in problem.contacts) or any(rb.free or rb.attach for rb in problem.rigid) or _dynamic(problem) \
             or getattr(problem, "gravity", None) is not None or getattr(problem, "equations", None):
         return False
     on_boundary = sum(np.unique(boundary_faces(b.mesh)[0]).size for b in problem.bodies)
@@ -145,8 +145,8 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if ranks > 1 and not distributes(linear):
         raise InputError(f"{where}: {ranks} MPI ranks, but the linear solver {linear!r} runs in one process; "
                          f"use --solver petsc or petsc-gamg (or leave the solver to auto)")
-    if distributes(linear) and any(rb.free for rb in problem.rigid):
-        raise InputError(f"{where}: rigid bodies with free components (reference nodes) are not available with "
+    if distributes(linear) and any(rb.free or rb.attach for rb in problem.rigid):
+        raise InputError(f"{where}: rigid bodies with free components or attached nodes (reference nodes) are not available with "
                          f"the distributed solver {linear!r} yet; use a serial solver")
     if distributes(linear) and getattr(problem, "gravity", None) is not None:
         raise InputError(f"{where}: gravity is not available with the distributed solver {linear!r} yet; use a "

@@ -58,3 +58,105 @@ class LinearConstraints:
             K = (self.Tt @ K @ self.T + self.unit).tocsr()
             K.sort_indices()
         return R, K
+
+
+class RigidLinks:
+    """Node sets of deformable bodies attached to rigid bodies with a reference node (``[[rigid]]`` ``attach``;
+    docs/theory.md, "Multi-point constraints").
+
+    An attached node follows its rigid body: u_i = t + (R(theta) - I) Y_i with Y_i = X_i - X_ref and (t, theta)
+    the displacements of the body's nodes A and B, so delta u_i = delta t - [R Y_i]_x T(theta) delta theta
+    (``covcontact.contact.reference``). With P that map (identity on the other dofs, zero columns at the attached
+    ones) the residual becomes P^T R: A takes the sum of the attached nodes' forces f_i, B takes T^T sum R Y_i x f_i;
+    the tangent P^T K P plus the part from the rotation's second derivative on B,
+    sum T^T [f_i]_x [R Y_i]_x T + d(T^T m)/d theta with m = sum R Y_i x f_i. The attached dofs drop out (the solver
+    treats them as constrained) and are set from (t, theta) before every evaluation (``complete``).
+    """
+
+    def __init__(self, system):
+        n = system.n_dofs
+        self.n = n
+        self.links = []  # (reference body, attached global nodes, Y)
+        self.mask = np.zeros(n, dtype=bool)
+        for ref in system.reference:
+            nodes = np.asarray(getattr(ref, "attached", ()), dtype=np.int64)
+            if nodes.size == 0:
+                continue
+            self.links.append((ref, nodes, system.X[nodes] - ref.origin))
+            self.mask[(3 * nodes[:, None] + np.arange(3)).ravel()] = True
+        self.dependent = np.flatnonzero(self.mask)
+        keep = np.flatnonzero(~self.mask)
+        self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
+        self.unit = sp.diags(self.mask.astype(float)).tocsr()
+        self._u = np.zeros(n)
+
+    def complete(self, u: np.ndarray) -> None:
+        """Set the attached nodes' displacements (in place) from their bodies' (t, theta)."""
+        from ..motion import rotation_matrix
+
+        for ref, nodes, Y in self.links:
+            t, theta = u[3 * ref.A: 3 * ref.A + 3], u[3 * ref.B: 3 * ref.B + 3]
+            u.reshape(-1, 3)[nodes] = t + Y @ rotation_matrix(theta).T - Y
+        self._u = u.copy()
+
+    def _map(self):
+        """P (n x n) at the displacement of the last ``complete`` and per link (rows R Y_i, T)."""
+        from ..contact.reference import skew, tangent_map
+        from ..motion import rotation_matrix
+
+        rows, cols, vals, parts = [], [], [], []
+        u = self._u
+        for ref, nodes, Y in self.links:
+            theta = u[3 * ref.B: 3 * ref.B + 3]
+            T = tangent_map(theta)
+            ry = Y @ rotation_matrix(theta).T
+            B = -skew(ry) @ T                                      # (m, 3, 3)
+            r0 = 3 * nodes[:, None] + np.arange(3)                 # (m, 3)
+            rows += [r0.ravel(), np.repeat(r0.ravel(), 3)]
+            cols += [np.tile(3 * ref.A + np.arange(3), len(nodes)),
+                     np.tile(3 * ref.B + np.arange(3), 3 * len(nodes))]
+            vals += [np.ones(r0.size), B.ravel()]
+            parts.append((ref, nodes, ry, T, theta))
+        P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(self.n, self.n)) + self._keep
+        return P.tocsr(), parts
+
+    def transform(self, R: np.ndarray, K):
+        """(P^T R, P^T K P + the rotation's second-order part) (K may be None)."""
+        from ..contact.reference import skew, tangent_map_derivatives
+
+        P, parts = self._map()
+        Pt = P.T.tocsr()
+        Rn = Pt @ R
+        if K is None:
+            return Rn, None
+        K = Pt @ K @ P + self.unit
+        G_rows, G_cols, G_vals = [], [], []
+        for ref, nodes, ry, T, theta in parts:
+            f = R.reshape(-1, 3)[nodes]
+            G = T.T @ np.einsum("mij,mjk->ik", skew(f), skew(ry)) @ T
+            G += np.einsum("i,ijk->jk", np.cross(ry, f).sum(axis=0), tangent_map_derivatives(theta))
+            b = 3 * ref.B + np.arange(3)
+            G_rows.append(np.repeat(b, 3))
+            G_cols.append(np.tile(b, 3))
+            G_vals.append(G.ravel())
+        K = (K + sp.csr_matrix((np.concatenate(G_vals), (np.concatenate(G_rows), np.concatenate(G_cols))),
+                               shape=K.shape)).tocsr()
+        K.sort_indices()
+        return Rn, K
+
+
+class ChainedConstraints:
+    """Linear equations and rigid links together: u = T g(w) (the equations' dependent dofs are set from the
+    attached nodes after those are set from their bodies), so the residual is P^T T^T R."""
+
+    def __init__(self, linear: LinearConstraints, rigid: RigidLinks):
+        self.linear, self.rigid = linear, rigid
+        self.mask = linear.mask | rigid.mask
+
+    def complete(self, u: np.ndarray) -> None:
+        self.rigid.complete(u)
+        self.linear.complete(u)
+
+    def transform(self, R: np.ndarray, K):
+        return self.rigid.transform(*self.linear.transform(R, K))

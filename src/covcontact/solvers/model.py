@@ -28,7 +28,7 @@ class Model:
     rank = 0
     size = 1
 
-    #: linear multi-point constraints (``covcontact.solvers.constraints.LinearConstraints``), None without
+    #: multi-point constraints (``covcontact.solvers.constraints``: linear equations, rigid links), None without
     constraints = None
 
     def __init__(self, problem, tangent: str | None = None):
@@ -40,12 +40,21 @@ class Model:
         blocks = [b.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies) for b in body.mesh.blocks]
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
         self.stages = StagePlan(problem, self.system)
-        self.constraints = None
-        if getattr(problem, "equations", None):
-            from .constraints import LinearConstraints
-
-            self.constraints = LinearConstraints(problem.equations, self.system)
+        self.constraints = self._constraints(problem)
+        if self.constraints is not None and getattr(self.constraints, "rigid", self.constraints).__class__.__name__ \
+                == "RigidLinks":  # (the rotation's second-order part is not symmetric)
+            self.symmetric = False
         self.set_stage(State([], None))
+
+    def _constraints(self, problem):
+        """The multi-point constraints: linear equations, nodes attached to rigid bodies, both or None."""
+        from .constraints import ChainedConstraints, LinearConstraints, RigidLinks
+
+        linear = LinearConstraints(problem.equations, self.system) if getattr(problem, "equations", None) else None
+        rigid = RigidLinks(self.system) if any(r.attached.size for r in self.system.reference) else None
+        if linear is not None and rigid is not None:
+            return ChainedConstraints(linear, rigid)
+        return linear if linear is not None else rigid
 
     # stages -----------------------------------------------------------------------------------
     def set_stage(self, state: State) -> None:
@@ -199,14 +208,14 @@ class Model:
         if want_K:
             CouplingPattern.scatter(K.data, pattern, triples)
         t3 = time.perf_counter()
-        if want_K and self.system.reference:
-            self._check_restrained(K)
         if timing is not None:
             timing["assembly"] += t2 - t1
             timing["contact"] += (t1 - t0) + (t3 - t2)
         r = r - self.external(lam)
         if self.constraints is not None and not raw:
             r, K = self.constraints.transform(r, K)
+        if want_K and self.system.reference:
+            self._check_restrained(K)
         return r, K, committed.but(elements=etrial, contact=ctrial, lam=lam)
 
     # rigid bodies with a reference node ------------------------------------------------------------
@@ -236,7 +245,8 @@ class Model:
 
     def rigid_report(self, u: np.ndarray, lam: float, state: State) -> dict:
         """Per reference body: displacement, rotation vector, applied force and moment, and the contact
-        resultant (force and moment about the reference point) acting on it."""
+        resultant (force and moment about the reference point) acting on it; with attached nodes also their
+        resultant on it (``attached_force``, ``attached_moment``)."""
         if not self.system.reference:
             return {}
         from ..contact.reference import tangent_map
@@ -254,6 +264,15 @@ class Model:
                              "rotation": theta.tolist(),
                              "applied_force": force.tolist(), "applied_moment": moment.tolist(),
                              "contact_force": (-r[ref.A]).tolist(), "contact_moment": contact_moment.tolist()}
+        if any(ref.attached.size for ref in self.system.reference):
+            # the attached nodes' pull: each node's residual R_i is the force the body applies to it
+            R = self.evaluate(u.copy(), lam, state, want_K=False, raw=True)[0].reshape(-1, 3)
+            for ref in self.system.reference:
+                if ref.attached.size:
+                    f = R[ref.attached]
+                    ry = x[ref.attached] - x[ref.A]
+                    out[ref.name]["attached_force"] = (-f.sum(axis=0)).tolist()
+                    out[ref.name]["attached_moment"] = (-np.cross(ry, f).sum(axis=0)).tolist()
         return out
 
     def start_warnings(self, u: np.ndarray, state: State) -> list[str]:

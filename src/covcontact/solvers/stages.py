@@ -209,7 +209,7 @@ class StagePlan:
                 conds.append(_Condition(f"rigid:{ref.name}", np.array([ref.A]), comps, None, None,
                                         motions[ref.name], ref))
             pairs = [c.name for c in self.problem.contacts if ref.name in (c.slave[0], c.master[0])]
-            off = not any(contacts.get(n, True) for n in pairs)
+            off = not any(contacts.get(n, True) for n in pairs) and not ref.attached.size
             # a stage motion for a body with free components takes them over: the body is held where the
             # stage found it and translated by the motion (e.g. a blank holder lifted off by displacement)
             driven = moved is not None and ref.name in moved
