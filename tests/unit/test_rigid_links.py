@@ -163,3 +163,108 @@ def test_attached_input_errors(tmp_path):
         with pytest.raises(InputError) as err:
             load_problem(path)
         assert words in str(err.value) and "\n" not in str(err.value), (words, str(err.value))
+
+
+# ------------------------------------------------------------------------------------------------ decks
+
+def _bar_deck(path, steps: str, rigid: str = "*RIGID BODY, NSET=TOP, REF NODE=1000, ROT NODE=1001") -> None:
+    """A C3D8 bar 1 x 1 x 2 (2 x 2 x 3 elements), E = 100, nu = 0, its base held; its top a rigid body whose REF
+    NODE (1000) sits at the top's centre and whose ROT NODE (1001) is a free-standing node."""
+    from covcontact.mesh.generators import block
+
+    m = block(1.0, 1.0, 2.0, 2, 2, 3, "hex8")
+    lines = [f"{i + 1}, {x:.17g}, {y:.17g}, {z:.17g}" for i, (x, y, z) in enumerate(m.points)]
+    els = [", ".join(map(str, [e + 1, *(c + 1)])) for e, c in enumerate(m.cells)]
+    top = np.flatnonzero(np.isclose(m.points[:, 2], 2.0)) + 1
+    base = np.flatnonzero(np.isclose(m.points[:, 2], 0.0)) + 1
+    path.write_text(f"""*NODE, NSET=NALL
+{chr(10).join(lines)}
+1000, 0.5, 0.5, 2.0
+1001, 0.0, 0.0, 0.0
+*ELEMENT, TYPE=C3D8, ELSET=BAR
+{chr(10).join(els)}
+*NSET, NSET=TOP
+{", ".join(map(str, top))}
+*NSET, NSET=BASE
+{", ".join(map(str, base))}
+*NSET, NSET=PILOT
+1000, 1001
+*MATERIAL, NAME=M
+*ELASTIC
+100.0, 0.0
+*SOLID SECTION, ELSET=BAR, MATERIAL=M
+*BOUNDARY
+BASE, 1, 3
+{rigid}
+{steps}""")
+
+
+def _dat_block(text: str, kind: str, nset: str, time: str) -> dict:
+    lines = text.splitlines()
+    at = lines.index(f" {kind} for set {nset} and time  {time}")
+    out = {}
+    for ln in lines[at + 2:]:
+        if not ln.strip():
+            break
+        f = ln.split()
+        out[int(f[0])] = np.array([float(v) for v in f[1:4]])
+    return out
+
+
+def test_deck_rigid_body_stretches_and_turns_the_bar(tmp_path):
+    """*RIGID BODY on the bar's top: step 1 moves the REF NODE up by 0.5 (the St. Venant-Kirchhoff stretch: the
+    .dat's force at the REF NODE and the base's reaction E/2 (l^3 - l) A, l = 1.25, to 1e-8); step 2 turns the ROT
+    NODE's z component to 0.3 rad with its x and y free: the top turned by 0.3 about the bar's axis (its nodes at
+    c + R (X - c) to the table's seven digits), the ROT NODE's displacement printed as the rotation vector."""
+    from covcontact.cli import main
+    from covcontact.motion import rotation_matrix
+
+    deck = tmp_path / "rb.inp"
+    step = "*STEP, NLGEOM\n*STATIC\n0.5, 1.0\n*BOUNDARY\n{bc}\n*NODE PRINT, NSET=PILOT\nU, RF\n" \
+           "*NODE PRINT, NSET=TOP\nU\n*NODE PRINT, NSET=BASE\nRF\n*END STEP\n"
+    _bar_deck(deck, step.format(bc="1000, 1, 2, 0.0\n1000, 3, 3, 0.5\n1001, 3, 3, 0.0")
+              + step.format(bc="1001, 3, 3, 0.3"))
+    assert main(["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    text = (tmp_path / "out" / "rb.dat").read_text()
+    force = 50.0 * (1.25 ** 3 - 1.25)
+    pilot = _dat_block(text, "forces (fx,fy,fz)", "PILOT", "0.1000000E+01")
+    base = _dat_block(text, "forces (fx,fy,fz)", "BASE", "0.1000000E+01")
+    assert pilot[1000][2] == pytest.approx(force, rel=1e-8)
+    assert sum(v[2] for v in base.values()) == pytest.approx(-force, rel=1e-8)
+    u = _dat_block(text, "displacements (vx,vy,vz)", "PILOT", "0.2000000E+01")
+    np.testing.assert_allclose(u[1000], [0.0, 0.0, 0.5], atol=1e-8)
+    np.testing.assert_allclose(u[1001], [0.0, 0.0, 0.3], atol=1e-8)
+    top = _dat_block(text, "displacements (vx,vy,vz)", "TOP", "0.2000000E+01")
+    from covcontact.mesh.generators import block
+
+    X = block(1.0, 1.0, 2.0, 2, 2, 3, "hex8").points
+    c = np.array([0.5, 0.5, 2.0])
+    for lab, disp in top.items():
+        want = c + [0.0, 0.0, 0.5] + rotation_matrix([0.0, 0.0, 0.3]) @ (X[lab - 1] - c) - X[lab - 1]
+        np.testing.assert_allclose(disp, want, atol=1e-6)  # (the table's seven digits)
+
+
+def test_deck_rigid_body_errors_and_unsupported(tmp_path):
+    """A REF NODE no *NODE defines, NSET and ELSET together, a rigid body's node in a *BOUNDARY (one line each, exit
+    2); a *BOUNDARY on the ROT NODE that starts in the second step is listed as unsupported."""
+    import contextlib
+    import io
+
+    from covcontact.cli import main
+
+    step = "*STEP, NLGEOM\n*STATIC\n*BOUNDARY\n{bc}\n*END STEP\n"
+    cases = {
+        ("*RIGID BODY, NSET=TOP, REF NODE=1002", step.format(bc="1000, 3, 3, 0.1")): "REF NODE=1002: no *NODE defines",
+        ("*RIGID BODY, NSET=TOP, ELSET=BAR, REF NODE=1000", step.format(bc="1000, 3, 3, 0.1")):
+            "takes one of NSET= and ELSET=",
+        ("*RIGID BODY, NSET=TOP, REF NODE=1000", step.format(bc="TOP, 3, 3, 0.1")): "attached to rigid body",
+        ("*RIGID BODY, NSET=TOP, REF NODE=1000, ROT NODE=1001",
+         step.format(bc="1000, 3, 3, 0.1") + step.format(bc="1001, 3, 3, 0.2")): "starts after the first step",
+    }
+    for k, ((rigid, steps), words) in enumerate(cases.items()):
+        deck = tmp_path / f"bad{k}.inp"
+        _bar_deck(deck, steps, rigid)
+        buf = io.StringIO()
+        with contextlib.redirect_stderr(buf):
+            code = main(["run", str(deck), "--out", str(tmp_path / f"o{k}"), "--quiet"])
+        assert code == 2 and words in buf.getvalue(), (words, buf.getvalue())

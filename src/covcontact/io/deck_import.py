@@ -21,6 +21,7 @@ from .deck import DeckError
 from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
+from .deck_rigid import DeckRigid
 
 _COMP = "xyz"
 
@@ -72,6 +73,7 @@ class _Writer:
             raise DeckError(f"{deck}: no solid elements ({', '.join(ELEMENTS)})")
         self.b = Parts(m)
         self.body_names = self._body_names()
+        self.rigid = DeckRigid(m, self.b)
         self.extra_nsets: dict[str, np.ndarray] = {}
         self.extra_elsets: dict[str, np.ndarray] = {}
         self.extra_surfaces: dict[str, list[tuple[np.ndarray, int]]] = {}
@@ -225,8 +227,11 @@ class _Writer:
                     lspec[key] = (loads.get(key, 0.0), ld.value, amp)
             # conditions on dofs free before (new ones, or released in an earlier step): they start in this step
             # from the displacement their dofs have then (FIXED: keep it)
-            late = {key for key in bspec if s > 0 and (key not in names or key not in active)}
-            release = [names[key] for key in active if key not in bspec]
+            late = {key for key in bspec if s > 0 and (key not in names or key not in active)
+                    and (key[0] != "rigid" or key not in active)}
+            release = [names[key] for key in active if key not in bspec and key[0] != "rigid"]
+            if any(key not in bspec and key[0] == "rigid" for key in active):
+                self.unsupported.append(f"{step.where}: *BOUNDARY, OP=NEW drops a rigid body's prescribed component")
             breaks = {period}
             for _, _, amp in list(bspec.values()) + list(lspec.values()):
                 if amp is not None:
@@ -252,7 +257,15 @@ class _Writer:
                 self.stage_jump.append(jump)
 
                 stage_name = f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else "")
+                rigid_v, rigid_l = {}, {}
                 for key, spec in bspec.items():
+                    if key[0] == "rigid":  # a rigid body's REF or ROT node: its motion (DeckRigid)
+                        if key in late or spec[1] is None:
+                            self.unsupported.append(f"{where[key]}: a *BOUNDARY on a rigid body's REF or ROT node "
+                                                    f"that starts after the first step, or FIXED")
+                            continue
+                        rigid_v[key[1:]] = prev_b[key] = at(spec)
+                        continue
                     if key in late:
                         if j == 0:
                             names[key] = f"bc{len(names) + 1}"
@@ -283,6 +296,9 @@ class _Writer:
                     prev_b[key] = v
                 for key, spec in lspec.items():
                     v = at(spec)
+                    if key[0] == "rforce":
+                        rigid_l[key[1:]] = prev_l[key] = v
+                        continue
                     if key not in names:
                         names[key] = f"{ {'cload': 'f', 'dload': 'p'}.get(key[0], 'g') }{len(names) + 1}"
                         first[key] = self._load_entry(key, names[key], v if (s, j) == (0, 0) else 0.0)
@@ -293,9 +309,13 @@ class _Writer:
                     prev_l[key] = v
                 duration = tau - (breaks[j - 1] if j else 0.0)
                 self.stage_steps.append((s, duration))
+                motions, rigid_targets = self.rigid.stage(rigid_v, rigid_l)
+                targets.update(rigid_targets)
                 if (s, j) == (0, 0):
                     continue
                 st = {"name": stage_name, **self._timing(step, duration, jump)}
+                if motions:
+                    st["motions"] = motions
                 if release and j == 0:
                     st["release"] = release
                 changed = {f"pair{k + 1}": mu for k, (inter, *_rest) in enumerate(m.pairs)
@@ -345,7 +365,13 @@ class _Writer:
 
     def _boundary_keys(self, b: Boundary, where: dict) -> dict:
         out = {}
-        for body, set_name in self._node_targets(b.name, b.nodes, b.where):
+        labels, rigid = self.rigid.split(b.nodes)
+        for r, off in rigid:
+            for d in b.dofs:
+                key = ("rigid", r, off + d - 1)
+                where.setdefault(key, b.where)
+                out[key] = 0.0 if b.value is None else b.value
+        for body, set_name in self._node_targets(b.name, labels, b.where):
             for d in b.dofs:
                 key = (body, set_name, d - 1)
                 where.setdefault(key, b.where)
@@ -354,8 +380,11 @@ class _Writer:
 
     def _load_keys(self, ld: Load):
         if ld.kind == "cload":
-            targets = self._node_targets(ld.target, ld.nodes, ld.where)
-            if not targets:
+            labels, rigid = self.rigid.split(ld.nodes)
+            for r, off in rigid:
+                yield ("rforce", r, off + ld.dof - 1)
+            targets = self._node_targets(ld.target, labels, ld.where) if labels.size else []
+            if not targets and not rigid:
                 raise DeckError(f"{ld.where}: *CLOAD on nodes of no element ({ld.target})")
             for body, set_name in targets:
                 yield ("cload", body, set_name, ld.dof - 1)
@@ -477,12 +506,14 @@ class _Writer:
         bodies = self._bodies_toml()
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
+        rigid = "".join(_table("[[rigid]]", e) for e in self.rigid.entries(self.extra_nsets, self._ref))
+        self.unsupported += self.rigid.unsupported
         first = self.m.steps[0]
         head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(
             first, self.stage_steps[0][1], self.stage_jump[0]) if first.dynamic else {})})
         self.out.parent.mkdir(parents=True, exist_ok=True)
-        self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + contacts
-                            + conds + stages)
+        self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + rigid
+                            + contacts + conds + stages)
         self._write_mesh()
         labels = self.out.with_suffix(".nodes.json")
         per_body = {}
@@ -496,7 +527,7 @@ class _Writer:
         missing = sorted(wanted - set(self.m.nsets))
         if missing:
             raise DeckError(f"{self.deck}: *NODE PRINT names the node set {missing[0]!r}, which no *NSET defines")
-        labels.write_text(json.dumps({"bodies": per_body, "node_print": prints,
+        labels.write_text(json.dumps({"bodies": per_body, "node_print": prints, "rigid": self.rigid.labels(),
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
                                       "periods": [d for _, d in self.stage_steps],
                                       "deck_step": [k for k, _ in self.stage_steps]}))

@@ -30,7 +30,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
-             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION")
+             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY")
 #: output requests: accepted, only *NODE PRINT's U and RF are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
@@ -123,6 +123,8 @@ class DeckModel:
     #: amplitudes of a kind not read (listed as unsupported): the loads that use them are left as they are
     skipped_amplitudes: set[str] = field(default_factory=set)
     model_boundary: list[Boundary] = field(default_factory=list)
+    #: *RIGID BODY: (node labels, REF NODE label or None, ROT NODE label or None, where)
+    rigid_bodies: list[tuple[np.ndarray, int | None, int | None, str]] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
 
@@ -256,6 +258,8 @@ class _Reader:
                 m.steps.append(self.step)
                 self.step = None
                 self.changing = None
+            elif c.name == "RIGID BODY":
+                self._rigid_body(c)
             elif c.name == "BOUNDARY":
                 self._boundary(c)
             elif c.name in ("CLOAD", "DLOAD"):
@@ -275,7 +279,7 @@ class _Reader:
                     c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
                     p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
                     p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
-                    c.name == "AMPLITUDE" and p == "TIME"):
+                    c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
@@ -508,6 +512,32 @@ class _Reader:
         if ref.upper() in self.m.nsets:
             return self.m.nsets[ref.upper()]
         raise c.fail(f"{ref!r} is neither a node label nor a *NSET defined above", k)
+
+    def _rigid_body(self, c: Card) -> None:
+        """*RIGID BODY, NSET= or ELSET=, REF NODE=, ROT NODE= (model data)."""
+        if self.step is not None:
+            raise c.fail("*RIGID BODY is model data: it belongs before the first *STEP")
+        nset, elset = c.param("NSET"), c.param("ELSET")
+        if (nset is None) == (elset is None):
+            raise c.fail("*RIGID BODY takes one of NSET= and ELSET=")
+        if nset is not None:
+            nodes = self.m.nsets.get(nset.upper())
+            if nodes is None:
+                raise c.fail(f"NSET={nset}: no *NSET of that name above")
+        else:
+            els = self.m.elsets.get(elset.upper())
+            if els is None:
+                raise c.fail(f"ELSET={elset}: no *ELSET of that name above")
+            want = set(els.tolist())
+            nodes = np.unique(np.concatenate([conn[np.isin(labels, list(want))].ravel()
+                                              for _, _, labels, conn in self.m.blocks] + [np.zeros(0, np.int64)]))
+        refs = []
+        for key in ("REF NODE", "ROT NODE"):
+            v = c.param(key, c.param(key.replace(" ", "")))  # (CalculiX also reads REFNODE, ROTNODE)
+            if v is not None and not v.strip().isdigit():
+                raise c.fail(f"{key} must be a node label, got {v!r}")
+            refs.append(int(v) if v is not None else None)
+        self.m.rigid_bodies.append((np.asarray(nodes, dtype=np.int64), refs[0], refs[1], c.where()))
 
     def _boundary(self, c: Card) -> None:
         out = []

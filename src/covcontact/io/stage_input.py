@@ -130,7 +130,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                           f"free", n)
             motions[n] = read_motion(msec.get(n, "table"))
             body = next((r for r in rigid if r.name == n), None)
-            if body is not None and body.free and (np.any(motions[n].rotation != 0.0)
+            if body is not None and body.free and not body.attach and (np.any(motions[n].rotation != 0.0)
                                                    or n in targets):
                 msec.fail(f"rigid body {n!r} has free components: a stage motion holds them and may only "
                           f"translate it ({'no rotation' if n not in targets else 'no force target as well'})",

@@ -212,7 +212,8 @@ class StagePlan:
             off = not any(contacts.get(n, True) for n in pairs) and not ref.attached.size
             # a stage motion for a body with free components takes them over: the body is held where the
             # stage found it and translated by the motion (e.g. a blank holder lifted off by displacement)
-            driven = moved is not None and ref.name in moved
+            # (a body with attached nodes: the motion moves its prescribed components on, the free ones stay free)
+            driven = moved is not None and ref.name in moved and not ref.attached.size
             if ref.free and (off or driven):
                 parked += [3 * (ref.A if c < 3 else ref.B) + c % 3 for c in ref.free]
                 parked_names.append(ref.name)
