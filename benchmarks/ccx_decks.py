@@ -43,20 +43,24 @@ def _text(path: Path) -> str | None:
 
 
 def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]:
-    """The displacement and force blocks of a .dat file: (kind, set, time) -> node label -> values."""
+    """The displacement, force and stress blocks of a .dat file: (kind, set, time) -> node label (stresses: (element
+    label, integration point)) -> values."""
     out: dict = {}
     key = None
     for line in text.splitlines():
         if " for set " in line and " and time " in line:
             kind = line.split(" for set")[0].split()[0]
             key = (kind, line.split("set ")[1].split()[0], float(line.split("time")[1]))
-            out[key] = {} if kind in ("displacements", "forces") else None
+            out[key] = {} if kind in ("displacements", "forces", "stresses") else None
             continue
         if key is None or out.get(key) is None or not line.strip():
             continue
         f = line.split()
         try:
-            out[key][int(f[0])] = np.array([float(v) for v in f[1:4]])
+            if key[0] == "stresses":
+                out[key][(int(f[0]), int(f[1]))] = np.array([float(v) for v in f[2:8]])
+            else:
+                out[key][int(f[0])] = np.array([float(v) for v in f[1:4]])
         except (ValueError, IndexError):
             key = None
     return {k: v for k, v in out.items() if v}
@@ -187,7 +191,7 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
     if frd and not any(b["kind"] == "displacements" for b in blocks):  # only the .frd holds displacements
         blocks += compare_blocks(ours_at_step_ends(work / "run"), frd_displacements(frd))
     row["blocks"] = blocks
-    for kind in ("displacements", "forces"):
+    for kind in ("displacements", "forces", "stresses"):
         vals = [b["rel_diff"] for b in blocks if b["kind"] == kind]
         if vals:
             row[f"max_rel_{kind}"] = max(vals)
@@ -208,7 +212,7 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
             if not any(b["kind"] == "displacements" for b in nb) and (nl / f"{name}.frd").is_file():
                 nb += compare_blocks(ours_at_step_ends(work / "run"),
                                      frd_displacements((nl / f"{name}.frd").read_text(errors="replace")))
-            for kind in ("displacements", "forces"):
+            for kind in ("displacements", "forces", "stresses"):
                 vals = [b["rel_diff"] for b in nb if b["kind"] == kind]
                 if vals:
                     row[f"max_rel_{kind}_vs_ccx_nlgeom"] = max(vals)
@@ -231,12 +235,13 @@ def main() -> int:
         row = run_deck(name, folder, out)
         rows.append(row)
         u = row.get("max_rel_displacements")
-        print(f"{name:16s} exit {row['exit_code']}  U {u if u is None else f'{u:.2e}'}  {row.get('why', '')}",
-              flush=True)
+        sv = row.get("max_rel_stresses")
+        print(f"{name:16s} exit {row['exit_code']}  U {u if u is None else f'{u:.2e}'}  S {sv if sv is None else f'{sv:.2e}'}"
+              f"  {row.get('why', '')}", flush=True)
     out.mkdir(parents=True, exist_ok=True)
     (out / "ccx_decks.json").write_text(json.dumps(rows, indent=1))
-    lines = ["| deck | NLGEOM | exit | U vs .dat.ref | RF vs .dat.ref | U vs ccx NLGEOM | RF vs ccx NLGEOM | note |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| deck | NLGEOM | exit | U vs .dat.ref | RF vs .dat.ref | S vs .dat.ref | U vs ccx NLGEOM | RF vs ccx NLGEOM "
+             "| S vs ccx NLGEOM | note |", "|---|---|---|---|---|---|---|---|---|---|"]
 
     def fmt(v):
         return "" if v is None else f"{v:.1e}"
@@ -244,8 +249,9 @@ def main() -> int:
     for r in rows:
         lines.append(f"| {r['deck']} | {'yes' if r.get('nlgeom') else 'no'} | {r['exit_code']} | "
                      f"{fmt(r.get('max_rel_displacements'))} | {fmt(r.get('max_rel_forces'))} | "
-                     f"{fmt(r.get('max_rel_displacements_vs_ccx_nlgeom'))} | "
-                     f"{fmt(r.get('max_rel_forces_vs_ccx_nlgeom'))} | {r.get('why', '')} |")
+                     f"{fmt(r.get('max_rel_stresses'))} | {fmt(r.get('max_rel_displacements_vs_ccx_nlgeom'))} | "
+                     f"{fmt(r.get('max_rel_forces_vs_ccx_nlgeom'))} | {fmt(r.get('max_rel_stresses_vs_ccx_nlgeom'))} | "
+                     f"{r.get('why', '')} |")
     (out / "ccx_decks.md").write_text("\n".join(lines) + "\n")
     print(f"wrote {out / 'ccx_decks.md'}", file=sys.stderr)
     return 0

@@ -41,7 +41,8 @@ class DatTable(Observer):
             return
         stage = inc.state.stage
         prints = self.info["node_print"][stage] if stage < len(self.info["node_print"]) else []
-        if not prints:
+        el_prints = self.info.get("el_print", [])
+        if not prints and not (stage < len(el_prints) and el_prints[stage]):
             return
         model = run.model
         sysm = model.system
@@ -76,6 +77,38 @@ class DatTable(Observer):
                 values = U[rows] if var == "U" else forces[rows]
                 text.append(f"\n {_BLOCK[var]} for set {nset} and time {fortran_e(time)}\n\n")
                 text += [f"{lab:10d}" + "".join(f"{v:14.6E}" for v in row) + "\n" for lab, row in zip(labels, values)]
+        text += self._el_print(model, run, stage, time)
         if model.is_root:
             with open(self.path, "a") as fh:
                 fh.write("".join(text))
+
+    def _el_print(self, model, run, stage: int, time: float) -> list[str]:
+        """The *EL PRINT blocks of S: the Cauchy stress at each Gauss point, in CalculiX's component order (xx, yy,
+        zz, xy, xz, yz) and its point numbering (the first direction of the element's coordinates fastest)."""
+        el_prints = self.info.get("el_print", [])
+        if stage >= len(el_prints) or not any("S" in v for _, v in el_prints[stage]):
+            return []
+        from ..elements.points import point_stresses
+
+        sysm = model.system
+        rows = {}   # element label -> (n_points, 6)
+        U = run.u.reshape(-1, 3)
+        for blk, est in zip(sysm.blocks, run.state.elements):
+            labels = self.info["elements"].get(blk.name, [])
+            try:
+                s = point_stresses(blk.solid, U[blk.offset: blk.offset + blk.n_nodes], est)
+            except ValueError:
+                continue
+            rows.update(zip(labels, s[:, :, [0, 1, 2, 3, 5, 4]]))
+        text = []
+        for elset, variables in el_prints[stage]:
+            if "S" not in variables:
+                continue
+            text.append(f"\n stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz) for set {elset} and time "
+                        f"{fortran_e(time)}\n\n")
+            for lab in self.info["elsets"][elset]:
+                if lab not in rows:
+                    continue
+                text += [f"{lab:10d}{g + 1:4d}" + "".join(f"{v:14.6E}" for v in row) + "\n"
+                         for g, row in enumerate(rows[lab]) if not np.isnan(row[0])]
+        return text

@@ -523,11 +523,19 @@ class _Writer:
                 or self.stage_steps[k + 1][0] != s]  # the stages that end a deck step print its requests
         prints = [[[nset, list(v)] for nset, v, _ in self.m.steps[s].node_print] if k in ends else []
                   for k, (s, _) in enumerate(self.stage_steps)]
+        el_prints = [[[elset, list(v)] for elset, v, _ in self.m.steps[s].el_print] if k in ends else []
+                     for k, (s, _) in enumerate(self.stage_steps)]
         wanted = {p[0] for per_step in prints for p in per_step}
         missing = sorted(wanted - set(self.m.nsets))
         if missing:
             raise DeckError(f"{self.deck}: *NODE PRINT names the node set {missing[0]!r}, which no *NSET defines")
+        el_wanted = {p[0] for per_step in el_prints for p in per_step}
+        missing = sorted(el_wanted - set(self.m.elsets))
+        if missing:
+            raise DeckError(f"{self.deck}: *EL PRINT names the element set {missing[0]!r}, which no *ELSET defines")
         labels.write_text(json.dumps({"bodies": per_body, "node_print": prints, "rigid": self.rigid.labels(),
+                                      "elements": self.element_labels, "el_print": el_prints,
+                                      "elsets": {k: self.m.elsets[k].tolist() for k in sorted(el_wanted)},
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
                                       "periods": [d for _, d in self.stage_steps],
                                       "deck_step": [k for k, _ in self.stage_steps]}))
@@ -541,8 +549,10 @@ class _Writer:
         from ..mesh.io import mesh_from_meshio
 
         self.meshes = {}
+        self.element_labels = {}  # body -> the deck's element labels in the mesh's element order
         for k in range(self.b.n):
             path = self.mesh_path.with_suffix(f".{k + 1}.inp")
             content = body_content(self.m, self.b, k, self.extra_nsets, self.extra_elsets, self.extra_surfaces)
+            self.element_labels[self.body_names[k]] = np.concatenate([lab for _, lab, _ in content["blocks"]]).tolist()
             path.write_text(body_text(content))
             self.meshes[path] = mesh_from_meshio(body_meshio(content), path, surfaces=(surface_refs(content), {}))

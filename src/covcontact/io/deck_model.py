@@ -31,7 +31,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY")
-#: output requests: accepted, only *NODE PRINT's U and RF are tabulated
+#: output requests: accepted, *NODE PRINT's U and RF and *EL PRINT's S are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
 #: parameters that do not change what covcontact computes (solver, output and bookkeeping choices)
@@ -84,6 +84,7 @@ class Step:
     loads: list[Load] = field(default_factory=list)
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
+    el_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)    # (elset, variables, where)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
 
 
@@ -268,6 +269,10 @@ class _Reader:
                 st = self._in_step(c)
                 variables = tuple(v.upper() for row in c.rows() for v in row)
                 st.node_print.append((c.param("NSET", required=True).upper(), variables, c.where()))
+            elif c.name == "EL PRINT":
+                st = self._in_step(c)
+                variables = tuple(v.upper() for row in c.rows() for v in row)
+                st.el_print.append((c.param("ELSET", required=True).upper(), variables, c.where()))
         if self.step is not None:
             raise DeckError(f"{self.step.where}: *STEP without its *END STEP")
         self._nodes_ready(nodes, coords)

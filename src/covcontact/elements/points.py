@@ -1,0 +1,38 @@
+"""The Cauchy stress at every Gauss point of a body (the deck's *EL PRINT table; docs/input.md, "Abaqus and CalculiX
+decks"), from the same kernel that averages it over the element: called once per Gauss point with a one-point rule
+(the point's own derivatives, weight and history), whose average is that point's value."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import get_num_threads
+
+from .composite import CompositeBody
+from .solid import SolidBody, solid_gauss_fields
+
+
+def point_stresses(solid, u: np.ndarray, state: dict | None = None) -> np.ndarray:
+    """(n_elements, n_points, 6) Cauchy stress (xx, yy, zz, xy, yz, xz) at the Gauss points of a solid body at its
+    displacement ``u`` (nnode, 3) and element history ``state``; NaN past a cell's own points (a body whose cell types
+    mix). A ValueError for formulations other than the plain solid (F-bar, solid-shell)."""
+    state = solid.new_state() if state is None else state
+    if isinstance(solid, CompositeBody):
+        rows = [point_stresses(part, u, solid._views(k, state)[0]) for k, part in enumerate(solid.parts)]
+        out = np.full((solid.n_elements, max(r.shape[1] for r in rows), 6), np.nan)
+        for idx, r in zip(solid.index, rows):
+            out[idx, : r.shape[1]] = r
+        return out
+    if not isinstance(solid, SolidBody):
+        raise ValueError(f"stresses at Gauss points are for solid elements, not {type(solid).__name__}")
+    u = solid._u(u)
+    ngp = solid.weights.size
+    out = np.empty((solid.n_elements, ngp, 6))
+    buf = np.empty((solid.n_elements, 18))
+    hist = state["hist"]
+    for g in range(ngp):
+        if solid.n_elements:
+            solid_gauss_fields(solid.material.kind, solid.material.params, solid.X, u, solid.cells,
+                               np.ascontiguousarray(solid.dNdxi[g: g + 1]), np.ascontiguousarray(solid.weights[g: g + 1]),
+                               2, buf, get_num_threads(), np.ascontiguousarray(hist[:, g: g + 1]))
+        out[:, g] = buf[:, :6]
+    return out
