@@ -214,14 +214,15 @@ def _dat_block(text: str, kind: str, nset: str, time: str) -> dict:
 def test_deck_rigid_body_stretches_and_turns_the_bar(tmp_path):
     """*RIGID BODY on the bar's top: step 1 moves the REF NODE up by 0.5 (the St. Venant-Kirchhoff stretch: the
     .dat's force at the REF NODE and the base's reaction E/2 (l^3 - l) A, l = 1.25, to 1e-8); step 2 turns the ROT
-    NODE's z component to 0.3 rad with its x and y free: the top turned by 0.3 about the bar's axis (its nodes at
+    NODE's z component to 0.3 rad with its x and y free (and *EL PRINT's S after step 1: the Cauchy stress F / A
+    at all 96 Gauss points in CalculiX's numbering): the top turned by 0.3 about the bar's axis (its nodes at
     c + R (X - c) to the table's seven digits), the ROT NODE's displacement printed as the rotation vector."""
     from covcontact.cli import main
     from covcontact.motion import rotation_matrix
 
     deck = tmp_path / "rb.inp"
     step = "*STEP, NLGEOM\n*STATIC\n0.5, 1.0\n*BOUNDARY\n{bc}\n*NODE PRINT, NSET=PILOT\nU, RF\n" \
-           "*NODE PRINT, NSET=TOP\nU\n*NODE PRINT, NSET=BASE\nRF\n*END STEP\n"
+           "*NODE PRINT, NSET=TOP\nU\n*NODE PRINT, NSET=BASE\nRF\n*EL PRINT, ELSET=BAR\nS\n*END STEP\n"
     _bar_deck(deck, step.format(bc="1000, 1, 2, 0.0\n1000, 3, 3, 0.5\n1001, 3, 3, 0.0")
               + step.format(bc="1001, 3, 3, 0.3"))
     assert main(["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"]) == 0
@@ -231,6 +232,13 @@ def test_deck_rigid_body_stretches_and_turns_the_bar(tmp_path):
     base = _dat_block(text, "forces (fx,fy,fz)", "BASE", "0.1000000E+01")
     assert pilot[1000][2] == pytest.approx(force, rel=1e-8)
     assert sum(v[2] for v in base.values()) == pytest.approx(-force, rel=1e-8)
+    lines = text.splitlines()
+    at = lines.index(" stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz) for set BAR and time  0.1000000E+01")
+    rows = [[float(v) for v in ln.split()] for ln in lines[at + 2: at + 2 + 96]]
+    assert [r[:2] for r in rows] == [[e, g] for e in range(1, 13) for g in range(1, 9)]  # 12 C3D8, 8 points each
+    stress = np.array([r[2:] for r in rows])
+    np.testing.assert_allclose(stress[:, 2], force, rtol=1e-6)   # sigma_zz = F / A (nu = 0 keeps the section)
+    assert np.abs(stress[:, [0, 1, 3, 4, 5]]).max() < 1e-6 * force
     u = _dat_block(text, "displacements (vx,vy,vz)", "PILOT", "0.2000000E+01")
     np.testing.assert_allclose(u[1000], [0.0, 0.0, 0.5], atol=1e-8)
     np.testing.assert_allclose(u[1001], [0.0, 0.0, 0.3], atol=1e-8)
