@@ -53,12 +53,14 @@ class DatTable(Observer):
         R, _, _ = model.evaluate(run.u, inc.lam, run.state, want_K=False, raw=True)
         forces = (R + model.external(inc.lam)).reshape(-1, 3)  # internal and contact forces at each node
         refs = {ref.name: ref for ref in sysm.reference}
-        for name, (ref_label, rot_label) in self.info.get("rigid", {}).items():
+        rigid = self.info.get("rigid", {})
+        if any(lab is not None for labels in rigid.values() for lab in labels):
+            Rr = model.evaluate(run.u, inc.lam, run.state, want_K=False)[0].reshape(-1, 3)
+        for name, (ref_label, rot_label) in rigid.items():
             # a rigid body's REF node: its translation and the attached nodes' pull, ROT node: its rotation vector
             # and the moment on it (the residual after the attached nodes hand their forces over, plus the load)
             ref = refs[name]
             if ref_label is not None or rot_label is not None:
-                Rr = model.evaluate(run.u, inc.lam, run.state, want_K=False)[0].reshape(-1, 3)
                 force, moment = model.loading.rigid_load(name, inc.lam)
                 forces[ref.A] = Rr[ref.A] + force
                 forces[ref.B] = Rr[ref.B] + tangent_map(run.u[3 * ref.B: 3 * ref.B + 3]).T @ moment

@@ -17,6 +17,9 @@ import scipy.sparse as sp
 class LinearConstraints:
     """The equations of a problem (``covcontact.loads.Equation``) on the dofs of ``system``."""
 
+    #: T^T K T keeps K's symmetry
+    symmetric = True
+
     def __init__(self, equations, system):
         n = system.n_dofs
         dep, rows, cols, vals = [], [], [], []
@@ -72,6 +75,9 @@ class RigidLinks:
     sum T^T [f_i]_x [R Y_i]_x T + d(T^T m)/d theta with m = sum R Y_i x f_i. The attached dofs drop out (the solver
     treats them as constrained) and are set from (t, theta) before every evaluation (``complete``).
     """
+
+    #: the second-order part on theta is not symmetric
+    symmetric = False
 
     def __init__(self, system):
         n = system.n_dofs
@@ -149,6 +155,8 @@ class RigidLinks:
 class ChainedConstraints:
     """Linear equations and rigid links together: u = T g(w) (the equations' dependent dofs are set from the
     attached nodes after those are set from their bodies), so the residual is P^T T^T R."""
+
+    symmetric = False
 
     def __init__(self, linear: LinearConstraints, rigid: RigidLinks):
         self.linear, self.rigid = linear, rigid

@@ -41,9 +41,8 @@ class Model:
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
         self.stages = StagePlan(problem, self.system)
         self.constraints = self._constraints(problem)
-        if self.constraints is not None and getattr(self.constraints, "rigid", self.constraints).__class__.__name__ \
-                == "RigidLinks":  # (the rotation's second-order part is not symmetric)
-            self.symmetric = False
+        if self.constraints is not None and not self.constraints.symmetric:
+            self.symmetric = False  # (attached nodes: the rotation's second-order part is not symmetric)
         self.set_stage(State([], None))
 
     def _constraints(self, problem):
