@@ -189,8 +189,9 @@ def test_mapping_of_the_keywords(tmp_path):
 
 
 def test_mapping_of_laws_materials_and_loads(tmp_path):
-    """The pressure-overclosure laws, friction, *PLASTIC (the table law), *DENSITY, a *DLOAD face pressure and an element
-    slave surface for surface-to-surface contact."""
+    """The pressure-overclosure laws, friction, *PLASTIC (the table law; HARDENING=KINEMATIC with two points: linear
+    kinematic hardening), *DENSITY, a *DLOAD face pressure and an element slave surface for surface-to-surface
+    contact."""
     text = two_block_deck(tmp_path / "tb.inp").read_text()
     variants = {
         "exponential": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n0.001, 50.0"),
@@ -198,6 +199,7 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
         "tied": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TIED"),
         "friction": ("1.0e6\n", "1.0e6\n*FRICTION\n0.2, 5.0e5\n"),
         "plastic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC\n5.0, 0.0\n6.0, 0.1\n*DENSITY\n2.0\n"),
+        "kinematic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC, HARDENING=KINEMATIC\n5.0, 0.0\n6.0, 0.1\n"),
         "tie": ("*CONTACT PAIR, INTERACTION=SI1, TYPE=NODE TO SURFACE\nSSLAV, SMAST",
                 "*TIE, NAME=T1, POSITION TOLERANCE=0.01\nSSLAV, SMAST"),
         "sts-dload": ("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE", "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
@@ -234,6 +236,10 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
             (g,) = p.body_forces  # GRAV: an acceleration on the element set (a unit direction times the magnitude)
             assert (g.body, g.cells, g.per_mass) == ("BASE", "BASE", True)
             assert g.value == pytest.approx((0.0, 0.0, -9.81))
+        elif name == "kinematic":  # linear (Prager) kinematic hardening, slope (6 - 5) / 0.1, no isotropic part
+            mat = p.bodies[0].material
+            assert mat.kind == 2 and mat.yield_stress == 5.0 and mat.kinematic_modulus == pytest.approx(10.0)
+            assert mat.hardening.law == "linear" and mat.hardening.modulus == 0.0
         else:
             assert c.slave == ("PUNCH", "SSLAV") and c.type == "sts" and c.weighting == "area"
             assert p.bodies[1].mesh.face_sets["SSLAV"].shape == (4, 4)

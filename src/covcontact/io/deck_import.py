@@ -120,6 +120,10 @@ class _Writer:
                 out["hardening"] = {"law": "linear", "modulus": 0.0}
             else:
                 out["hardening"] = {"law": "table", "stress": [p[0] for p in pts], "strain": [p[1] for p in pts]}
+        if "kinematic" in mat:  # linear (Prager) kinematic hardening from a two-point *PLASTIC, HARDENING=KINEMATIC
+            s0, slope = mat["kinematic"]
+            out = {"model": "j2", "E": mat["E"], "nu": mat["nu"], "yield_stress": s0,
+                   "hardening": {"law": "linear", "modulus": 0.0}, "kinematic_modulus": slope}
         if "density" in mat:
             out["density"] = mat["density"]
         return out

@@ -284,7 +284,8 @@ class _Reader:
                     c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
                     p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
                     p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
-                    c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")):
+                    c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
+                    c.name == "PLASTIC" and p == "HARDENING"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
@@ -433,14 +434,22 @@ class _Reader:
         elif c.name == "DENSITY":
             mat["density"] = c.number(0, 0, rows[0], "the density")
         else:
-            if c.param("HARDENING", "ISOTROPIC").upper() != "ISOTROPIC":
+            hardening = c.param("HARDENING", "ISOTROPIC").upper()
+            if hardening not in ("ISOTROPIC", "KINEMATIC"):
                 self.m.unsupported.append(f"{c.where()}: *PLASTIC, HARDENING={c.params['HARDENING']} is not supported "
-                                          f"(isotropic hardening only)")
+                                          f"(isotropic hardening, and linear kinematic hardening)")
                 return
             pts = [(c.number(k, 0, r, "the yield stress"), c.number(k, 1, r, "the plastic strain", 0.0))
                    for k, r in enumerate(rows)]
             if any(len(r) > 2 for r in rows):
                 self.m.unsupported.append(f"{c.where()}: *PLASTIC: temperature-dependent hardening is not supported")
+            if hardening == "KINEMATIC":  # (covcontact's kinematic hardening is linear: two points)
+                if len(pts) != 2 or pts[0][1] != 0.0 or pts[1][1] <= 0.0:
+                    self.m.unsupported.append(f"{c.where()}: *PLASTIC, HARDENING=KINEMATIC with other than two points "
+                                              f"(0 and a positive plastic strain): kinematic hardening is linear")
+                    return
+                mat["kinematic"] = (pts[0][0], (pts[1][0] - pts[0][0]) / pts[1][1])
+                return
             mat["plastic"] = pts
 
     def _interaction(self, c: Card) -> None:
