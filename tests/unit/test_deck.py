@@ -270,7 +270,8 @@ def test_dynamic_steps(tmp_path):
 def test_amplitudes_cut_a_step_into_stages(tmp_path):
     """A *CLOAD with a tabular amplitude 0 -> 1 -> 0.5 at step times 0, 0.4, 1 (period 1): two stages, the force
     reaching a(0.4) F at the first cut and a(1) F at the end; the punch's prescribed motion (no amplitude) ramped
-    over the step: 0.4 and 1 of it; the requests printed at the step's end only; an unknown amplitude is one line."""
+    over the step: 0.4 and 1 of it; the requests printed at the step's end only; an unknown amplitude is one line;
+    TIME DELAY shifts the table."""
     text = two_block_deck(tmp_path / "tb.inp").read_text()
     text = text.replace("*STEP, NLGEOM", "*AMPLITUDE, NAME=A1\n0., 0., 0.4, 1.0, 1.0, 0.5\n*STEP, NLGEOM")
     text = text.replace("*NODE PRINT", "*CLOAD, AMPLITUDE=A1\n1001, 1, 2.0\n*NODE PRINT")
@@ -292,6 +293,17 @@ def test_amplitudes_cut_a_step_into_stages(tmp_path):
     deck.write_text(text.replace("AMPLITUDE=A1", "AMPLITUDE=A2"))
     with pytest.raises(DeckError, match="AMPLITUDE=A2: no \\*AMPLITUDE of that name .defined: A1."):
         import_deck(deck, tmp_path / "b" / "p.toml")
+    # TIME DELAY 0.2: the table read at t - 0.2, its points at 0.2, 0.6 (and 1.2, past the step): the first value (0)
+    # until 0.2, 1.0 F at the cut 0.6, a(1 - 0.2) F = (2/3) F at the end
+    deck.write_text(text.replace("AMPLITUDE=A1", "AMPLITUDE=A1, TIME DELAY=0.2"))
+    p = load_problem(import_deck(deck, tmp_path / "c" / "p.toml").problem)
+    (force,) = p.forces
+    assert force.value == pytest.approx((0.0, 0.0, 0.0))
+    assert [st.targets[force.name] for st in p.stages] == [pytest.approx([2.0, 0.0, 0.0]),
+                                                            pytest.approx([4.0 / 3.0, 0.0, 0.0])]
+    deck.write_text(text.replace("*CLOAD, AMPLITUDE=A1", "*CLOAD, TIME DELAY=0.2"))
+    with pytest.raises(DeckError, match="TIME DELAY shifts an amplitude: it needs AMPLITUDE= as well"):
+        import_deck(deck, tmp_path / "d" / "p.toml")
 
 
 def test_deck_run_equals_the_problem_file_and_writes_the_dat_table(tmp_path):

@@ -173,15 +173,16 @@ class _Writer:
         return f"{self.body_names[body]}.{set_name}"
 
     # -- conditions and steps ---------------------------------------------------------------------
-    def _amplitude(self, name: str | None, where: str):
-        """The table (times, values, total time?) of amplitude ``name`` (None: none)."""
+    def _amplitude(self, name: str | None, where: str, delay: float = 0.0):
+        """The table (times, values, total time?) of amplitude ``name`` (None: none), its times shifted by the
+        TIME DELAY ``delay`` (before the first point the first value holds, after the last the last)."""
         if name is None or name.upper() in self.m.skipped_amplitudes:
             return None
         amp = self.m.amplitudes.get(name.upper())
         if amp is None:
             raise DeckError(f"{where}: AMPLITUDE={name}: no *AMPLITUDE of that name (defined: "
                             f"{', '.join(sorted(self.m.amplitudes)) or 'none'})")
-        return amp
+        return (amp[0] + delay, amp[1], amp[2]) if delay else amp
 
     def _conditions(self) -> tuple[str, str]:
         """The [[dirichlet]], [[force]], [[pressure]] entries (their first-stage values) and the [[stages]]: one
@@ -200,7 +201,7 @@ class _Writer:
         where: dict[tuple, str] = {}
         model: dict[tuple, tuple] = {}
         for b in m.model_boundary:
-            amp = self._amplitude(b.amplitude, b.where)
+            amp = self._amplitude(b.amplitude, b.where, b.delay)
             for key, v in self._boundary_keys(b, where).items():
                 model[key] = (v, amp)
         total = 0.0
@@ -214,7 +215,7 @@ class _Writer:
             else:
                 bspec = {k: (v, v, None) for k, v in active.items()}
             for b in step.boundary:
-                amp = self._amplitude(b.amplitude, b.where)
+                amp = self._amplitude(b.amplitude, b.where, b.delay)
                 for key, v in self._boundary_keys(b, where).items():
                     if b.fixed:  # held where the step finds it: a held dof stays, a free one starts held
                         bspec[key] = (active[key], active[key], None) if key in active else (0.0, None, None)
@@ -226,7 +227,7 @@ class _Writer:
                     if key[0] == kind:
                         lspec[key] = (v, 0.0, None)
             for ld in step.loads:
-                amp = self._amplitude(ld.amplitude, ld.where)
+                amp = self._amplitude(ld.amplitude, ld.where, ld.delay)
                 for key in self._load_keys(ld):
                     lspec[key] = (loads.get(key, 0.0), ld.value, amp)
             # conditions on dofs free before (new ones, or released in an earlier step): they start in this step

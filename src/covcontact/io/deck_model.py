@@ -52,6 +52,7 @@ class Boundary:
     name: str            # the set name or node label as written
     amplitude: str | None = None
     fixed: bool = False  # *BOUNDARY, FIXED: held at the displacement the step finds
+    delay: float = 0.0   # TIME DELAY: the amplitude read at t - delay
 
 
 @dataclass
@@ -67,6 +68,7 @@ class Load:
     elements: np.ndarray | None = None
     amplitude: str | None = None
     direction: tuple[float, float, float] | None = None   # GRAV: the unit direction (value: the magnitude)
+    delay: float = 0.0   # TIME DELAY: the amplitude read at t - delay
 
 
 @dataclass
@@ -282,7 +284,7 @@ class _Reader:
         for p in c.params:
             if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (c.name == "CONTROLS") or (
                     c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
-                    p == "AMPLITUDE" and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
+                    p in ("AMPLITUDE", "TIME DELAY") and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
                     p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
                     c.name == "PLASTIC" and p == "HARDENING"):
@@ -527,6 +529,19 @@ class _Reader:
             return self.m.nsets[ref.upper()]
         raise c.fail(f"{ref!r} is neither a node label nor a *NSET defined above", k)
 
+    @staticmethod
+    def _delay(c: Card) -> float:
+        """TIME DELAY= of a *BOUNDARY, *CLOAD or *DLOAD with an amplitude (0 without)."""
+        text = c.param("TIME DELAY")
+        if text is None:
+            return 0.0
+        if c.param("AMPLITUDE") is None:
+            raise c.fail("TIME DELAY shifts an amplitude: it needs AMPLITUDE= as well")
+        try:
+            return float(text)
+        except ValueError:
+            raise c.fail(f"TIME DELAY must be a number, got {text!r}") from None
+
     def _rigid_body(self, c: Card) -> None:
         """*RIGID BODY, NSET= or ELSET=, REF NODE=, ROT NODE= (model data)."""
         if self.step is not None:
@@ -566,7 +581,7 @@ class _Reader:
                 self.m.unsupported.append(f"{c.where(k)}: *BOUNDARY on dofs above 3 (rotations, temperature)")
             if dofs:
                 out.append(Boundary(self._resolve_nodes(c, k, row[0]), dofs, value, c.where(k), row[0].upper(),
-                                    c.param("AMPLITUDE"), "FIXED" in c.params))
+                                    c.param("AMPLITUDE"), "FIXED" in c.params, self._delay(c)))
         if self.step is None:  # (model data: in force from the first step on, a value reached over it)
             if c.params.get("OP", "MOD").upper() == "NEW":
                 raise c.fail("OP=NEW belongs inside a *STEP")
@@ -589,7 +604,8 @@ class _Reader:
                     self.m.unsupported.append(f"{c.where(k)}: *CLOAD on dof {dof} (only forces 1..3)")
                     continue
                 st.loads.append(Load("cload", row[0].upper(), dof, c.number(k, 2, row, "the magnitude"), c.where(k),
-                                     nodes=self._resolve_nodes(c, k, row[0]), amplitude=c.param("AMPLITUDE")))
+                                     nodes=self._resolve_nodes(c, k, row[0]), amplitude=c.param("AMPLITUDE"),
+                                     delay=self._delay(c)))
             else:
                 if len(row) < 3:
                     raise c.fail("a *DLOAD line is 'element or set, Pn, magnitude'", k)
@@ -606,7 +622,7 @@ class _Reader:
                     if not np.linalg.norm(n) > 0:
                         raise c.fail("the direction of GRAV must not be zero", k)
                     st.loads.append(Load("grav", ref, 0, g, c.where(k), elements=els, amplitude=c.param("AMPLITUDE"),
-                                         direction=tuple(n / np.linalg.norm(n))))
+                                         direction=tuple(n / np.linalg.norm(n)), delay=self._delay(c)))
                     continue
                 if not (lab.startswith("P") and lab[1:].isdigit()):
                     self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (only face pressures P1..P6)")
@@ -619,4 +635,4 @@ class _Reader:
                 else:
                     raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
                 st.loads.append(Load("dload", ref, int(lab[1:]), c.number(k, 2, row, "the magnitude"), c.where(k),
-                                     elements=els, amplitude=c.param("AMPLITUDE")))
+                                     elements=els, amplitude=c.param("AMPLITUDE"), delay=self._delay(c)))
