@@ -62,13 +62,18 @@ class Pressure:
 @dataclass
 class BodyForce:
     """Dead body force ``lam * value`` on the cells of ``body`` (of its element set ``cells``, "" all of them): per unit
-    reference volume, or (``per_mass``) an acceleration times the material's density (a weight on part of a body)."""
+    reference volume, or (``per_mass``) an acceleration times the material's density (a weight on part of a body).
+
+    With ``axis`` it is the centrifugal load of a spin about the axis through ``center``: the acceleration
+    omega^2 (X - c)_perp times the density at the reference positions X, ``value[0]`` = omega^2 (the ramped quantity)."""
 
     body: str
     cells: str
     value: tuple[float, float, float]
     name: str = ""
     per_mass: bool = False
+    axis: tuple[float, float, float] | None = None
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
 @dataclass

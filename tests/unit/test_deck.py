@@ -190,8 +190,8 @@ def test_mapping_of_the_keywords(tmp_path):
 
 def test_mapping_of_laws_materials_and_loads(tmp_path):
     """The pressure-overclosure laws, friction, *PLASTIC (the table law; HARDENING=KINEMATIC with two points: linear
-    kinematic hardening), *DENSITY, a *DLOAD face pressure and an element slave surface for surface-to-surface
-    contact."""
+    kinematic hardening), *DENSITY, *DLOAD GRAV and CENTRIF, a *DLOAD face pressure and an element slave surface for
+    surface-to-surface contact."""
     text = two_block_deck(tmp_path / "tb.inp").read_text()
     variants = {
         "exponential": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n0.001, 50.0"),
@@ -200,6 +200,7 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
         "friction": ("1.0e6\n", "1.0e6\n*FRICTION\n0.2, 5.0e5\n"),
         "plastic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC\n5.0, 0.0\n6.0, 0.1\n*DENSITY\n2.0\n"),
         "kinematic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC, HARDENING=KINEMATIC\n5.0, 0.0\n6.0, 0.1\n"),
+        "centrif": ("1000.0, 0.3\n", "1000.0, 0.3\n*DENSITY\n2.0\n"),
         "tie": ("*CONTACT PAIR, INTERACTION=SI1, TYPE=NODE TO SURFACE\nSSLAV, SMAST",
                 "*TIE, NAME=T1, POSITION TOLERANCE=0.01\nSSLAV, SMAST"),
         "sts-dload": ("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE", "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
@@ -210,6 +211,8 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
         body = text.replace(old, new)
         if name == "plastic":
             body = body.replace("*NODE PRINT", "*DLOAD\nBASE, GRAV, 9.81, 0., 0., -2.\n*NODE PRINT")
+        if name == "centrif":
+            body = body.replace("*NODE PRINT", "*DLOAD\nBASE, CENTRIF, 4.0, 1., 1., 0., 0., 0., 3.\n*NODE PRINT")
         if name == "sts-dload":
             body = body.replace("NODE TO SURFACE", "SURFACE TO SURFACE").replace(
                 "*NODE PRINT", "*DLOAD\nPUNCH, P2, 0.5\n*NODE PRINT")
@@ -236,6 +239,11 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
             (g,) = p.body_forces  # GRAV: an acceleration on the element set (a unit direction times the magnitude)
             assert (g.body, g.cells, g.per_mass) == ("BASE", "BASE", True)
             assert g.value == pytest.approx((0.0, 0.0, -9.81))
+        elif name == "centrif":  # omega^2 = 4 about the axis (0, 0, 1) through (1, 1, 0)
+            (g,) = p.body_forces
+            assert (g.body, g.cells, g.per_mass) == ("BASE", "BASE", True)
+            assert g.value == pytest.approx((4.0, 0.0, 0.0)) and g.axis == pytest.approx((0.0, 0.0, 1.0))
+            assert g.center == pytest.approx((1.0, 1.0, 0.0))
         elif name == "kinematic":  # linear (Prager) kinematic hardening, slope (6 - 5) / 0.1, no isotropic part
             mat = p.bodies[0].material
             assert mat.kind == 2 and mat.yield_stress == 5.0 and mat.kinematic_modulus == pytest.approx(10.0)

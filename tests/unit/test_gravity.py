@@ -130,3 +130,51 @@ def test_step_load_in_a_dynamic_stage(tmp_path):
     assert res.exit_code == 0
     u = res.u.reshape(-1, 3)
     np.testing.assert_allclose(u[:, 2], -0.5 * (4.0 / 2.0) * 0.5 ** 2, rtol=1e-10)  # b / rho = 2
+
+
+SPIN = """
+[problem]
+name = "spin"
+[[bodies]]
+name = "arm"
+element = "CELL"
+material = { model = "svk", E = 1.0e5, nu = 0.3, density = 2.0 }
+mesh = { generator = "block", lx = 2.0, ly = 0.5, lz = 0.4, nx = 4, ny = 1, nz = 1 }
+[[dirichlet]]
+set = "arm.xmin"
+[[body_force]]
+name = "spin"
+body = "arm"
+centrifugal = { omega = 3.0, axis = [0.0, 0.0, 2.0], center = [-1.0, 0.25, 7.0] }
+[steps]
+count = 2
+[[stages]]
+name = "faster"
+steps = { count = 1 }
+targets = { spin = 6.0 }
+"""
+
+
+@pytest.mark.parametrize("cell", ["hex8", "tet10", "hex20"])
+def test_centrifugal_load(tmp_path, cell):
+    """An arm spun about the z axis through (-1, 0.25, .) (the section's centre line, 1 from its root), held at its
+    root: the support carries minus the whole centrifugal force, rho omega^2 V (x_c - c)_perp = rho omega^2 V (2, 0,
+    0), ramped in omega^2 (half of it at the first step of omega = 3) and four times that at omega = 6 (exact: the
+    acceleration is linear in X, so the consistent mass times it integrates it exactly); the load per node is
+    int N_a rho omega^2 (X - c)_perp dV0: each node's share grows with its distance from the axis."""
+    path = tmp_path / "s.toml"
+    path.write_text(SPIN.replace("CELL", cell))
+    res = load_problem(path).run(out=tmp_path / "out")
+    assert res.exit_code == 0
+    V, rho = 2.0 * 0.5 * 0.4, 2.0
+    full = rho * 9.0 * V * 2.0
+    for s, scale in zip(res.summary["steps"], (0.5, 1.0, 4.0)):
+        np.testing.assert_allclose(s["reactions"]["arm.xmin"], [-scale * full, 0.0, 0.0], atol=1e-9 * full)
+    cases = {("omega = 3.0", "omega = -3.0"): "must be >= 0",
+             ("axis = [0.0, 0.0, 2.0]", "axis = [0.0, 0.0, 0.0]"): "must not be zero",
+             ('name = "spin"\nbody', 'name = "spin"\nvalue = [1.0, 0.0, 0.0]\nbody'): "give exactly one of",
+             (", density = 2.0", ""): "an acceleration needs the density"}
+    for bad, words in cases.items():
+        path.write_text(SPIN.replace("CELL", cell).replace(*bad))
+        with pytest.raises(InputError, match=words):
+            load_problem(path)

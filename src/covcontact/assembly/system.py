@@ -230,7 +230,12 @@ class System:
         body = self.bodies[load.body]
         chosen = body.mesh.element_sets[load.cells] if load.cells else np.arange(body.mesh.n_cells)
         weight = np.zeros(self.n_nodes)
+        f = np.zeros((self.n_nodes, 3))
         off = self.offset(load.body)
+        if load.axis is not None:  # centrifugal: the acceleration omega^2 (X - c)_perp, linear in X, so M a is exact
+            e = np.asarray(load.axis, dtype=float) / np.linalg.norm(load.axis)
+            d = body.mesh.points - np.asarray(load.center, dtype=float)
+            accel = float(value.reshape(-1)[0]) * (d - np.outer(d @ e, e))
         for _, idx, material, cell_type in body.material_parts(chosen):
             rho = 1.0
             if load.per_mass:
@@ -239,7 +244,12 @@ class System:
                     raise ValueError(f"body {body.name!r}: a body force per mass needs the density of its material")
             cells = body.mesh.cells_of(chosen[idx])[1]
             me = element_masses(cell_type, body.mesh.points, cells, rho)
-            np.add.at(weight, cells.ravel() + off, me.sum(axis=2).ravel())
+            if load.axis is not None:
+                np.add.at(f, cells.ravel() + off, np.einsum("eab,ebi->eai", me, accel[cells]).reshape(-1, 3))
+            else:
+                np.add.at(weight, cells.ravel() + off, me.sum(axis=2).ravel())
+        if load.axis is not None:
+            return f.ravel()
         return (weight[:, None] * value[None, :]).ravel()
 
     def _build_loads(self) -> None:

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..description import COMPONENTS
 from ..loads import BodyForce, Dirichlet, Equation, NodalForce, Pressure, Traction
 from .fields import dirichlet_values, read_motion, split_ref
@@ -189,16 +191,28 @@ def read_body_forces(top: Section, bodies: list) -> list[BodyForce]:
             known = ", ".join(sorted(body.mesh.element_sets)) or "none"
             b.fail(f"body {bname!r} has no element set {cells!r}{suggest(cells, body.mesh.element_sets)} (known: "
                    f"{known})", "cells")
-        if b.has("value") == b.has("acceleration"):
-            b.fail("give exactly one of 'value' (force per unit volume) or 'acceleration' (times the density)")
-        per_mass = b.has("acceleration")
-        value = b.get("acceleration" if per_mass else "value", "vector")
+        if b.has("value") + b.has("acceleration") + b.has("centrifugal") != 1:
+            b.fail("give exactly one of 'value' (force per unit volume), 'acceleration' (times the density) or "
+                   "'centrifugal' (a spin)")
+        per_mass = b.has("acceleration") or b.has("centrifugal")
+        axis, center = None, (0.0, 0.0, 0.0)
+        if b.has("centrifugal"):
+            c = b.get("centrifugal", "table")
+            omega = c.get("omega", "float", nonnegative=True)
+            axis = c.get("axis", "vector")
+            center = c.get("center", "vector", (0.0, 0.0, 0.0))
+            if not np.linalg.norm(axis) > 0.0:
+                c.fail("must not be zero", "axis")
+            c.done()
+            value = (omega * omega, 0.0, 0.0)
+        else:
+            value = b.get("acceleration" if per_mass else "value", "vector")
         if per_mass:
             for _, _, material, _ in body.material_parts(body.mesh.element_sets[cells] if cells else None):
                 if getattr(material, "density", None) is None:
                     b.fail(f"missing: an acceleration needs the density of the material of body {bname!r}",
-                           "acceleration")
+                           "centrifugal" if axis is not None else "acceleration")
         name = b.get("name", "str", "")
         b.done()
-        out.append(BodyForce(bname, cells, value, name, per_mass))
+        out.append(BodyForce(bname, cells, value, name, per_mass, axis, center))
     return out

@@ -335,7 +335,8 @@ class _Writer:
             total += period
         conds = ""
         for key, entry in first.items():
-            kind = {"cload": "force", "dload": "pressure", "grav": "body_force"}.get(key[0], "dirichlet")
+            kind = {"cload": "force", "dload": "pressure", "grav": "body_force", "centrif": "body_force"}.get(key[0],
+                                                                                                            "dirichlet")
             if kind == "dirichlet" and entry.get("value", 0.0) is None:
                 continue  # (a late condition the step cannot give: listed as unsupported)
             conds += _table(f"[[{kind}]]", entry)
@@ -398,11 +399,12 @@ class _Writer:
             if np.any(bodies < 0):
                 raise DeckError(f"{ld.where}: element {int(ld.elements[bodies < 0][0])} is not defined")
             for body in np.unique(bodies):
-                if ld.kind == "grav":  # an acceleration on the element set (times the density): a body force
+                if ld.kind in ("grav", "centrif"):  # an acceleration on the element set (times the density)
                     name = _name(ld.target) if not ld.target.isdigit() else f"_E{ld.target}"
                     if ld.target.isdigit():
                         self.extra_elsets[name] = ld.elements
-                    yield ("grav", int(body), name, ld.direction)
+                    yield (ld.kind, int(body), name, ld.direction) if ld.kind == "grav" else \
+                        (ld.kind, int(body), name, ld.direction, ld.point)
                     continue
                 name = f"_P{_name(ld.target)}_{ld.dof}"
                 self.extra_surfaces[name] = [(ld.elements[bodies == body], ld.dof)]
@@ -412,11 +414,16 @@ class _Writer:
         if key[0] == "grav":
             return {"name": name, "body": self.body_names[key[1]], "cells": key[2],
                     "acceleration": self._load_value(key, v)}
+        if key[0] == "centrif":  # (the deck's magnitude is omega^2)
+            return {"name": name, "body": self.body_names[key[1]], "cells": key[2],
+                    "centrifugal": {"omega": self._load_value(key, v), "axis": list(key[3]), "center": list(key[4])}}
         return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v)} | (
             {"distribution": "per_node"} if key[0] == "cload" else {})
 
     @staticmethod
     def _load_value(key: tuple, v: float):
+        if key[0] == "centrif":  # a stage target of a spin is its angular velocity
+            return float(np.sqrt(max(v, 0.0)))
         if key[0] == "grav":
             return [float(v) * d for d in key[3]]
         if key[0] == "cload":

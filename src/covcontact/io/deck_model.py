@@ -68,6 +68,7 @@ class Load:
     elements: np.ndarray | None = None
     amplitude: str | None = None
     direction: tuple[float, float, float] | None = None   # GRAV: the unit direction (value: the magnitude)
+    point: tuple[float, float, float] | None = None       # CENTRIF: a point of the axis (direction: the axis)
     delay: float = 0.0   # TIME DELAY: the amplitude read at t - delay
 
 
@@ -610,6 +611,25 @@ class _Reader:
                 if len(row) < 3:
                     raise c.fail("a *DLOAD line is 'element or set, Pn, magnitude'", k)
                 lab = row[1].upper()
+                if lab == "CENTRIF":  # a spin: omega^2, a point of the axis, the axis' direction
+                    if len(row) < 9:
+                        raise c.fail("a CENTRIF load is 'element set, CENTRIF, omega^2, x, y, z, ax, ay, az' (a point "
+                                     "of the axis and its direction)", k)
+                    ref = row[0].upper()
+                    els = self.m.elsets.get(ref) if not ref.isdigit() else np.array([int(ref)])
+                    if els is None:
+                        raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
+                    w2 = c.number(k, 2, row, "omega^2")
+                    pt = tuple(c.number(k, 3 + i, row, "the point of the axis") for i in range(3))
+                    ax = np.array([c.number(k, 6 + i, row, "the axis") for i in range(3)])
+                    if w2 < 0.0:
+                        raise c.fail(f"omega^2 must be >= 0, got {w2}", k)
+                    if not np.linalg.norm(ax) > 0:
+                        raise c.fail("the axis of CENTRIF must not be zero", k)
+                    st.loads.append(Load("centrif", ref, 0, w2, c.where(k), elements=els,
+                                         amplitude=c.param("AMPLITUDE"), direction=tuple(ax / np.linalg.norm(ax)),
+                                         point=pt, delay=self._delay(c)))
+                    continue
                 if lab == "GRAV":  # gravity: magnitude, direction
                     if len(row) < 6:
                         raise c.fail("a GRAV load is 'element set, GRAV, magnitude, nx, ny, nz'", k)
@@ -625,7 +645,8 @@ class _Reader:
                                          direction=tuple(n / np.linalg.norm(n)), delay=self._delay(c)))
                     continue
                 if not (lab.startswith("P") and lab[1:].isdigit()):
-                    self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (only face pressures P1..P6)")
+                    self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (face pressures P1..P6, GRAV and "
+                                              f"CENTRIF are read)")
                     continue
                 ref = row[0].upper()
                 if ref.isdigit():

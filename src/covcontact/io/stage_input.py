@@ -94,6 +94,9 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                 targets[n] = dirichlet_values(tsec, n, len(obj.components))
             elif kind == "pressure":
                 targets[n] = tsec.get(n, "float")
+            elif kind == "body_force" and obj.axis is not None:  # a spin: its new angular velocity omega
+                omega = tsec.get(n, "float", nonnegative=True)
+                targets[n] = (omega * omega, 0.0, 0.0)
             elif kind == "rigid":  # the force (a vector) or {force, moment} of a rigid body with free components
                 if isinstance(tsec.data[n], dict):
                     t = tsec.get(n, "table")
