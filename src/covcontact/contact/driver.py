@@ -278,10 +278,11 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
     """Contact point of one slave on its candidates cand_fac[c0:c1]; returns (kind, facet, g, nedge) and writes
     xi_out (2,), n_out (3,). kind -1: no facet accepts the point, the caller tries the blind spot (``edges``).
 
-    xi holds the previous contact point on pf on entry (when pf >= 0); fprm = (tol_inside, hysteresis, min_cos).
+    xi holds the previous contact point on pf on entry (when pf >= 0); fprm = (tol_inside, hysteresis, min_cos,
+    tol_keep): the previous facet accepts a projection up to tol_keep outside it.
     At most 30 arguments: beyond that Python passes them as a tuple, which numba cannot inline.
     """
-    tol_in, hyst, min_cos = fprm
+    tol_in, hyst, min_cos, tol_keep = fprm
     nvis = 0
     nedge = 0
     best_f = -1
@@ -317,7 +318,8 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
                 if _hull_dist2(xyz, xs, cp) > best_g * best_g:
                     continue
             planar_start(x, faces, f0, xs, xi)
-        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir,
+        tol = tol_keep if m < c0 else tol_in
+        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol, min_cos, max_hops, use_dir,
                                   ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
         if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
             best_f, best_g = f, g
@@ -351,13 +353,13 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
         xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
             node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. cand_ptr, cand_fac:
             candidate CSR. prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
-        prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops).
+        prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops, tol_keep).
         nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
     """
     ns = xs.shape[0]
     faces, nbr_facet, nbr_edge = topo[0], topo[1], topo[2]
-    gmax, tol_in, hyst, min_cos, max_hops = prm
-    fprm = (tol_in, hyst, min_cos)
+    gmax, tol_in, hyst, min_cos, max_hops, tol_keep = prm
+    fprm = (tol_in, hyst, min_cos, tol_keep)
     nen = faces.shape[1]
     for ch in prange(nchunk):
         xyz = np.empty((nen, 3))
@@ -495,6 +497,7 @@ def project_slaves(
     min_cos: float = -0.5,
     max_hops: int = 4,
     boxes: tuple[np.ndarray, np.ndarray] | None = None,
+    tol_keep: float | None = None,
 ) -> ProjectionResult:
     """Contact point of each slave on the whole master surface.
 
@@ -512,6 +515,8 @@ def project_slaves(
         min_cos: with a previous facet, facets whose normal makes a cosine below this with the
             previous normal are rejected (thin-body far face); -1 switches the guard off.
         max_hops: largest number of hand-overs across edges per walk.
+        tol_keep: the previous facet accepts a projection up to this much outside it (element coordinates; default
+            ``tol_inside``): a slave that sits on an edge keeps its facet while Newton moves it across by less.
         boxes: facet boxes (lo, hi) if already computed for these positions.
     """
     x = np.ascontiguousarray(x_nodes, dtype=np.float64)
@@ -546,7 +551,8 @@ def project_slaves(
         surface.node_ptr,
         surface.node_facets,
     )
-    prm = (gm, float(tol_inside), float(hysteresis), float(min_cos), int(max_hops))
+    prm = (gm, float(tol_inside), float(hysteresis), float(min_cos), int(max_hops),
+           float(tol_inside if tol_keep is None else tol_keep))
     cp = np.ascontiguousarray(cand_ptr, np.int64)
     cf = np.ascontiguousarray(cand_facets, np.int64)
     lo, hi = np.ascontiguousarray(lo), np.ascontiguousarray(hi)

@@ -37,6 +37,8 @@ _CASE_NAME = {v: k for k, v in CASES.items()}
 #: surface (the end of a tube) lie exactly on the boundary of the facets they touch, and round-off alone would
 #: decide whether they have a contact point
 SELF_TOL_INSIDE = 1e-4
+#: frictional passes: how far outside its facet of the last Newton iterate (element coordinates) a slave keeps it
+KEEP_BAND = 0.02
 
 
 @dataclass
@@ -191,7 +193,11 @@ class ContactManager:
                                  tol_inside=SELF_TOL_INSIDE)
             self._face_to_face(own, res, g0.facet >= 0)
         else:
-            res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi)
+            # a frictional slave keeps its facet of the last iterate up to KEEP_BAND outside it: across a master edge
+            # the friction history moves to the other facet's frame, and a slave resting on the edge (conforming meshes
+            # pressed together) would cycle between the two (frictionless slaves have the edge locks instead)
+            res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi,
+                                 tol_keep=KEEP_BAND if p.mu > 0.0 else None)
         self.timing["projection"] += time.perf_counter() - t0
         if p.mu == 0.0 and not p.self_contact:
             t.edge_lock = self._hold(p, xe, res, g0)
