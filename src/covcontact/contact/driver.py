@@ -68,9 +68,10 @@ def _kkt_ok(d, t, sgn, tol):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_hops, use_dir, ndir, xyz, rho, t1,
-          t2, nrm, pc, pG, vis, nvis, edges, nedge):  # fmt: skip
-    """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge).
+def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol_first, min_cos, max_hops, use_dir, ndir, xyz,
+          rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge):  # fmt: skip
+    """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge). f accepts a point up to
+    tol_first outside it, the facets handed over to up to tol_in.
 
     Records every edge a projection left through in ``edges`` (for the blind-spot rule). Arrays come one by one,
     not in tuples: unpacking a tuple of arrays costs reference counts in this hottest loop.
@@ -88,7 +89,8 @@ def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_h
             return -1, 0.0, nvis, nedge
         o1 = abs(xi[0]) - 1.0
         o2 = abs(xi[1]) - 1.0
-        if o1 <= tol_in and o2 <= tol_in:
+        tol = tol_first if hop == 0 else tol_in
+        if o1 <= tol and o2 <= tol:
             if status != 0 or not (g > -gmax[f]):
                 return -1, 0.0, nvis, nedge
             if use_dir:
@@ -99,7 +101,7 @@ def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, min_cos, max_h
         ea = 1 if xi[0] > 0.0 else 3  # edges 1 / 3 lie at xi1 = +1 / -1, edges 2 / 0 at xi2 = +1 / -1
         eb = 2 if xi[1] > 0.0 else 0
         for e, o in ((ea, o1), (eb, o2)):
-            if o > tol_in and nedge < edges.shape[0]:
+            if o > tol and nedge < edges.shape[0]:
                 dup = False
                 for k in range(nedge):
                     dup = dup or (edges[k, 0] == f and edges[k, 1] == e)
@@ -319,7 +321,7 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
                     continue
             planar_start(x, faces, f0, xs, xi)
         tol = tol_keep if m < c0 else tol_in
-        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol, min_cos, max_hops, use_dir,
+        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol, min_cos, max_hops, use_dir,
                                   ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
         if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
             best_f, best_g = f, g

@@ -190,10 +190,10 @@ class ContactManager:
             ptr, fac = drop_excluded(np.ascontiguousarray(cand[0], np.int64), np.ascontiguousarray(cand[1], np.int64),
                                      p.exclude, own, fn, np.where(g0.facet >= 0, HOLD_COS, 0.0))
             res = project_slaves(xe, p.surface, xe[p.slaves], ptr, fac, g0.facet, g0.xi, max_hops=0,
-                                 tol_inside=SELF_TOL_INSIDE)
+                                 tol_inside=SELF_TOL_INSIDE, tol_keep=KEEP_BAND if p.mu > 0.0 else None)
             self._face_to_face(own, res, g0.facet >= 0)
         else:
-            # a frictional slave keeps its facet of the last iterate up to KEEP_BAND outside it: across a master edge
+            # a frictional slave keeps its facet of the last iterate up to KEEP_BAND outside it (self-contact too): across a master edge
             # the friction history moves to the other facet's frame, and a slave resting on the edge (conforming meshes
             # pressed together) would cycle between the two (frictionless slaves have the edge locks instead)
             res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi,
