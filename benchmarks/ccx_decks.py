@@ -48,6 +48,11 @@ def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]
     out: dict = {}
     key = None
     for line in text.splitlines():
+        if line.strip().startswith("contact stress") and " and time " in line:  # press and |tangential| per node
+            key = ("contact", "ALL", float(line.split("time")[1]))
+            out[key] = {}
+            out[("tangential", "ALL", key[2])] = {}
+            continue
         if " for set " in line and " and time " in line:
             kind = line.split(" for set")[0].split()[0]
             key = (kind, line.split("set ")[1].split()[0], float(line.split("time")[1]))
@@ -59,6 +64,10 @@ def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]
         try:
             if key[0] == "stresses":
                 out[key][(int(f[0]), int(f[1]))] = np.array([float(v) for v in f[2:8]])
+            elif key[0] == "contact":  # the tangential axes are each code's own: their magnitude
+                v = [float(x) for x in f[1:4]]
+                out[key][int(f[0])] = np.array([v[0]])
+                out[("tangential", "ALL", key[2])][int(f[0])] = np.array([np.hypot(v[1], v[2])])
             else:
                 out[key][int(f[0])] = np.array([float(v) for v in f[1:4]])
         except (ValueError, IndexError):
@@ -191,7 +200,7 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
     if frd and not any(b["kind"] == "displacements" for b in blocks):  # only the .frd holds displacements
         blocks += compare_blocks(ours_at_step_ends(work / "run"), frd_displacements(frd))
     row["blocks"] = blocks
-    for kind in ("displacements", "forces", "stresses"):
+    for kind in ("displacements", "forces", "stresses", "contact", "tangential"):
         vals = [b["rel_diff"] for b in blocks if b["kind"] == kind]
         if vals:
             row[f"max_rel_{kind}"] = max(vals)
@@ -212,7 +221,7 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
             if not any(b["kind"] == "displacements" for b in nb) and (nl / f"{name}.frd").is_file():
                 nb += compare_blocks(ours_at_step_ends(work / "run"),
                                      frd_displacements((nl / f"{name}.frd").read_text(errors="replace")))
-            for kind in ("displacements", "forces", "stresses"):
+            for kind in ("displacements", "forces", "stresses", "contact", "tangential"):
                 vals = [b["rel_diff"] for b in nb if b["kind"] == kind]
                 if vals:
                     row[f"max_rel_{kind}_vs_ccx_nlgeom"] = max(vals)
@@ -240,8 +249,9 @@ def main() -> int:
               f"  {row.get('why', '')}", flush=True)
     out.mkdir(parents=True, exist_ok=True)
     (out / "ccx_decks.json").write_text(json.dumps(rows, indent=1))
-    lines = ["| deck | NLGEOM | exit | U vs .dat.ref | RF vs .dat.ref | S vs .dat.ref | U vs ccx NLGEOM | RF vs ccx NLGEOM "
-             "| S vs ccx NLGEOM | note |", "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| deck | NLGEOM | exit | U vs .dat.ref | RF vs .dat.ref | S vs .dat.ref | contact pressure, |tangential| "
+             "vs .dat.ref | U vs ccx NLGEOM | RF vs ccx NLGEOM | S vs ccx NLGEOM | note |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
 
     def fmt(v):
         return "" if v is None else f"{v:.1e}"
@@ -249,7 +259,9 @@ def main() -> int:
     for r in rows:
         lines.append(f"| {r['deck']} | {'yes' if r.get('nlgeom') else 'no'} | {r['exit_code']} | "
                      f"{fmt(r.get('max_rel_displacements'))} | {fmt(r.get('max_rel_forces'))} | "
-                     f"{fmt(r.get('max_rel_stresses'))} | {fmt(r.get('max_rel_displacements_vs_ccx_nlgeom'))} | "
+                     f"{fmt(r.get('max_rel_stresses'))} | {fmt(r.get('max_rel_contact'))}"
+                     f"{', ' + fmt(r.get('max_rel_tangential')) if r.get('max_rel_tangential') is not None else ''} | "
+                     f"{fmt(r.get('max_rel_displacements_vs_ccx_nlgeom'))} | "
                      f"{fmt(r.get('max_rel_forces_vs_ccx_nlgeom'))} | {fmt(r.get('max_rel_stresses_vs_ccx_nlgeom'))} | "
                      f"{r.get('why', '')} |")
     (out / "ccx_decks.md").write_text("\n".join(lines) + "\n")

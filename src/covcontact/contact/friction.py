@@ -458,3 +458,16 @@ def transfer_history(history, master_xyz, xi0=None) -> np.ndarray:
         raise ValueError("degenerate master facet (zero area element at the projection)")
     rho, rc, _ = _facet_frame(xyz, xi)
     return make_history(xi, rc @ t_n, rho, rc)
+
+
+def start_history(master_xyz, slave_xyz, xi0) -> np.ndarray:
+    """The history of a slave new to contact: its projection on the facet ``master_xyz`` (in the configuration where
+    the step started, with the slave at ``slave_xyz`` there) as the stick point, zero traction; no history (a
+    frictionless start, state NEW) where the facet is degenerate there."""
+    xyz = np.ascontiguousarray(master_xyz, dtype=np.float64)
+    xi = np.array(xi0, dtype=np.float64)
+    if project_on_facet(xyz, np.ascontiguousarray(slave_xyz, dtype=np.float64), xi)[0] == DEGENERATE or not np.all(
+            np.isfinite(xi)):
+        return new_history()
+    rho, rc, _ = _facet_frame(xyz, xi)
+    return make_history(xi, (0.0, 0.0), rho, rc)

@@ -21,7 +21,7 @@ from .driver import EDGE, FACET, VERTEX, project_slaves
 from .edge import edge_vertex_contact
 from .edgelock import FREE, RELEASED, edge_point, inconsistent, new_locks
 from .element import CASE_A, CASES
-from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, transfer_history
+from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, start_history, transfer_history
 from .kernels import contact_batch
 from .laws import is_active, linear_equivalents, uzawa_update
 from .reference import map_analytic, map_rigid_nodes
@@ -82,6 +82,9 @@ class ContactManager:
                 self.owner[off: off + rb.mesh.n_nodes] = index[rb.name]
         self._ref_of_pass = [index.get(p.rigid, -1) if p.analytic is not None else -1 for p in self.passes]
         self._poses = []
+        # the extended positions where the first step starts (its committed configuration: the state has none yet)
+        xe = np.ascontiguousarray(np.vstack([system.X, self.num.rigid_positions(0.0)]))
+        self._x_start = xe if not self.points.count else np.ascontiguousarray(np.vstack([xe, self.points.positions(xe)]))
 
     # -- state ------------------------------------------------------------------------------------
     def initial_state(self) -> ContactState:
@@ -225,7 +228,8 @@ class ContactManager:
             facet_conn = np.ascontiguousarray(conn[:, :nen])
             slaves = np.ascontiguousarray(conn[:, nen])
             if p.mu > 0.0:
-                hist = self._facet_history(p, c, idx, t.facet[idx], xi, x_commit)
+                hist = self._facet_history(p, c, idx, t.facet[idx], xi,
+                                           self._x_start if x_commit is None else x_commit)
                 hist_out = np.zeros_like(hist)
                 state = np.zeros(idx.size, dtype=np.int64)
                 friction_batch(xe, facet_conn, slaves, xi, eps, np.ascontiguousarray(p.eps_t[idx]),
@@ -319,8 +323,13 @@ class ContactManager:
 
     @staticmethod
     def _facet_history(p: Pass, c: PassState, idx, facets, xi, x_commit) -> np.ndarray:
-        """Committed friction history of slaves ``idx`` moved onto their current facets."""
+        """Committed friction history of slaves ``idx`` moved onto their current facets; a slave new to contact (no
+        history) sticks from where the step found it: its projection on its facet in the committed configuration,
+        zero traction (so a contact that closes in a step carries friction in that step already)."""
         hist = c.hist[idx].copy()
+        if x_commit is not None and p.kind == "nts":
+            for j in np.flatnonzero(hist[:, -1] == 0.0):
+                hist[j] = start_history(x_commit[p.surface.faces[facets[j]]], x_commit[p.slaves[idx[j]]], xi[j])
         moved = np.flatnonzero((hist[:, -1] > 0.0) & (c.hist_facet[idx] != facets))
         for j in moved:
             if x_commit is None:

@@ -42,7 +42,9 @@ class DatTable(Observer):
         stage = inc.state.stage
         prints = self.info["node_print"][stage] if stage < len(self.info["node_print"]) else []
         el_prints = self.info.get("el_print", [])
-        if not prints and not (stage < len(el_prints) and el_prints[stage]):
+        contact_prints = self.info.get("contact_print", [])
+        if not prints and not (stage < len(el_prints) and el_prints[stage]) and not (
+                stage < len(contact_prints) and "CSTRESS" in contact_prints[stage]):
             return
         model = run.model
         sysm = model.system
@@ -80,6 +82,8 @@ class DatTable(Observer):
                 text.append(f"\n {_BLOCK[var]} for set {nset} and time {fortran_e(time)}\n\n")
                 text += [f"{lab:10d}" + "".join(f"{v:14.6E}" for v in row) + "\n" for lab, row in zip(labels, values)]
         text += self._el_print(model, run, stage, time)
+        if stage < len(contact_prints) and "CSTRESS" in contact_prints[stage]:
+            text += self._contact_stress(model, run, inc.lam, where, time)
         if model.is_root:
             with open(self.path, "a") as fh:
                 fh.write("".join(text))
@@ -113,4 +117,38 @@ class DatTable(Observer):
                     continue
                 text += [f"{lab:10d}{g + 1:4d}" + "".join(f"{v:14.6E}" for v in row) + "\n"
                          for g, row in enumerate(rows[lab]) if not np.isnan(row[0])]
+        return text
+
+    @staticmethod
+    def _contact_stress(model, run, lam: float, where: dict, time: float) -> list[str]:
+        """*CONTACT PRINT CSTRESS: per active slave node of the node-to-surface pairs on meshed masters, the contact
+        pressure (the normal force over the node's tributary area, positive in compression) and the tangential
+        traction in the master's frame at the contact point (tang1 along rho_1, tang2 = n x tang1; CalculiX's own
+        tangential axes are its element's, so compare their magnitude)."""
+        from ..contact.surface import facet_frame
+
+        manager = model.contact
+        state = run.state.contact
+        label = {node: lab for lab, node in where.items()}
+        xe = manager.extended(model.positions(run.u), lam)
+        rows = []
+        rho, t1, t2, n = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+        for k, p in enumerate(manager.passes):
+            if p.kind != "nts" or p.surface is None or p.tied:
+                continue
+            s = state.passes[k]
+            for j in np.flatnonzero(manager.active_mask(k, state) & (s.facet >= 0)):
+                if int(p.slaves[j]) not in label:
+                    continue
+                xyz = np.ascontiguousarray(xe[p.surface.faces[s.facet[j]]])
+                facet_frame(xyz, float(s.xi[j, 0]), float(s.xi[j, 1]), rho, t1, t2, n)
+                f = s.force[j] / p.area[j]
+                e1 = t1 / np.linalg.norm(t1)
+                e2 = np.cross(n, e1)
+                rows.append((label[int(p.slaves[j])], f @ n, f @ e1, f @ e2))
+        if not rows:
+            return []
+        text = [f"\n contact stress (slave node,press,tang1,tang2) for all contact elements and time {fortran_e(time)}"
+                f"\n\n"]
+        text += [f"{lab:10d}" + "".join(f"{v:14.6E}" for v in vals) + "\n" for lab, *vals in sorted(rows)]
         return text

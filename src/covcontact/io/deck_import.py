@@ -537,6 +537,8 @@ class _Writer:
                   for k, (s, _) in enumerate(self.stage_steps)]
         el_prints = [[[elset, list(v)] for elset, v, _ in self.m.steps[s].el_print] if k in ends else []
                      for k, (s, _) in enumerate(self.stage_steps)]
+        contact_prints = [list(self.m.steps[s].contact_print) if k in ends else []
+                          for k, (s, _) in enumerate(self.stage_steps)]
         wanted = {p[0] for per_step in prints for p in per_step}
         missing = sorted(wanted - set(self.m.nsets))
         if missing:
@@ -547,6 +549,7 @@ class _Writer:
             raise DeckError(f"{self.deck}: *EL PRINT names the element set {missing[0]!r}, which no *ELSET defines")
         labels.write_text(json.dumps({"bodies": per_body, "node_print": prints, "rigid": self.rigid.labels(),
                                       "elements": self.element_labels, "el_print": el_prints,
+                                      "contact_print": contact_prints,
                                       "elsets": {k: self.m.elsets[k].tolist() for k in sorted(el_wanted)},
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
                                       "periods": [d for _, d in self.stage_steps],

@@ -31,7 +31,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY")
-#: output requests: accepted, *NODE PRINT's U and RF and *EL PRINT's S are tabulated
+#: output requests: accepted, *NODE PRINT's U and RF, *EL PRINT's S and *CONTACT PRINT's CSTRESS are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
 #: parameters that do not change what covcontact computes (solver, output and bookkeeping choices)
@@ -88,6 +88,7 @@ class Step:
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
     el_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)    # (elset, variables, where)
+    contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables (CSTRESS is tabulated)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
 
 
@@ -272,6 +273,9 @@ class _Reader:
                 st = self._in_step(c)
                 variables = tuple(v.upper() for row in c.rows() for v in row)
                 st.node_print.append((c.param("NSET", required=True).upper(), variables, c.where()))
+            elif c.name == "CONTACT PRINT":
+                st = self._in_step(c)
+                st.contact_print += tuple(v.upper() for row in c.rows() for v in row)
             elif c.name == "EL PRINT":
                 st = self._in_step(c)
                 variables = tuple(v.upper() for row in c.rows() for v in row)
