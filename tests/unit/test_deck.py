@@ -527,3 +527,32 @@ def test_imported_meshes_equal_their_files(tmp_path):
             for k in ours:
                 np.testing.assert_array_equal(ours[k], theirs[k])
     assert imp.read[imp.meshes[1]].face_sets["SSLAV"].shape == (4, 4)
+
+
+def test_contact_print_tabulates_contact_stresses(tmp_path):
+    """*CONTACT PRINT CSTRESS: a block per step end with every active slave node (the deck's labels of the punch's
+    bottom nodes), the pressure positive and summing (a node slave surface: per node, the force) to the support's
+    reaction (to the tilt of the deformed surface), the tangential tractions zero without friction (1e-9 of the pressure: the normal is the gap vector's
+    direction, also at edge and vertex points)."""
+    deck = two_block_deck(tmp_path / "tb.inp")
+    deck.write_text(deck.read_text().replace("*NODE PRINT", "*CONTACT PRINT\nCSTRESS\n*NODE PRINT"))
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "out"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    lines = (tmp_path / "out" / "tb.dat").read_text().splitlines()
+    at = lines.index(" contact stress (slave node,press,tang1,tang2) for all contact elements and time  0.1000000E+01")
+    rows = []
+    for ln in lines[at + 2:]:
+        if not ln.strip():
+            break
+        rows.append([float(v) for v in ln.split()])
+    rows = np.array(rows)
+    assert rows[:, 0].astype(int).tolist() == list(range(1001, 1018, 2))   # the punch's bottom nodes
+    import json
+
+    fz = json.loads((tmp_path / "out" / "summary.json").read_text())["steps"][-1]["reactions"]
+    support = sum(v[2] for k, v in fz.items() if k.startswith("BASE.BOTTOM"))
+    # (the pressures act along the deformed surface's normals, tilted by about 1e-2: their sum is the vertical
+    # reaction to 1e-4)
+    assert np.all(rows[:, 1] > 0.0) and rows[:, 1].sum() == pytest.approx(support, rel=1e-4)
+    assert np.abs(rows[:, 2:]).max() < 1e-9 * rows[:, 1].max()

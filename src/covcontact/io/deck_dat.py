@@ -123,8 +123,9 @@ class DatTable(Observer):
     def _contact_stress(model, run, lam: float, where: dict, time: float) -> list[str]:
         """*CONTACT PRINT CSTRESS: per active slave node of the node-to-surface pairs on meshed masters, the contact
         pressure (the normal force over the node's tributary area, positive in compression) and the tangential
-        traction in the master's frame at the contact point (tang1 along rho_1, tang2 = n x tang1; CalculiX's own
-        tangential axes are its element's, so compare their magnitude)."""
+        traction in the master's frame at the contact point (n along the gap vector, which is the facet's normal at a
+        facet point and the direction from the point at an edge or vertex; tang1 along rho_1 projected off n,
+        tang2 = n x tang1; CalculiX's own tangential axes are its element's, so compare their magnitude)."""
         from ..contact.surface import facet_frame
 
         manager = model.contact
@@ -142,8 +143,13 @@ class DatTable(Observer):
                     continue
                 xyz = np.ascontiguousarray(xe[p.surface.faces[s.facet[j]]])
                 facet_frame(xyz, float(s.xi[j, 0]), float(s.xi[j, 1]), rho, t1, t2, n)
+                d = xe[p.slaves[j]] - rho   # g n: the contact normal also at an edge or vertex point
+                if abs(s.gap[j]) > 1e-9 * np.linalg.norm(t1):
+                    n = d / s.gap[j]
+                    n /= np.linalg.norm(n)
                 f = s.force[j] / p.area[j]
-                e1 = t1 / np.linalg.norm(t1)
+                e1 = t1 - (t1 @ n) * n
+                e1 /= np.linalg.norm(e1)
                 e2 = np.cross(n, e1)
                 rows.append((label[int(p.slaves[j])], f @ n, f @ e1, f @ e2))
         if not rows:
