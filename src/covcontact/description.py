@@ -118,6 +118,7 @@ class ContactPair:
     order: int | None = None           # sts: Gauss points per direction of a slave facet (None: 2 quad4, 3 quad9)
     self_surfaces: tuple | None = None  # self-contact: the (body, face set) surfaces merged into one
     tie_tolerance: float | None = None  # law "tied": largest distance of a tied point (None: 5 % facet size)
+    adjust: float | str | None = None  # slave nodes moved onto the master before the first step: below this gap, or a node set
 
 
 @dataclass

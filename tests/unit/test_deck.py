@@ -190,8 +190,8 @@ def test_mapping_of_the_keywords(tmp_path):
 
 def test_mapping_of_laws_materials_and_loads(tmp_path):
     """The pressure-overclosure laws, friction, *PLASTIC (the table law; HARDENING=KINEMATIC with two points: linear
-    kinematic hardening), *DENSITY, *DLOAD GRAV and CENTRIF, a *DLOAD face pressure and an element slave surface for
-    surface-to-surface contact."""
+    kinematic hardening), *DENSITY, *DLOAD GRAV and CENTRIF, a *DLOAD face pressure, an element slave surface for
+    surface-to-surface contact, *CONTACT PAIR ADJUST (a distance or a node set) and SMALL SLIDING."""
     text = two_block_deck(tmp_path / "tb.inp").read_text()
     variants = {
         "exponential": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n0.001, 50.0"),
@@ -201,6 +201,8 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
         "plastic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC\n5.0, 0.0\n6.0, 0.1\n*DENSITY\n2.0\n"),
         "kinematic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC, HARDENING=KINEMATIC\n5.0, 0.0\n6.0, 0.1\n"),
         "centrif": ("1000.0, 0.3\n", "1000.0, 0.3\n*DENSITY\n2.0\n"),
+        "adjust": ("TYPE=NODE TO SURFACE\n", "TYPE=NODE TO SURFACE, ADJUST=0.01, SMALL SLIDING\n"),
+        "adjust-set": ("TYPE=NODE TO SURFACE\n", "TYPE=NODE TO SURFACE, ADJUST=NSLAVE\n"),
         "tie": ("*CONTACT PAIR, INTERACTION=SI1, TYPE=NODE TO SURFACE\nSSLAV, SMAST",
                 "*TIE, NAME=T1, POSITION TOLERANCE=0.01\nSSLAV, SMAST"),
         "sts-dload": ("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE", "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
@@ -244,6 +246,10 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
             assert (g.body, g.cells, g.per_mass) == ("BASE", "BASE", True)
             assert g.value == pytest.approx((4.0, 0.0, 0.0)) and g.axis == pytest.approx((0.0, 0.0, 1.0))
             assert g.center == pytest.approx((1.0, 1.0, 0.0))
+        elif name == "adjust":  # (SMALL SLIDING: read as the finite sliding covcontact always does)
+            assert c.adjust == 0.01
+        elif name == "adjust-set":
+            assert c.adjust == "NSLAVE"
         elif name == "kinematic":  # linear (Prager) kinematic hardening, slope (6 - 5) / 0.1, no isotropic part
             mat = p.bodies[0].material
             assert mat.kind == 2 and mat.yield_stress == 5.0 and mat.kinematic_modulus == pytest.approx(10.0)

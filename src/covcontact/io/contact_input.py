@@ -6,7 +6,7 @@ from __future__ import annotations
 from ..description import TANGENT_CASES, ContactPair
 from .conditions_input import SetRefs
 from .fields import split_ref
-from .validate import Section
+from .validate import Section, suggest
 
 #: the largest number of Gauss points per direction of a segment-to-surface slave facet
 MAX_ORDER = 8
@@ -146,6 +146,7 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         eps_t = c.get("tangential_penalty", "float", None, positive=True)
         enabled = c.get("enabled", "bool", True)
         smoothing = c.get("smoothing", "float", 0.0, nonnegative=True)
+        adjust = _adjust(c, sets, slave, master, law, surfaces, rigid)
         c.done()
         if any(x.name == cname for x in contacts):
             c.fail(f"duplicate contact name {cname!r}", "name")
@@ -154,5 +155,26 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
                                     auto_factor=auto_factor, enabled=enabled, smoothing=smoothing, law=law,
                                     clearance=clearance, pressure=pressure, type=ctype, order=order,
-                                    self_surfaces=surfaces, tie_tolerance=tie_tol))
+                                    self_surfaces=surfaces, tie_tolerance=tie_tol, adjust=adjust))
     return contacts
+
+
+def _adjust(c: Section, sets: SetRefs, slave, master, law: str, surfaces, rigid) -> float | str | None:
+    """``adjust``: a distance (>= 0) or a node set of the slave body."""
+    if not c.has("adjust"):
+        return None
+    if surfaces is not None or law == "tied":
+        c.fail("moves slave nodes onto a master: not for self-contact or law = \"tied\" (which bonds within "
+               "tie_tolerance)", "adjust")
+    if master[1] == "":
+        c.fail(f"moves slave nodes onto a meshed master; {master[0]!r} is an analytic surface", "adjust")
+    if any(r.name == slave[0] for r in rigid):
+        c.fail(f"moves slave nodes of a deformable body; {slave[0]!r} is rigid", "adjust")
+    if isinstance(c.data["adjust"], str):
+        name = c.get("adjust", "str")
+        sets_of = sets.mesh(slave[0]).node_sets
+        if name not in sets_of:
+            c.fail(f"body {slave[0]!r} has no node set {name!r}{suggest(name, sets_of)} (a distance, or a node set "
+                   f"of the slave body)", "adjust")
+        return name
+    return c.get("adjust", "float", nonnegative=True)

@@ -477,6 +477,9 @@ class _Writer:
                 entry.update({"penalty": self._hard_penalty(mb), "method": "augmented"})
             else:
                 entry.update({"penalty": "auto", "method": "augmented"})
+            adjust = self.m.pair_adjust.get(where)
+            if adjust is not None and it.behavior != "tied":  # (a node set: its name in the slave body's mesh)
+                entry["adjust"] = _name(adjust) if isinstance(adjust, str) else adjust
             if it.friction is not None and it.friction[0] > 0 and it.behavior != "tied":
                 entry["friction"] = it.friction[0]
                 if it.friction[1] is not None and it.friction[1] > 0:

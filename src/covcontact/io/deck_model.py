@@ -120,6 +120,8 @@ class DeckModel:
     sections: list[tuple[str, str, str]] = field(default_factory=list)   # (elset, material, where)
     interactions: dict[str, Interaction] = field(default_factory=dict)
     pairs: list[tuple[str, str, str, str, str]] = field(default_factory=list)  # (interaction, type, slave, master, where)
+    #: ADJUST= of a *CONTACT PAIR by its line (where): a distance, or a node set's name
+    pair_adjust: dict[str, float | str] = field(default_factory=dict)
     #: *TIE: (name, slave, master, position tolerance or None, where)
     ties: list[tuple[str, str, str, float | None, str]] = field(default_factory=list)
     equations: list[tuple[list[tuple[int, int, float]], str]] = field(default_factory=list)
@@ -208,11 +210,23 @@ class _Reader:
                 if kind not in ("NODE TO SURFACE", "SURFACE TO SURFACE"):
                     m.unsupported.append(f"{c.where()}: *CONTACT PAIR, TYPE={kind} is not supported")
                     continue
+                adjust = c.param("ADJUST")
+                if adjust is not None:
+                    try:
+                        adjust = float(adjust)
+                    except ValueError:
+                        adjust = adjust.upper()
+                        if adjust not in m.nsets:
+                            raise c.fail(f"ADJUST={c.params['ADJUST']}: neither a distance nor a *NSET defined above")
+                    if isinstance(adjust, float) and adjust < 0.0:
+                        raise c.fail(f"ADJUST must be >= 0, got {adjust}")
                 for j, row in enumerate(c.rows()):
                     if len(row) < 2:
                         raise c.fail("a contact pair needs 'slave surface, master surface'", j)
                     m.pairs.append((c.param("INTERACTION", required=True).upper(), kind, row[0].upper(),
                                     row[1].upper(), c.where(j)))
+                    if adjust is not None:
+                        m.pair_adjust[c.where(j)] = adjust
             elif c.name == "EQUATION":
                 if not c.params:  # (REMOVE, REMOVE ALL: listed as unsupported)
                     self._equation(c)
@@ -292,6 +306,7 @@ class _Reader:
                     p in ("AMPLITUDE", "TIME DELAY") and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
                     p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
+                    c.name == "CONTACT PAIR" and p in ("ADJUST", "SMALL SLIDING")) or (
                     c.name == "PLASTIC" and p == "HARDENING"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "

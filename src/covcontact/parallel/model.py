@@ -19,7 +19,7 @@ from numba import njit
 from ..assembly.pattern import Pattern
 from ..assembly.system import BodyBlock, InvertedElementError, System, make_solid
 from ..elements.base import SolidStress
-from ..solvers.model import Model
+from ..solvers.model import Model, adjust_once
 from ..solvers.stages import StagePlan
 from ..solvers.state import State
 from .comm import gather_all, share_cores, sum_all
@@ -300,6 +300,7 @@ class DistributedModel(Model):
         self.rank, self.size = comm.rank, comm.size
         self.threads = share_cores(comm)
         self.problem = problem
+        adjust_once(problem)
         self.system = DistributedSystem(problem.bodies, problem.loads, problem.dirichlet, comm)
         self.tangent = tangent
         from .contact import DistributedContact

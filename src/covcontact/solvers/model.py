@@ -17,6 +17,15 @@ from .stages import Loading, StagePlan
 from .state import State
 
 
+def adjust_once(problem) -> None:
+    """Move the slave nodes of the pairs with ``adjust`` onto their masters, once per problem (every model of it, and
+    every rank of a distributed run, then sees the same meshes); ``problem.adjusted`` keeps what was done."""
+    if getattr(problem, "adjusted", None) is None:
+        from ..contact.adjust import adjust_slaves
+
+        problem.adjusted = adjust_slaves(problem)
+
+
 class Model:
     """Bodies, loads, Dirichlet conditions and contact of a problem, evaluated at a displacement u.
 
@@ -33,6 +42,7 @@ class Model:
 
     def __init__(self, problem, tangent: str | None = None):
         self.problem = problem
+        adjust_once(problem)
         self.system = System(problem.bodies, problem.rigid, problem.loads, problem.dirichlet)
         self.tangent = tangent
         self.contact = ContactManager(problem, self.system, tangent)
@@ -277,7 +287,7 @@ class Model:
     def start_warnings(self, u: np.ndarray, state: State) -> list[str]:
         """Warnings about the start of a run that is legal but almost certainly wrong: materials whose Young's
         modulus and yield stress look like mixed units; slave nodes inside their master (contact/report.py)."""
-        out = self._material_warnings()
+        out = self._material_warnings() + list(getattr(self.problem, "adjusted", None) or [])
         if not self.contact.passes or self.size > 1:
             return out
         from ..contact.report import start_warnings
