@@ -94,6 +94,8 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     if dynamic or gravity is not None:
         check_densities(top, bodies, "a dynamic stage" if dynamic else "gravity")
         for i, r in enumerate(rigid):  # a free rigid body moves by its mass and inertia
+            if r.attach:  # (its inertia is its attached nodes')
+                continue
             if any(c < 3 for c in r.free) and r.mass is None:
                 top.fail("missing: a rigid body with free translations needs its mass in a dynamic stage (or with "
                          "gravity)", f"rigid[{i}].mass")
@@ -102,12 +104,6 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                          "[Ixx, Iyy, Izz] about its reference point in a dynamic stage", f"rigid[{i}].inertia")
     elif velocities:
         top.fail("initial velocities need a dynamic stage (procedure = \"dynamic\")", "initial_velocity")
-    if equations and dynamic:
-        top.fail("multi-point constraints ([[equation]]) are for quasi-static stages only, not yet dynamic ones",
-                 "equation")
-    for i, r in enumerate(rigid):
-        if r.attach and dynamic:
-            top.fail("attached nodes are for quasi-static stages only, not yet dynamic ones", f"rigid[{i}].attach")
     check_attached(top, rigid, bodies, dirichlet, equations)
     solver = read_solver(top)
     output = read_output(top)

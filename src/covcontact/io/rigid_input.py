@@ -60,8 +60,8 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         if inertia is not None and not all(v > 0.0 for v in inertia):
             r.fail(f"the principal moments of inertia must be > 0, got {list(inertia)}", "inertia")
         if attach and (mass is not None or inertia is not None):
-            r.fail("a rigid body with attached nodes takes its mass from their elements (quasi-static stages only); "
-                   "remove mass and inertia", "mass" if mass is not None else "inertia")
+            r.fail("a rigid body with attached nodes takes its mass and inertia from their elements; remove mass and "
+                   "inertia", "mass" if mass is not None else "inertia")
         for key, val in (("mass", mass), ("inertia", inertia)):
             if val is not None and not free:
                 r.fail(f"{key} is for a body with free components (its motion follows equilibrium); this one's "

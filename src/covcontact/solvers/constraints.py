@@ -54,6 +54,14 @@ class LinearConstraints:
         """Set the dependent dofs of ``u`` (in place) from the others."""
         u[self.dependent] = self.rows @ u
 
+    def mass(self, M):
+        """T^T M T: the mass of the independent dofs."""
+        return (self.Tt @ M @ self.T).tocsr()
+
+    def lift(self, a: np.ndarray) -> np.ndarray:
+        """T a: a rate (velocity, acceleration) of the independent dofs at every dof."""
+        return self.T @ a
+
     def transform(self, R: np.ndarray, K):
         """(T^T R, T^T K T) (K may be None)."""
         R = self.Tt @ R
@@ -127,6 +135,16 @@ class RigidLinks:
                           shape=(self.n, self.n)) + self._keep
         return P.tocsr(), parts
 
+    def mass(self, M):
+        """P^T M P at the displacement of the last ``complete``: the attached nodes' mass on their bodies' (t, theta)."""
+        P = self._map()[0]
+        return (P.T @ M @ P).tocsr()
+
+    def lift(self, a: np.ndarray) -> np.ndarray:
+        """P a: a rate of the independent dofs at every dof (the attached nodes' from their bodies'; to first order:
+        without the centripetal part, which the rates at rest, where this is used, do not have)."""
+        return self._map()[0] @ a
+
     def transform(self, R: np.ndarray, K):
         """(P^T R, P^T K P + the rotation's second-order part) (K may be None)."""
         from ..contact.reference import skew, tangent_map_derivatives
@@ -168,3 +186,9 @@ class ChainedConstraints:
 
     def transform(self, R: np.ndarray, K):
         return self.rigid.transform(*self.linear.transform(R, K))
+
+    def mass(self, M):
+        return self.rigid.mass(self.linear.mass(M))
+
+    def lift(self, a: np.ndarray) -> np.ndarray:
+        return self.linear.lift(self.rigid.lift(a))

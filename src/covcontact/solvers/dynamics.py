@@ -118,13 +118,20 @@ class DynamicModel:
 
     def evaluate(self, u: np.ndarray, lam: float, committed: State, guess: State | None = None,
                  want_K: bool = True, timing: dict | None = None):
-        R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=timing)
+        # with multi-point constraints the inertia joins the nodal forces at every dof, then the constraints hand
+        # them over (R and the stored r are at every dof, Rd the independent dofs')
+        cons = getattr(self.model, "constraints", None)
+        R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=timing, raw=cons is not None)
         g, d = self.integ, committed.dynamics
         a, v, dt = self.kinematics(u, lam, committed)
         Rd = self.M @ ((1.0 - g.alpha_m) * a + g.alpha_m * d["a"]) + (1.0 - g.alpha_f) * R + g.alpha_f * d["r"]
         if K is not None:
             K.data *= 1.0 - g.alpha_f
             K = add_into(K, self.M, g.mass_factor(dt), self._cache)
+        if cons is not None:
+            Rd, K = cons.transform(Rd, K)
+            if K is not None and self.model.system.reference:
+                self.model._check_restrained(K)
         # the work of the applied forces and of the contact forces on the bodies over the step (trapezoidal rule)
         f = applied_forces(self.model, Rd, lam)
         du = u - d["u"]
@@ -144,6 +151,9 @@ def applied_forces(model, Rd: np.ndarray, lam: float) -> np.ndarray:
     dynamic residual there)."""
     f = model.external(lam).copy()
     c = ~model.free
+    cons = getattr(model, "constraints", None)
+    if cons is not None:  # (the dofs a constraint eliminates are no supports: its forces do no work in all)
+        c &= ~cons.mask
     f[c] += Rd[c]
     return f
 
@@ -196,16 +206,25 @@ class Dynamic(QuasiStatic):
         if "v" in state.dynamics or u is None:
             return state
         model = self.model
-        R, _, _ = model.evaluate(u, state.lam, state, want_K=False)
+        cons = getattr(model, "constraints", None)
+        R, _, _ = model.evaluate(u, state.lam, state, want_K=False, raw=cons is not None)
+        r_all = R  # (at every dof; with constraints R below is the independent dofs')
+        M = self.M
+        if cons is not None:  # the independent dofs' mass, residual and rates; the others follow (lift)
+            R = cons.transform(R, None)[0]
+            M = cons.mass(self.M)
         free = model.free
         first = not any(self.problem.stage_dynamics(i) is not None for i in range(state.stage))
         v = initial_velocity(model, self.problem) if first else np.zeros(model.n_dofs)
         v[~free] = 0.0  # (a prescribed dof moves with its prescription)
         a = np.zeros(model.n_dofs)
-        inert = free & (self.M.diagonal() > 0.0)  # (the redistributed mass leaves contact nodes without inertia)
+        inert = free & (M.diagonal() > 0.0)  # (the redistributed mass leaves contact nodes without inertia)
         if np.any(R[inert]):
-            a[inert] = sla.spsolve(self.M[inert][:, inert].tocsc(), -R[inert])
-        Rd = R + self.M @ a  # the supports' forces at rest or with the initial velocities' inertia
+            a[inert] = sla.spsolve(M[inert][:, inert].tocsc(), -R[inert])
+        Rd = R + M @ a  # the supports' forces at rest or with the initial velocities' inertia
+        if cons is not None:
+            v, a = cons.lift(v), cons.lift(a)
+        R = r_all
         rc = getattr(model, "last_contact_residual", None)
         dyn = {"u": u.copy(), "u0": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
                "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam),

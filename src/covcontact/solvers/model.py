@@ -223,7 +223,7 @@ class Model:
         r = r - self.external(lam)
         if self.constraints is not None and not raw:
             r, K = self.constraints.transform(r, K)
-        if want_K and self.system.reference:
+        if want_K and self.system.reference and (self.constraints is None or not raw):
             self._check_restrained(K)
         return r, K, committed.but(elements=etrial, contact=ctrial, lam=lam)
 
