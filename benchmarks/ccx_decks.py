@@ -132,7 +132,7 @@ def compare_blocks(a: dict, b: dict) -> list[dict]:
     """The blocks of ``b`` (reference) that ``a`` has at the same time: max |difference| / max |reference|."""
     rows = []
     for key, rb in b.items():
-        match = [k for k in a if k[0] == key[0] and k[1] == key[1] and abs(k[2] - key[2]) <= 1e-6 * max(1, key[2])]
+        match = [k for k in a if k[0] == key[0] and k[1] == key[1] and abs(k[2] - key[2]) <= 1e-6 * abs(key[2])]
         if not match:
             continue
         ab = a[match[0]]

@@ -562,3 +562,121 @@ def test_contact_print_tabulates_contact_stresses(tmp_path):
     # reaction to 1e-4)
     assert np.all(rows[:, 1] > 0.0) and rows[:, 1].sum() == pytest.approx(support, rel=1e-4)
     assert np.abs(rows[:, 2:]).max() < 1e-9 * rows[:, 1].max()
+
+
+# ------------------------------------------------------------------------------------------------ removed equations
+
+STACK = """
+[problem]
+name = "stack"
+procedure = "dynamic"
+dt = 0.01
+t_end = 0.1
+method = "newmark"
+ramp = false
+[[bodies]]
+name = "low"
+element = "hex8"
+material = { model = "svk", E = 1.0e4, nu = 0.3, density = 1.0 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 1, ny = 1, nz = 1 }
+[bodies.sets]
+a = { closest = [0.0, 0.0, 1.0] }
+b = { closest = [1.0, 0.0, 1.0] }
+c = { closest = [1.0, 1.0, 1.0] }
+d = { closest = [0.0, 1.0, 1.0] }
+[[bodies]]
+name = "up"
+element = "hex8"
+material = { model = "svk", E = 1.0e4, nu = 0.3, density = 1.0 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 1, ny = 1, nz = 1, origin = [0.0, 0.0, 1.0] }
+[bodies.sets]
+a = { closest = [0.0, 0.0, 1.0] }
+b = { closest = [1.0, 0.0, 1.0] }
+c = { closest = [1.0, 1.0, 1.0] }
+d = { closest = [0.0, 1.0, 1.0] }
+[[dirichlet]]
+set = "low.zmin"
+[[body_force]]
+body = "up"
+value = [0.0, 0.0, 50.0]
+EQUATIONS
+[[stages]]
+name = "free"
+procedure = "dynamic"
+dt = 0.01
+t_end = 0.05
+method = "newmark"
+remove = REMOVED
+"""
+
+
+def _stack(tmp_path, removed: str) -> Path:
+    eqs = "".join(f'[[equation]]\nname = "{n}{c}"\nterms = [["up.{n}", "{c}", 1.0], ["low.{n}", "{c}", -1.0]]\n'
+                  for n in "abcd" for c in "xyz")
+    path = tmp_path / "stack.toml"
+    path.write_text(STACK.replace("EQUATIONS", eqs).replace("REMOVED", removed))
+    return path
+
+
+def test_equations_removed_in_a_later_stage(tmp_path):
+    """Two bricks stacked, the upper one's bottom corners tied to the lower one's top corners by equations (x, y, z),
+    pulled up by a body force applied at once: they vibrate as one column; a later stage removes the equations (a
+    deck's *EQUATION, REMOVE ALL) and the upper brick flies off: its momentum grows by F dt in every step exactly
+    (1e-10; the stage starts from the equilibrium acceleration of the freed brick, not the one the constraint forces
+    were in, which would miss by dt/2 times the tie's force), its bottom leaves the lower brick's top. Removing an
+    equation twice, or one no [[equation]] names, is one line."""
+    from covcontact.solvers.model import Model
+
+    path = _stack(tmp_path, str([f"{n}{c}" for n in "abcd" for c in "xyz"]).replace("'", '"'))
+    problem = load_problem(path)
+    res = problem.run(out=tmp_path / "out", quiet=True)
+    assert res.exit_code == 0
+    model = Model(load_problem(path))
+    M = model.system.mass()
+    up = slice(3 * model.system.offset("up"), 3 * (model.system.offset("up") + 8))
+    steps = [s for s in res.summary["steps"] if s["stage"] == "free"]
+    assert len(steps) == 5
+    # the momentum of the upper brick: p(t_end) - p(removal) = F (t_end - t_removal), F = b V = 50
+    v_end = res.state.dynamics["v"]
+    p_end = float((M @ v_end)[up][2::3].sum())
+    # the momentum at the removal: the first stage alone, run again
+    first = load_problem(path)
+    first.stages = []
+    first_res = first.run(out=tmp_path / "first", quiet=True)
+    p0 = float((M @ first_res.state.dynamics["v"])[up][2::3].sum())
+    assert p_end - p0 == pytest.approx(50.0 * 0.05, rel=1e-10)
+    u = res.u.reshape(-1, 3)
+    lo, hi = model.system.offset("low"), model.system.offset("up")
+    gap = u[hi + np.flatnonzero(np.isclose(model.system.X[hi:hi + 8, 2], 1.0)), 2].mean() - \
+        u[lo + np.flatnonzero(np.isclose(model.system.X[lo:lo + 8, 2], 1.0)), 2].mean()
+    assert gap > 1e-3
+    for removed, words in (('["ax", "ax"]', "was removed in an earlier stage"),
+                           ('["ax", "qx"]', "no load or equation named 'qx'")):
+        text = _stack(tmp_path, removed).read_text()
+        if removed == '["ax", "ax"]':
+            text = text.replace('remove = ["ax", "ax"]', 'remove = ["ax"]') + (
+                '[[stages]]\nname = "again"\nprocedure = "dynamic"\ndt = 0.01\nt_end = 0.01\nremove = ["ax"]\n')
+        path.write_text(text)
+        with pytest.raises(InputError) as err:
+            load_problem(path)
+        assert words in str(err.value) and "\n" not in str(err.value), (words, str(err.value))
+
+
+def test_equation_remove_becomes_a_stage_removal(tmp_path):
+    """*EQUATION (model data, named eq1, eq2 in order) and *EQUATION, REMOVE in a later step: the stage removes the
+    equations whose dependent (first) node and dof the lines name (a node label or a set); REMOVE ALL removes every
+    one; a new *EQUATION inside a step is one line."""
+    eqs = "*EQUATION\n2\n1001, 3, 1.0, 1003, 3, -1.0\n*EQUATION\n2\n1005, 3, 1.0, 1003, 3, -1.0\n*STEP"
+    step2 = "*STEP\n*STATIC\n0.5, 1.0\n*EQUATION, REMOVE\nREMOVED\n*END STEP\n"
+    for removed, names in (("1005, 3", ["eq2"]), ("NSLAVE, 3", ["eq1", "eq2"])):
+        deck = two_block_deck(tmp_path / "eq.inp", extra_step=step2.replace("REMOVED", removed))
+        deck.write_text(deck.read_text().replace("*STEP", eqs, 1))
+        imp = import_deck(deck, tmp_path / removed.split(",")[0] / "p.toml")
+        assert imp.unsupported == []
+        p = load_problem(imp.problem)
+        assert [e.name for e in p.equations] == ["eq1", "eq2"] and list(p.stages[0].remove) == names
+    deck.write_text(deck.read_text().replace("*EQUATION, REMOVE\nNSLAVE, 3", "*EQUATION, REMOVE ALL"))
+    assert list(load_problem(import_deck(deck, tmp_path / "all" / "p.toml").problem).stages[0].remove) == ["eq1", "eq2"]
+    deck.write_text(deck.read_text().replace("*EQUATION, REMOVE ALL", "*EQUATION\n2\n1001, 1, 1.0, 1003, 1, -1.0"))
+    with pytest.raises(DeckError, match="new equations belong to the model data, before the first"):
+        import_deck(deck, tmp_path / "new" / "p.toml")

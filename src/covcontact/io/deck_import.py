@@ -321,6 +321,12 @@ class _Writer:
                 st = {"name": stage_name, **self._timing(step, duration, jump)}
                 if motions:
                     st["motions"] = motions
+                removed = self._removed_equations(step) if j == 0 else []
+                if s == 0 and j == 0 and (step.remove_equations is None or step.remove_equations):
+                    self.unsupported.append(f"{step.where}: *EQUATION, REMOVE in the first step (the equations are "
+                                            f"model data; leave them out instead)")
+                if removed:
+                    st["remove"] = removed
                 if release and j == 0:
                     st["release"] = release
                 changed = {f"pair{k + 1}": mu for k, (inter, *_rest) in enumerate(m.pairs)
@@ -505,7 +511,7 @@ class _Writer:
     # -- files ---------------------------------------------------------------------------------------
     def _equations(self) -> str:
         text = ""
-        for terms, where in self.m.equations:
+        for k, (terms, where) in enumerate(self.m.equations):
             out = []
             for node, dof, coef in terms:
                 if not 1 <= dof <= 3:
@@ -513,8 +519,17 @@ class _Writer:
                 (body, set_name), = self._node_targets(str(node), np.array([node]), where)
                 out.append([self._ref(body, set_name), _COMP[dof - 1], coef])
             else:
-                text += _table("[[equation]]", {"terms": out})
+                text += _table("[[equation]]", {"name": f"eq{k + 1}", "terms": out})
         return text
+
+    def _removed_equations(self, step) -> list[str]:
+        """The names of the equations a step's *EQUATION, REMOVE removes (by their dependent node and dof)."""
+        gone = set(step.remove_equations or ())
+        names = [f"eq{k + 1}" for k, (terms, _) in enumerate(self.m.equations)
+                 if step.remove_equations is None or (terms[0][0], terms[0][1]) in gone]
+        done = getattr(self, "_eq_removed", set())
+        self._eq_removed = done | set(names)
+        return [n for n in names if n not in done]
 
     def write(self) -> Imported:
         self.mesh_path = self.out.with_suffix(".mesh.inp")

@@ -89,6 +89,8 @@ class Step:
     node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
     el_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)    # (elset, variables, where)
     contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables (CSTRESS is tabulated)
+    #: *EQUATION, REMOVE: the dependent (node, dof) of the equations removed from this step on; None: REMOVE ALL
+    remove_equations: list | None = field(default_factory=list)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
 
 
@@ -228,7 +230,19 @@ class _Reader:
                     if adjust is not None:
                         m.pair_adjust[c.where(j)] = adjust
             elif c.name == "EQUATION":
-                if not c.params:  # (REMOVE, REMOVE ALL: listed as unsupported)
+                if "REMOVE ALL" in c.params or "REMOVE" in c.params:
+                    st = self._in_step(c)
+                    if "REMOVE ALL" in c.params:
+                        st.remove_equations = None
+                    elif st.remove_equations is not None:
+                        for j, row in enumerate(c.rows()):
+                            if len(row) < 2:
+                                raise c.fail("a line of *EQUATION, REMOVE is 'node or set, dof'", j)
+                            dof = int(c.number(j, 1, row, "the dof"))
+                            st.remove_equations += [(int(n), dof) for n in self._resolve_nodes(c, j, row[0])]
+                elif self.step is not None:
+                    raise c.fail("new equations belong to the model data, before the first *STEP")
+                else:
                     self._equation(c)
             elif c.name == "AMPLITUDE":
                 self._amplitude(c)
@@ -307,6 +321,7 @@ class _Reader:
                     p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
                     c.name == "CONTACT PAIR" and p in ("ADJUST", "SMALL SLIDING")) or (
+                    c.name == "EQUATION" and p in ("REMOVE", "REMOVE ALL")) or (
                     c.name == "PLASTIC" and p == "HARDENING"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "

@@ -76,7 +76,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     steps = dynamics.steps() if dynamics is not None else read_steps(top.get("steps", "table", None))
     velocities = read_initial_velocities(top, sets)
 
-    named = named_conditions(top, dirichlet, forces, pressures, tractions, body_forces)
+    named = named_conditions(top, dirichlet, forces, pressures, tractions, body_forces, equations)
     for r in rigid:  # rigid bodies with free components: their force is a load later stages may change
         if r.free and r.name not in named:
             named[r.name] = ("rigid", r)

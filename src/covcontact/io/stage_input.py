@@ -10,11 +10,11 @@ from .fields import COMPONENT_NAMES, dirichlet_values, names, read_motion, read_
 from .validate import Section, suggest
 
 
-def named_conditions(top: Section, dirichlet, forces, pressures, tractions, body_forces=()) -> dict:
-    """Name -> (kind, object) of the named Dirichlet conditions and loads (one namespace)."""
+def named_conditions(top: Section, dirichlet, forces, pressures, tractions, body_forces=(), equations=()) -> dict:
+    """Name -> (kind, object) of the named Dirichlet conditions, loads and equations (one namespace)."""
     named: dict = {}
     for kind, items in (("dirichlet", dirichlet), ("force", forces), ("pressure", pressures),
-                        ("traction", tractions), ("body_force", body_forces)):
+                        ("traction", tractions), ("body_force", body_forces), ("equation", equations)):
         for i, obj in enumerate(items):
             if not obj.name:
                 continue
@@ -78,7 +78,10 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
         st.fail("names a condition twice", "release")
     remove = names(st, "remove")
     for n in remove:
-        check_name(st, "remove", n, ("force", "pressure", "traction", "body_force", "rigid"), "load")
+        check_name(st, "remove", n, ("force", "pressure", "traction", "body_force", "rigid", "equation"),
+                   "load or equation")
+        if named[n][0] == "equation" and any(n in x.remove for x in earlier):
+            st.fail(f"equation {n!r} was removed in an earlier stage", "remove")
     targets = {}
     tsec = st.get("targets", "table", None)
     if tsec is not None:

@@ -203,28 +203,29 @@ class Dynamic(QuasiStatic):
         stage) gets them: u, the initial velocities (first dynamic stage) or rest, the acceleration of
         equilibrium M a_0 = -r(u_0) on the free dofs, and the energy account's start."""
         super().start(state)
-        if "v" in state.dynamics or u is None:
+        if u is None:
             return state
+        if "v" in state.dynamics:
+            if not self._frees_equations(state.stage):
+                return state
+            # equations removed at the stage's start: the dofs they held are free from here, and the acceleration
+            # the last step left (with the constraint forces in it) is not that of the new equations of motion: the
+            # equilibrium acceleration at the same displacement and velocity, as a dynamic step that starts
+            R, _, _ = self.model.evaluate(u, state.lam, state, want_K=False, raw=True)
+            a, Rd = self._equilibrium(R, self.model.free)
+            dyn = dict(state.dynamics)
+            dyn.update(a=a, r=R, rd=Rd, f=applied_forces(self.model, Rd, state.lam))
+            return state.but(dynamics=dyn)
         model = self.model
         cons = getattr(model, "constraints", None)
         R, _, _ = model.evaluate(u, state.lam, state, want_K=False, raw=cons is not None)
-        r_all = R  # (at every dof; with constraints R below is the independent dofs')
-        M = self.M
-        if cons is not None:  # the independent dofs' mass, residual and rates; the others follow (lift)
-            R = cons.transform(R, None)[0]
-            M = cons.mass(self.M)
         free = model.free
         first = not any(self.problem.stage_dynamics(i) is not None for i in range(state.stage))
         v = initial_velocity(model, self.problem) if first else np.zeros(model.n_dofs)
         v[~free] = 0.0  # (a prescribed dof moves with its prescription)
-        a = np.zeros(model.n_dofs)
-        inert = free & (M.diagonal() > 0.0)  # (the redistributed mass leaves contact nodes without inertia)
-        if np.any(R[inert]):
-            a[inert] = sla.spsolve(M[inert][:, inert].tocsc(), -R[inert])
-        Rd = R + M @ a  # the supports' forces at rest or with the initial velocities' inertia
-        if cons is not None:
-            v, a = cons.lift(v), cons.lift(a)
-        R = r_all
+        if cons is not None:  # (the eliminated dofs' velocities follow the others')
+            v = cons.lift(v)
+        a, Rd = self._equilibrium(R, free)  # (Rd: the supports' forces at rest or with the initial velocities' inertia)
         rc = getattr(model, "last_contact_residual", None)
         dyn = {"u": u.copy(), "u0": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
                "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam),
@@ -233,6 +234,26 @@ class Dynamic(QuasiStatic):
         dyn["e0"] = np.array(e["mechanical"])
         dyn["ec0"] = np.array(e["contact"])
         return state.but(dynamics=dyn)
+
+    def _frees_equations(self, stage: int) -> bool:
+        """Whether ``stage`` removes equations (its ``remove`` names one)."""
+        names = {e.name for e in getattr(self.problem, "equations", None) or [] if e.name}
+        return stage > 0 and bool(names & set(self.problem.stages[stage - 1].remove))
+
+    def _equilibrium(self, R: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(a, Rd): the acceleration of M a = -R on the free dofs with mass (``R`` at every dof; with constraints
+        solved on the independent dofs with T^T M T and lifted) and the residual with that inertia."""
+        cons = getattr(self.model, "constraints", None)
+        M = self.M
+        if cons is not None:
+            R = cons.transform(R, None)[0]
+            M = cons.mass(self.M)
+        a = np.zeros(len(R))
+        inert = free & (M.diagonal() > 0.0)  # (the redistributed mass leaves contact nodes without inertia)
+        if np.any(R[inert]):
+            a[inert] = sla.spsolve(M[inert][:, inert].tocsc(), -R[inert])
+        Rd = R + M @ a
+        return (cons.lift(a) if cons is not None else a), Rd
 
     def advance(self, u: np.ndarray, state: State, step: int, lam: float) -> Increment:
         """A time step: Newton on the dynamic model. With ``reuse_factorization = "auto"`` a dynamic step reuses its

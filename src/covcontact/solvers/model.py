@@ -55,15 +55,23 @@ class Model:
             self.symmetric = False  # (attached nodes: the rotation's second-order part is not symmetric)
         self.set_stage(State([], None))
 
-    def _constraints(self, problem):
-        """The multi-point constraints: linear equations, nodes attached to rigid bodies, both or None."""
+    def _constraints(self, problem, stage: int = 0):
+        """The multi-point constraints of a stage: linear equations (those no stage up to it removed), nodes attached
+        to rigid bodies, both or None; built once per set of equations."""
         from .constraints import ChainedConstraints, LinearConstraints, RigidLinks
 
-        linear = LinearConstraints(problem.equations, self.system) if getattr(problem, "equations", None) else None
-        rigid = RigidLinks(self.system) if any(r.attached.size for r in self.system.reference) else None
-        if linear is not None and rigid is not None:
-            return ChainedConstraints(linear, rigid)
-        return linear if linear is not None else rigid
+        if not hasattr(self, "_constraint_sets"):
+            self._constraint_sets = {}
+            self._rigid_links = RigidLinks(self.system) if any(r.attached.size for r in self.system.reference) \
+                else None
+        removed = frozenset(n for st in list(getattr(problem, "stages", []))[:stage] for n in st.remove)
+        if removed not in self._constraint_sets:
+            eqs = [e for e in getattr(problem, "equations", None) or [] if not (e.name and e.name in removed)]
+            linear = LinearConstraints(eqs, self.system) if eqs else None
+            rigid = self._rigid_links
+            both = ChainedConstraints(linear, rigid) if linear is not None and rigid is not None else None
+            self._constraint_sets[removed] = both or (linear if linear is not None else rigid)
+        return self._constraint_sets[removed]
 
     # stages -----------------------------------------------------------------------------------
     def set_stage(self, state: State) -> None:
@@ -71,6 +79,8 @@ class Model:
         spec = self.stages[state.stage]
         self.loading = Loading(spec, self.system.X, state.forces.get("release"), state.forces.get("held"),
                                state.forces.get("parked"), state.forces.get("applied"))
+        if getattr(self.problem, "equations", None):  # (equations a stage removes hold no more from its start)
+            self.constraints = self._constraints(self.problem, state.stage)
         held = spec.constrained if self.constraints is None else spec.constrained | self.constraints.mask
         self.system.set_constraints(held)
         self.contact.set_stage(spec.motions, spec.contacts, spec.friction)
