@@ -53,16 +53,16 @@ def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]
             out[key] = {}
             out[("tangential", "ALL", key[2])] = {}
             continue
-        if " for set " in line and " and time " in line:
-            kind = line.split(" for set")[0].split()[0]
-            key = (kind, line.split("set ")[1].split()[0], float(line.split("time")[1]))
-            out[key] = {} if kind in ("displacements", "forces", "stresses") else None
+        if "for set " in line and " and time " in line:  # (CalculiX writes PEEQ's header without a space)
+            kind = line.split()[0]
+            key = (kind, line.split("for set ")[1].split()[0], float(line.split("time")[1]))
+            out[key] = {} if kind in ("displacements", "forces", "stresses", "equivalent") else None
             continue
         if key is None or out.get(key) is None or not line.strip():
             continue
         f = line.split()
         try:
-            if key[0] == "stresses":
+            if key[0] in ("stresses", "equivalent"):  # (per integration point; "equivalent": PEEQ)
                 out[key][(int(f[0]), int(f[1]))] = np.array([float(v) for v in f[2:8]])
             elif key[0] == "contact":  # the tangential axes are each code's own: their magnitude
                 v = [float(x) for x in f[1:4]]
@@ -200,7 +200,7 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
     if frd and not any(b["kind"] == "displacements" for b in blocks):  # only the .frd holds displacements
         blocks += compare_blocks(ours_at_step_ends(work / "run"), frd_displacements(frd))
     row["blocks"] = blocks
-    for kind in ("displacements", "forces", "stresses", "contact", "tangential"):
+    for kind in ("displacements", "forces", "stresses", "contact", "tangential", "equivalent"):
         vals = [b["rel_diff"] for b in blocks if b["kind"] == kind]
         if vals:
             row[f"max_rel_{kind}"] = max(vals)
@@ -221,7 +221,7 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
             if not any(b["kind"] == "displacements" for b in nb) and (nl / f"{name}.frd").is_file():
                 nb += compare_blocks(ours_at_step_ends(work / "run"),
                                      frd_displacements((nl / f"{name}.frd").read_text(errors="replace")))
-            for kind in ("displacements", "forces", "stresses", "contact", "tangential"):
+            for kind in ("displacements", "forces", "stresses", "contact", "tangential", "equivalent"):
                 vals = [b["rel_diff"] for b in nb if b["kind"] == kind]
                 if vals:
                     row[f"max_rel_{kind}_vs_ccx_nlgeom"] = max(vals)

@@ -379,3 +379,28 @@ def test_pendulum_through_an_attached_pivot():
     err = max(abs(s["energy"]["balance_error"]) * max(s["energy"]["kinetic"] + s["energy"]["strain"],
                                                        abs(s["energy"]["external_work"])) for s in steps)
     assert err < 3e-3 * peak
+
+
+def test_deck_el_print_peeq(tmp_path):
+    """*EL PRINT PEEQ: the equivalent plastic strain at every Gauss point in CalculiX's layout (its header has no space
+    before "for"): the bar of J2 perfect plasticity (yield 5 against E = 100) stretched by 25 % through its rigid
+    top yields everywhere, PEEQ > 0 at all 96 points and below the stretch's ln 1.25 on average (the clamped ends
+    concentrate it); the elastic bar prints zeros."""
+    from covcontact.cli import main
+
+    step = "*STEP, NLGEOM\n*STATIC\n0.25, 1.0\n*BOUNDARY\n1000, 1, 2, 0.0\n1000, 3, 3, 0.5\n" \
+           "*EL PRINT, ELSET=BAR\nPEEQ\n*END STEP\n"
+    for plastic in (True, False):
+        deck = tmp_path / f"p{plastic}.inp"
+        _bar_deck(deck, step)
+        if plastic:
+            deck.write_text(deck.read_text().replace("100.0, 0.0\n", "100.0, 0.0\n*PLASTIC\n5.0, 0.0\n"))
+        assert main(["run", str(deck), "--out", str(tmp_path / f"o{plastic}"), "--quiet"]) == 0
+        lines = (tmp_path / f"o{plastic}" / f"p{plastic}.dat").read_text().splitlines()
+        at = lines.index(" equivalent plastic strain (elem, integ.pnt.,pe)for set BAR and time  0.1000000E+01")
+        rows = np.array([[float(v) for v in ln.split()] for ln in lines[at + 2: at + 2 + 96]])
+        assert rows[:, :2].tolist() == [[e, g] for e in range(1, 13) for g in range(1, 9)]
+        if plastic:
+            assert np.all(rows[:, 2] > 0.0) and 0.0 < rows[:, 2].mean() < np.log(1.25)
+        else:
+            assert np.all(rows[:, 2] == 0.0)

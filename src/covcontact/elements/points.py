@@ -36,3 +36,24 @@ def point_stresses(solid, u: np.ndarray, state: dict | None = None) -> np.ndarra
                                2, buf, get_num_threads(), np.ascontiguousarray(hist[:, g: g + 1]))
         out[:, g] = buf[:, :6]
     return out
+
+
+def point_plastic_strains(solid, state: dict | None = None) -> np.ndarray | None:
+    """(n_elements, n_points) equivalent plastic strain at the Gauss points (the J2 history), NaN past a cell's own
+    points; None for a body without plastic history. Zero in the elastic parts of a composite body."""
+    from ..materials.plasticity import H_ALPHA, J2
+
+    state = solid.new_state() if state is None else state
+    if isinstance(solid, CompositeBody):
+        rows = [point_plastic_strains(part, solid._views(k, state)[0]) for k, part in enumerate(solid.parts)]
+        if all(r is None for r in rows):
+            return None
+        width = max(p.weights.size for p in solid.parts)
+        out = np.full((solid.n_elements, width), np.nan)
+        for idx, r, part in zip(solid.index, rows, solid.parts):
+            out[idx, : part.weights.size] = 0.0 if r is None else r
+        return out
+    hist = state.get("hist")
+    if hist is None or getattr(solid, "material", None) is None or solid.material.kind != J2:
+        return None
+    return np.array(hist[:, :, H_ALPHA])

@@ -92,12 +92,12 @@ class DatTable(Observer):
         """The *EL PRINT blocks of S: the Cauchy stress at each Gauss point, in CalculiX's component order (xx, yy,
         zz, xy, xz, yz) and its point numbering (the first direction of the element's coordinates fastest)."""
         el_prints = self.info.get("el_print", [])
-        if stage >= len(el_prints) or not any("S" in v for _, v in el_prints[stage]):
+        if stage >= len(el_prints) or not any("S" in v or "PEEQ" in v for _, v in el_prints[stage]):
             return []
-        from ..elements.points import point_stresses
+        from ..elements.points import point_plastic_strains, point_stresses
 
         sysm = model.system
-        rows = {}   # element label -> (n_points, 6)
+        rows, peeq = {}, {}   # element label -> (n_points, 6), (n_points,)
         U = run.u.reshape(-1, 3)
         for blk, est in zip(sysm.blocks, run.state.elements):
             labels = self.info["elements"].get(blk.name, [])
@@ -106,17 +106,23 @@ class DatTable(Observer):
             except ValueError:
                 continue
             rows.update(zip(labels, s[:, :, [0, 1, 2, 3, 5, 4]]))
+            p = point_plastic_strains(blk.solid, est)
+            if p is None:  # (an elastic body: zero at its points)
+                p = np.where(np.isnan(s[:, :, 0]), np.nan, 0.0)
+            peeq.update(zip(labels, p[:, :, None]))
         text = []
         for elset, variables in el_prints[stage]:
-            if "S" not in variables:
-                continue
-            text.append(f"\n stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz) for set {elset} and time "
-                        f"{fortran_e(time)}\n\n")
-            for lab in self.info["elsets"][elset]:
-                if lab not in rows:
+            for var, head, table in (("S", "stresses (elem, integ.pnt.,sxx,syy,szz,sxy,sxz,syz)", rows),
+                                     ("PEEQ", "equivalent plastic strain (elem, integ.pnt.,pe)", peeq)):
+                if var not in variables:
                     continue
-                text += [f"{lab:10d}{g + 1:4d}" + "".join(f"{v:14.6E}" for v in row) + "\n"
-                         for g, row in enumerate(rows[lab]) if not np.isnan(row[0])]
+                gap = "" if var == "PEEQ" else " "  # (CalculiX's own headers: PEEQ's has no space before "for")
+                text.append(f"\n {head}{gap}for set {elset} and time {fortran_e(time)}\n\n")
+                for lab in self.info["elsets"][elset]:
+                    if lab not in table:
+                        continue
+                    text += [f"{lab:10d}{g + 1:4d}" + "".join(f"{v:14.6E}" for v in row) + "\n"
+                             for g, row in enumerate(table[lab]) if not np.isnan(row[0])]
         return text
 
     @staticmethod
