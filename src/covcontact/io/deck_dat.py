@@ -1,5 +1,6 @@
-"""The ``.dat`` table of a deck's run: the *NODE PRINT requests (U: displacements, RF: forces) at the end of each step,
-in CalculiX's layout, with the deck's node labels (docs/input.md, "Abaqus and CalculiX decks")."""
+"""The ``.dat`` table of a deck's run: the *NODE PRINT requests (U: displacements, RF: forces; a rigid body's REF and
+ROT nodes too), *EL PRINT (S, PEEQ at the Gauss points) and *CONTACT PRINT (CSTRESS) at the end of each step, in
+CalculiX's layout, with the deck's node and element labels (docs/input.md, "Abaqus and CalculiX decks")."""
 
 from __future__ import annotations
 
@@ -89,8 +90,9 @@ class DatTable(Observer):
                 fh.write("".join(text))
 
     def _el_print(self, model, run, stage: int, time: float) -> list[str]:
-        """The *EL PRINT blocks of S: the Cauchy stress at each Gauss point, in CalculiX's component order (xx, yy,
-        zz, xy, xz, yz) and its point numbering (the first direction of the element's coordinates fastest)."""
+        """The *EL PRINT blocks of S (the Cauchy stress at each Gauss point, in CalculiX's component order xx, yy, zz,
+        xy, xz, yz) and PEEQ (the equivalent plastic strain there), in CalculiX's point numbering (the first
+        direction of the element's coordinates fastest)."""
         el_prints = self.info.get("el_print", [])
         if stage >= len(el_prints) or not any("S" in v or "PEEQ" in v for _, v in el_prints[stage]):
             return []
