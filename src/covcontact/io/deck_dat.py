@@ -57,8 +57,8 @@ class DatTable(Observer):
         forces = (R + model.external(inc.lam)).reshape(-1, 3)  # internal and contact forces at each node
         refs = {ref.name: ref for ref in sysm.reference}
         rigid = self.info.get("rigid", {})
-        if any(lab is not None for labels in rigid.values() for lab in labels):
-            Rr = model.evaluate(run.u, inc.lam, run.state, want_K=False)[0].reshape(-1, 3)
+        if any(lab is not None for labels in rigid.values() for lab in labels):  # (the constraints hand R over)
+            Rr = model.constraints.transform(R, None)[0].reshape(-1, 3)
         for name, (ref_label, rot_label) in rigid.items():
             # a rigid body's REF node: its translation and the attached nodes' pull, ROT node: its rotation vector
             # and the moment on it (the residual after the attached nodes hand their forces over, plus the load)

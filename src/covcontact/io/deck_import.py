@@ -74,6 +74,7 @@ class _Writer:
         self.b = Parts(m)
         self.body_names = self._body_names()
         self.rigid = DeckRigid(m, self.b)
+        self._eq_removed: set[str] = set()   # the equations stages removed so far
         self.extra_nsets: dict[str, np.ndarray] = {}
         self.extra_elsets: dict[str, np.ndarray] = {}
         self.extra_surfaces: dict[str, list[tuple[np.ndarray, int]]] = {}
@@ -527,9 +528,9 @@ class _Writer:
         gone = set(step.remove_equations or ())
         names = [f"eq{k + 1}" for k, (terms, _) in enumerate(self.m.equations)
                  if step.remove_equations is None or (terms[0][0], terms[0][1]) in gone]
-        done = getattr(self, "_eq_removed", set())
-        self._eq_removed = done | set(names)
-        return [n for n in names if n not in done]
+        new = [n for n in names if n not in self._eq_removed]
+        self._eq_removed |= set(new)
+        return new
 
     def write(self) -> Imported:
         self.mesh_path = self.out.with_suffix(".mesh.inp")

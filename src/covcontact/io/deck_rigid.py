@@ -33,6 +33,10 @@ class DeckRigid:
                                     f"rigid body; give each body its own")
                 self.by_label[lab] = (r, off)
         self.names = [f"RIGID{r + 1}" for r in range(len(m.rigid_bodies))]
+        # each body's reference point: its REF NODE, or (without one: its translation can be neither prescribed nor
+        # loaded) the centroid of its nodes
+        self.origins = [m.X[index[ref]] if ref is not None else m.X[index[nodes]].mean(axis=0)
+                        for nodes, ref, _, _ in m.rigid_bodies]
         self.stage_values: list[dict] = []   # per covcontact stage: {(r, comp): prescribed value at its end}
         self.stage_loads: list[dict] = []    # per covcontact stage: {(r, comp): force or moment at its end}
         self.unsupported: list[str] = []
@@ -43,13 +47,6 @@ class DeckRigid:
             return labels, []
         hit = np.isin(labels, list(self.by_label))
         return labels[~hit], [self.by_label[int(lab)] for lab in labels[hit]]
-
-    def _origin(self, r: int) -> np.ndarray:
-        nodes, ref, _, _ = self.m.rigid_bodies[r]
-        index = self.m.node_index()
-        if ref is not None:
-            return self.m.X[index[ref]]
-        return self.m.X[index[nodes]].mean(axis=0)   # (no REF NODE: its translation cannot be prescribed or loaded)
 
     def stage(self, values: dict, loads: dict) -> tuple[dict, dict]:
         """Record a stage's prescribed values and loads; for a stage after the first its ``motions`` (the change of
@@ -65,7 +62,7 @@ class DeckRigid:
             if comps:
                 d = [values.get((r, c), 0.0) - prev_v.get((r, c), 0.0) for c in range(6)]
                 if any(d):
-                    motions[name] = {"translation": d[:3], "rotation": d[3:], "center": self._origin(r).tolist()}
+                    motions[name] = {"translation": d[:3], "rotation": d[3:], "center": self.origins[r].tolist()}
             new = [loads.get((r, c), 0.0) for c in range(6)]
             if new != [prev_l.get((r, c), 0.0) for c in range(6)]:
                 targets[name] = {"force": new[:3], "moment": new[3:]}
@@ -93,7 +90,7 @@ class DeckRigid:
                 attach.append(ref(int(k), set_name))
             if not attach:
                 raise DeckError(f"{where}: the rigid body holds no node of an element")
-            origin = self._origin(r)
+            origin = self.origins[r]
             free = [_NAMES[c] for c in range(6) if (r, c) not in prescribed]
             entry = {"name": self.names[r], "attach": attach, "reference": origin.tolist()}
             vals = [first_v.get((r, c), 0.0) for c in range(6)]

@@ -102,16 +102,16 @@ class RigidLinks:
         keep = np.flatnonzero(~self.mask)
         self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
         self.unit = sp.diags(self.mask.astype(float)).tocsr()
-        self._u = np.zeros(n)
+        self._theta = [np.zeros(3) for _ in self.links]  # each body's rotation vector at the last ``complete``
 
     def complete(self, u: np.ndarray) -> None:
         """Set the attached nodes' displacements (in place) from their bodies' (t, theta)."""
         from ..motion import rotation_matrix
 
-        for ref, nodes, Y in self.links:
-            t, theta = u[3 * ref.A: 3 * ref.A + 3], u[3 * ref.B: 3 * ref.B + 3]
+        for k, (ref, nodes, Y) in enumerate(self.links):
+            t, theta = u[3 * ref.A: 3 * ref.A + 3], u[3 * ref.B: 3 * ref.B + 3].copy()
             u.reshape(-1, 3)[nodes] = t + Y @ rotation_matrix(theta).T - Y
-        self._u = u.copy()
+            self._theta[k] = theta
 
     def _map(self):
         """P (n x n) at the displacement of the last ``complete`` and per link (rows R Y_i, T)."""
@@ -119,9 +119,7 @@ class RigidLinks:
         from ..motion import rotation_matrix
 
         rows, cols, vals, parts = [], [], [], []
-        u = self._u
-        for ref, nodes, Y in self.links:
-            theta = u[3 * ref.B: 3 * ref.B + 3]
+        for (ref, nodes, Y), theta in zip(self.links, self._theta):
             T = tangent_map(theta)
             ry = Y @ rotation_matrix(theta).T
             B = -skew(ry) @ T                                      # (m, 3, 3)

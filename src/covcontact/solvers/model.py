@@ -44,6 +44,8 @@ class Model:
         self.problem = problem
         adjust_once(problem)
         self.system = System(problem.bodies, problem.rigid, problem.loads, problem.dirichlet)
+        self._constraint_sets: dict = {}
+        self._rigid_links = None
         self.tangent = tangent
         self.contact = ContactManager(problem, self.system, tangent)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
@@ -60,10 +62,8 @@ class Model:
         to rigid bodies, both or None; built once per set of equations."""
         from .constraints import ChainedConstraints, LinearConstraints, RigidLinks
 
-        if not hasattr(self, "_constraint_sets"):
-            self._constraint_sets = {}
-            self._rigid_links = RigidLinks(self.system) if any(r.attached.size for r in self.system.reference) \
-                else None
+        if self._rigid_links is None and any(r.attached.size for r in self.system.reference):
+            self._rigid_links = RigidLinks(self.system)
         removed = frozenset(n for st in list(getattr(problem, "stages", []))[:stage] for n in st.remove)
         if removed not in self._constraint_sets:
             eqs = [e for e in getattr(problem, "equations", None) or [] if not (e.name and e.name in removed)]
