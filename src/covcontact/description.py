@@ -111,9 +111,13 @@ class ContactPair:
     auto_factor: float = 10.0
     enabled: bool = True               # off: the pair does nothing until a stage switches it on
     smoothing: float = 0.0             # width of the band of gaps over which the normal law is rounded (C1)
-    law: str = "penalty"               # normal law: "penalty" (with ``smoothing``) or "exponential"
+    law: str = "penalty"               # normal law: "penalty" (with ``smoothing``), "exponential", "arctan", "table"
     clearance: float | None = None     # exponential law: the gap at which the pressure starts
     pressure: float | None = None      # exponential law: the pressure at zero gap
+    form: str = "abaqus"               # exponential law: "abaqus" (zero at c0) or "calculix" (p0 exp(-ln100 g/c0))
+    tension: float = 0.0               # arctan law: the tension sigma_inf at large clearance
+    reach: float | None = None         # arctan and table laws: the largest clearance over sqrt(area) (None: 1e-3)
+    table: tuple = ()                  # table law: (overclosure, pressure) points
     type: str = "nts"                  # "nts": slave nodes; "sts": Gauss points of the slave facets
     order: int | None = None           # sts: Gauss points per direction of a slave facet (None: 2 quad4, 3 quad9)
     self_surfaces: tuple | None = None  # self-contact: the (body, face set) surfaces merged into one

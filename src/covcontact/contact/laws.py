@@ -130,3 +130,93 @@ def c_inverse(a_cov, a_con, h_cov, g, out):
         for j in range(2):
             out[i, j] = a_con[i, j]
     return False
+
+
+# -- pressure-overclosure curves evaluated in the Python layer (meshed masters) -----------------------------------
+#: the largest clearance a tabular or arctan law reaches, over the square root of the slave's area (CalculiX's c0)
+DEFAULT_REACH = 1e-3
+#: the slope handed to the kernels is at least this fraction of the law's reference stiffness (a flat piece of a
+#: table has none, and the kernels divide by the slope)
+SLOPE_FLOOR = 1e-12
+
+
+class PressureLaw:
+    """A pressure-overclosure curve p(d) of the overclosure d = -g (docs/theory.md, "Pressure-overclosure laws"):
+
+    - ``arctan``: p = K d (1/2 + atan(d / e) / pi), e = pi sigma_inf / K (CalculiX's node-to-face LINEAR law with
+      its tension sigma_inf at large clearance); the kernels carry compression only, so the tension tail
+      (|p| < sigma_inf at clearances up to ``reach`` sqrt(area)) is not transmitted (docs/input.md says so);
+    - ``table``: piecewise linear through (d_i, p_i), constant outside the table (CalculiX's TABULAR), felt up to
+      the clearance ``reach`` sqrt(area) where p > 0;
+    - ``calculix_exponential``: p = p0 exp(-ln(100) g / c0) for g < c0 (CalculiX's EXPONENTIAL; no force beyond c0).
+
+    p is a pressure (times the slave's area, ``per_area``) or a force per slave node. The kernels are written for the
+    linear law; :meth:`equivalents` gives, at each gap, the linear law with this curve's traction and slope there.
+    ``stiffness`` is the law's reference slope (K, the table's largest, p0 ln(100) / c0): the scale of its
+    tangential penalty and of the slope floor."""
+
+    def __init__(self, kind: str, per_area: bool, slope: float = 0.0, tension: float = 0.0, reach: float | None = None,
+                 table: tuple = (), clearance: float = 0.0, pressure: float = 0.0):
+        self.kind, self.per_area = kind, per_area
+        self.reach = DEFAULT_REACH if reach is None else float(reach)
+        if kind == "arctan":
+            self.K = float(slope)
+            self.e = np.pi * float(tension) / self.K
+            self.stiffness = self.K
+        elif kind == "table":
+            d = np.array([t[0] for t in table], dtype=float)
+            p = np.array([t[1] for t in table], dtype=float)
+            self.d, self.p = d, p
+            self.stiffness = float(np.max(np.abs(np.diff(p) / np.diff(d)))) if len(d) > 1 else 1.0
+            self.stiffness = self.stiffness or 1.0
+        elif kind == "calculix_exponential":
+            self.c0, self.p0 = float(clearance), float(pressure)
+            self.beta = np.log(100.0) / self.c0
+            self.stiffness = self.p0 * self.beta
+        else:
+            raise ValueError(f"unknown pressure-overclosure law {kind!r}")
+
+    def pressure(self, g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(p, dp/dd) per unit weight at the gaps ``g`` (finite)."""
+        d = -np.asarray(g, dtype=float)
+        if self.kind == "arctan":
+            x = d / self.e
+            s = 0.5 + np.arctan(x) / np.pi
+            return self.K * d * s, self.K * (s + x / (np.pi * (1.0 + x * x)))
+        if self.kind == "table":
+            k = np.clip(np.searchsorted(self.d, d, side="right") - 1, 0, len(self.d) - 2) if len(self.d) > 1 else \
+                np.zeros(d.shape, dtype=np.int64)
+            if len(self.d) == 1:
+                return np.full(d.shape, self.p[0]), np.zeros(d.shape)
+            slope = (self.p[k + 1] - self.p[k]) / (self.d[k + 1] - self.d[k])
+            inside = (d >= self.d[0]) & (d <= self.d[-1])
+            p = np.where(d < self.d[0], self.p[0], np.where(d > self.d[-1], self.p[-1],
+                                                             self.p[k] + slope * (d - self.d[k])))
+            return p, np.where(inside, slope, 0.0)
+        p = self.p0 * np.exp(self.beta * d)
+        return p, self.beta * p
+
+    def limit(self, area: np.ndarray) -> np.ndarray:
+        """The largest clearance at which the law acts on each slave."""
+        if self.kind == "calculix_exponential":
+            return np.full(np.shape(area), self.c0)
+        return self.reach * np.sqrt(np.maximum(area, 0.0))
+
+    def traction(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(active, sigma, dsigma/dg) per slave: sigma = -w p(-g) the signed normal force (negative in compression),
+        w the area or 1; active where g is below the law's limit and the force compresses."""
+        g = np.asarray(g, dtype=float)
+        w = area if self.per_area else np.ones_like(g)
+        gg = np.where(np.isfinite(g), g, 0.0)
+        p, dp = self.pressure(gg)
+        active = np.isfinite(g) & (g < self.limit(area)) & (p > 0.0)
+        return active, np.where(active, -w * p, 0.0), np.where(active, w * dp, 0.0)
+
+    def equivalents(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(active, eps', lam') of the linear law lam' + eps' g with this law's traction and slope at each gap (the
+        slope at least SLOPE_FLOOR times the reference stiffness times the weight)."""
+        active, sig, dsig = self.traction(g, area)
+        w = area if self.per_area else np.ones_like(sig)
+        eps = np.maximum(dsig, SLOPE_FLOOR * self.stiffness * np.maximum(w, 1e-300))
+        gg = np.where(np.isfinite(g), g, 0.0)
+        return active, eps, sig - eps * gg

@@ -209,13 +209,17 @@ class ContactManager:
         t.xi = np.where(ok[:, None], res.xi, 0.0)
         t.gap = np.where(ok, res.g, np.inf)
         t.hist_facet = t.facet.copy()
-        active = ok & is_active(res.g, t.multiplier, p.eps, p.band)
         nen = p.surface.nen
         nd = 3 * (nen + 1)
-        # the smoothed law as the linear one with its traction and slope at each gap (the same g the kernels
-        # compute from the projection)
-        eps_s, lam_s = linear_equivalents(res.g, t.multiplier, p.eps, p.band) if p.band != 0.0 else \
-            (p.eps, t.multiplier)
+        # the smoothed law (or a pressure-overclosure curve) as the linear one with its traction and slope at each
+        # gap (the same g the kernels compute from the projection)
+        if p.law is not None:
+            on, eps_s, lam_s = p.law.equivalents(np.where(ok, res.g, np.inf), p.area)
+            active = ok & on
+        else:
+            active = ok & is_active(res.g, t.multiplier, p.eps, p.band)
+            eps_s, lam_s = linear_equivalents(res.g, t.multiplier, p.eps, p.band) if p.band != 0.0 else \
+                (p.eps, t.multiplier)
         idx = np.flatnonzero(active & (res.kind == FACET))
         if idx.size:
             conn = np.hstack([p.surface.faces[res.facet[idx]], p.slaves[idx][:, None]])
@@ -439,6 +443,8 @@ class ContactManager:
         s = state.passes[k]
         if self.passes[k].tied:
             return s.facet >= 0
+        if self.passes[k].law is not None:
+            return self.passes[k].law.traction(s.gap, self.passes[k].area)[0]
         return is_active(s.gap, s.multiplier, self.passes[k].eps, self.passes[k].band)
 
     def active_count(self, state: ContactState) -> int:

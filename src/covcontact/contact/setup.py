@@ -19,6 +19,7 @@ from .points import VirtualPoints, gauss_points
 from .selfcontact import excluded_facets
 from .surface import MeshSurface, facet_sizes, tributary_area
 from .tied import tie
+from .laws import PressureLaw
 from .tool_profile import Profile
 
 
@@ -56,6 +57,7 @@ class Pass:
     exclude: np.ndarray | None = None      # self-contact: (ns, k) facets each slave never touches, -1 padded
     slave_facet: np.ndarray | None = None  # sts: (ns,) each point's facet in slave_faces
     own_patch: np.ndarray | None = None    # sts self-contact: (ns,) each point's patch quadrilateral in surface
+    law: object = None                     # a laws.PressureLaw evaluated in the Python layer (None: band's law)
 
     @property
     def ns(self) -> int:
@@ -162,6 +164,19 @@ def _slaves(num: Numbering, pair, faces: np.ndarray | None, nodes: np.ndarray | 
     return nodes, area, None
 
 
+def _pressure_law(pair) -> PressureLaw | None:
+    """The pair's pressure-overclosure curve evaluated in the Python layer (CalculiX's laws), or None (the kernels'
+    own: penalty, smoothed penalty, Abaqus' exponential)."""
+    per_area = pair.weighting == "area" or pair.type == "sts" or pair.penalty == "auto"
+    if pair.law == "arctan":
+        return PressureLaw("arctan", per_area, slope=float(pair.penalty), tension=pair.tension, reach=pair.reach)
+    if pair.law == "table":
+        return PressureLaw("table", per_area, table=pair.table, reach=pair.reach)
+    if pair.law == "exponential" and pair.form == "calculix":
+        return PressureLaw("calculix_exponential", per_area, clearance=pair.clearance, pressure=pair.pressure)
+    return None
+
+
 def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None, surfaces=None) -> Pass:
     """The pass of ``slave`` against ``master`` of ``pair``; ``tangent`` overrides the pair's case. ``surfaces``:
     the (body, face set) list of a self-contact, merged into one surface that is both slave and master."""
@@ -181,16 +196,23 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         eps = penalty * area
     else:
         eps = np.full(len(slaves), float(penalty))
+    law = _pressure_law(pair)
+    if law is not None:  # eps: the law's reference stiffness per slave (the scale of the tangential penalty)
+        w = eps / penalty
+        penalty = law.stiffness
+        eps = penalty * w
     ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
     band = float(pair.smoothing)
-    if pair.law == "exponential":  # eps: the nodal force at zero gap; the kernels' law code: band = -c0
+    if pair.law == "exponential" and law is None:  # eps: the nodal force at zero gap; the kernels' law: band = -c0
         band = -float(pair.clearance)
         if not pair.tangential_penalty:
             ratio = 1.0 / float(pair.clearance)  # the tangential stiffness p0 / c0 (per area)
+    elif law is not None and law.kind == "calculix_exponential" and not pair.tangential_penalty:
+        ratio = float(pair.pressure) / float(pair.clearance) / penalty  # p0 / c0 as for Abaqus' curve
     kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
           "slave_body": slave[0] if surfaces is None else "", "master_body": master[0] if surfaces is None else "",
-          "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own}
+          "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own, "law": law}
     if surfaces is not None:
         quads, _ = quad_patches(slave_faces, num.points)  # tri3, tri6, quad8 facets as quadrilaterals
         surface = MeshSurface(quads, n_nodes=num.n_ext + num.points.count)

@@ -45,6 +45,22 @@ def _self_surfaces(c, sets) -> tuple:
     return tuple(out)
 
 
+def _pressure_table(c) -> tuple:
+    """``table``: at least two [overclosure, pressure] pairs, the overclosures increasing, no pressure negative."""
+    val = c.get("table", "any")
+    ok = isinstance(val, list) and len(val) >= 2 and all(
+        isinstance(r, list) and len(r) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                    for v in r) for r in val)
+    if not ok:
+        c.fail("give at least two pairs [overclosure, pressure], e.g. [[0.0, 0.0], [0.01, 100.0]]", "table")
+    rows = tuple((float(a), float(b)) for a, b in val)
+    if any(b[0] <= a[0] for a, b in zip(rows, rows[1:])):
+        c.fail("the overclosures must increase from pair to pair", "table")
+    if any(r[1] < 0.0 for r in rows):
+        c.fail("pressures must not be negative (the contact pushes; tension is not transmitted)", "table")
+    return rows
+
+
 def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]:
     """Every ``[[contact]]`` entry."""
     contacts = []
@@ -87,8 +103,9 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
             if not 1 <= order <= MAX_ORDER:
                 c.fail(f"{order} Gauss points per direction: the slave facets have rules of 1 to {MAX_ORDER} points "
                        f"per direction (2 suits quad4 facets, 3 quad9)", "order")
-        law = c.get("law", "str", "penalty", choices=("penalty", "exponential", "tied"))
+        law = c.get("law", "str", "penalty", choices=("penalty", "exponential", "tied", "arctan", "table"))
         clearance = pressure = tie_tol = None
+        form, tension, reach, table = "abaqus", 0.0, None, ()
         if law == "tied":
             for key in ("friction", "method", "smoothing", "two_pass"):
                 if c.has(key):
@@ -107,11 +124,43 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                            "clearance and pressure)", key)
             clearance = c.get("clearance", "float", positive=True)
             pressure = c.get("pressure", "float", positive=True)
+            form = c.get("form", "str", "abaqus", choices=("abaqus", "calculix"))
+            if form == "calculix" and master[1] == "":
+                c.fail(f"form = \"calculix\" acts on meshed masters; {master[0]!r} is an analytic surface", "form")
             penalty = pressure
+        elif c.has("form"):
+            c.fail("form is for law = \"exponential\" (\"abaqus\" or \"calculix\")", "form")
+        if law in ("arctan", "table"):
+            for key in ("smoothing", "method"):
+                if c.has(key):
+                    c.fail(f"not used by law = \"{law}\" (its curve is the pressure-overclosure law itself; "
+                           f"penalty only)", key)
+            if master[1] == "":
+                c.fail(f"law = \"{law}\" acts on meshed masters; {master[0]!r} is an analytic surface (use law = "
+                       f"\"penalty\" or \"exponential\")", "law")
+            reach = c.get("reach", "float", None, positive=True)
+        elif c.has("reach"):
+            c.fail("reach is for law = \"arctan\" or \"table\"", "reach")
+        if law == "arctan":
+            tension = c.get("tension", "float", positive=True)
+        elif c.has("tension"):
+            c.fail("tension is for law = \"arctan\"", "tension")
+        if law == "table":
+            if c.has("penalty"):
+                c.fail("not used by law = \"table\" (the table's slopes are its stiffness)", "penalty")
+            table = _pressure_table(c)
+            penalty = max(abs(b[1] - a[1]) / (b[0] - a[0]) for a, b in zip(table, table[1:])) or 1.0
+        elif c.has("table"):
+            c.fail("table is for law = \"table\" (pairs [overclosure, pressure])", "table")
+        if law in ("exponential", "table"):
+            pass
         elif isinstance(c.data.get("penalty"), str):
             penalty = c.get("penalty", "str", choices=("auto",))
         else:
             penalty = c.get("penalty", "float", positive=True)
+        if law == "arctan" and penalty == "auto":
+            c.fail("law = \"arctan\" takes its slope K as a number (its tension sigma_inf is relative to it)",
+                   "penalty")
         auto_factor = c.get("auto_factor", "float", 10.0, positive=True)
         method = c.get("method", "str", "penalty", choices=("penalty", "augmented"))
         gap_tol = c.get("gap_tolerance", "float", None, positive=True)
@@ -154,7 +203,8 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                                     friction=mu, tangential_penalty=eps_t, method=method, gap_tolerance=gap_tol,
                                     gap_tolerance_relative=gap_rel, max_augmentations=max_aug,
                                     auto_factor=auto_factor, enabled=enabled, smoothing=smoothing, law=law,
-                                    clearance=clearance, pressure=pressure, type=ctype, order=order,
+                                    clearance=clearance, pressure=pressure, form=form, tension=tension,
+                                    reach=reach, table=table, type=ctype, order=order,
                                     self_surfaces=surfaces, tie_tolerance=tie_tol, adjust=adjust))
     return contacts
 

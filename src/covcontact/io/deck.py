@@ -1,11 +1,14 @@
 """Abaqus and CalculiX input decks, read as cards (docs/input.md, "Abaqus and CalculiX decks").
 
 A deck is a sequence of keyword lines (``*NAME, PARAM=VALUE, FLAG``) each followed by its data lines; ``**`` starts
-a comment line, ``*INCLUDE, INPUT=file`` reads another file in place (relative to the including file). Keywords,
+a comment line, ``*INCLUDE, INPUT=file`` reads another file in place (relative to the including file) anywhere, also
+inside a keyword's data: the data lines of an included file that come before its first keyword continue the card
+in force, and so do the data lines after the *INCLUDE (as CalculiX reads it: the include is transparent). Keywords,
 parameter names and set names are case-insensitive: they are kept upper-case. A keyword line that ends with a comma
-continues on the next line. Data lines are kept as text with their file and line number, so that the model layer
-(:mod:`covcontact.io.deck_model`) parses large blocks (nodes, elements) in one vectorised pass and still names the
-line of a malformed entry.
+continues on the next line only when that line starts with a parameter (``NAME=...``): Abaqus continues keyword
+lines so, CalculiX never does (its ``*NODE FILE,`` followed by ``U`` is a keyword and a data line). Data lines are
+kept as text with their file and line number, so that the model layer (:mod:`covcontact.io.deck_model`) parses
+large blocks (nodes, elements) in one vectorised pass and still names the file and line of a malformed entry.
 """
 
 from __future__ import annotations
@@ -30,8 +33,10 @@ class Card:
         name: the keyword, upper-case, single spaces ("SOLID SECTION").
         params: parameter name -> value (upper-case names; a flag without ``=`` maps to "").
         data: the data lines (stripped text).
-        lines: the line number of each data line (in ``file``: a card's data never spans an *INCLUDE).
+        lines: the line number of each data line.
         file, line: where the keyword line is.
+        sources: (first data index, file) of each run of data lines read from one file, when the data continue
+            across an *INCLUDE (empty: all in ``file``).
         text: the keyword line as written.
     """
 
@@ -42,10 +47,22 @@ class Card:
     text: str
     data: list[str] = field(default_factory=list)
     lines: list[int] = field(default_factory=list)
+    sources: list[tuple[int, Path]] = field(default_factory=list)
 
     def where(self, k: int | None = None) -> str:
         """"file:line" of the keyword line, or of data line ``k``."""
-        return f"{self.file}:{self.line if k is None else int(self.lines[k])}"
+        if k is None:
+            return f"{self.file}:{self.line}"
+        return f"{self.file_of(k)}:{int(self.lines[k])}"
+
+    def file_of(self, k: int) -> Path:
+        """The file data line ``k`` was read from."""
+        f = self.file
+        for start, src in self.sources:
+            if start > k:
+                break
+            f = src
+        return f
 
     def fail(self, problem: str, k: int | None = None) -> DeckError:
         return DeckError(f"{self.where(k)}: *{self.name}: {problem}")
@@ -104,7 +121,9 @@ def read_deck(path: str | Path) -> list[Card]:
     return cards
 
 
-def _read(path: Path, cards: list[Card], stack: list[Path]) -> None:
+def _read(path: Path, cards: list[Card], stack: list[Path], card: Card | None = None) -> Card | None:
+    """Read ``path`` into ``cards``; its data lines before its first keyword continue ``card`` (the card in force
+    where it is included). Returns the card in force at its end."""
     if not path.is_file():
         where = f"{stack[-1]}: " if stack else ""
         raise DeckError(f"{where}{path}: no such deck file")
@@ -119,7 +138,6 @@ def _read(path: Path, cards: list[Card], stack: list[Path]) -> None:
     # keyword and comment lines (a '*' first, after blanks); the data lines between them are taken in bulk
     marks = [i for i, ln in enumerate(raw) if ln[:1] == "*" or (ln[:1] in (" ", "\t") and ln.lstrip()[:1] == "*")]
     marks.append(len(raw))
-    card: Card | None = None
     _data(card, raw, 0, marks[0], path)
     k = 0
     while k < len(marks) - 1:
@@ -132,23 +150,35 @@ def _read(path: Path, cards: list[Card], stack: list[Path]) -> None:
             continue
         first = i + 1
         j = i + 1
-        while line.endswith(",") and j < end and raw[j].strip():
-            line += raw[j].strip()  # a keyword line continued
+        while line.endswith(",") and j < end and _continues(raw[j]):
+            line += raw[j].strip()  # a keyword line continued (Abaqus): the next line starts with a parameter
             j += 1
         name, params = _params(line, path, first)
         if name == "INCLUDE":
             target = params.get("INPUT")
             if not target:
                 raise DeckError(f"{path}:{first}: *INCLUDE needs INPUT=file")
-            target = target.strip('"')
-            _read((path.parent / target) if not Path(target).is_absolute() else Path(target), cards, stack)
-            card = None
+            target = target.strip('"').strip("'")
+            where = f"{path}:{first}: *INCLUDE, INPUT={target}"
+            full = (path.parent / target) if not Path(target).is_absolute() else Path(target)
+            if not full.is_file():
+                raise DeckError(f"{where}: no such file (looked for {full}; a relative INPUT is relative to the "
+                                f"including file)")
+            card = _read(full, cards, stack, card)
             _data(card, raw, j, end, path)
             continue
         card = Card(name, params, path, first, line)
         cards.append(card)
         _data(card, raw, j, end, path)
     stack.pop()
+    return card
+
+
+def _continues(text: str) -> bool:
+    """Whether a line after a keyword line that ends with a comma continues it: it starts with a parameter
+    (``NAME=VALUE``), as Abaqus' continuation lines do; a data line (numbers, set names, output variables) does not."""
+    head = text.split(",", 1)[0].strip()
+    return "=" in head and head[:1].isalpha()
 
 
 def _data(card: Card | None, raw: list[str], a: int, b: int, path: Path) -> None:
@@ -165,6 +195,8 @@ def _data(card: Card | None, raw: list[str], a: int, b: int, path: Path) -> None
             return
     if card is None:
         raise DeckError(f"{path}:{numbers_[0]}: a data line before any keyword (a missing *NODE or *ELEMENT line?)")
+    if path != (card.sources[-1][1] if card.sources else card.file):
+        card.sources.append((len(card.data), path))
     card.data += chunk
     card.lines += numbers_
 
