@@ -51,6 +51,9 @@ def _parser() -> argparse.ArgumentParser:
                         "one process)")
     r.add_argument("--ignore-unsupported", action="store_true",
                    help="a deck: go on without what covcontact does not support (each ignored line is listed)")
+    r.add_argument("--dialect", choices=("auto", "calculix", "abaqus"), default="auto",
+                   help="a deck: read it as CalculiX or Abaqus does where the two differ (default auto: Abaqus "
+                        "where the deck has *PART / *ASSEMBLY / *INSTANCE, else CalculiX)")
     d = sub.add_parser("import", help="write the covcontact problem of an Abaqus / CalculiX deck",
                        description="Read an Abaqus or CalculiX input deck and write the equivalent problem file, its "
                        "meshes (NAME.mesh.K.inp, one per body) and node labels (NAME.nodes.json) beside it "
@@ -61,6 +64,8 @@ def _parser() -> argparse.ArgumentParser:
                    "beside the deck)")
     d.add_argument("--ignore-unsupported", action="store_true",
                    help="write the problem without what covcontact does not support (each ignored line is listed)")
+    d.add_argument("--dialect", choices=("auto", "calculix", "abaqus"), default="auto",
+                   help="read the deck as CalculiX or Abaqus does where the two differ (default auto)")
     s = sub.add_parser("study", help="run a problem once per tangent case and tabulate the iterations",
                        description="Run a problem once per tangent case; writes table.md, table.csv "
                        "(the layout of the paper's Table 1) and iterations.png.")
@@ -131,12 +136,14 @@ def _check_solver(name: str | None) -> None:
                          f"(available here: {', '.join(available())})")
 
 
-def _import(deck: Path, out: Path, ignore: bool) -> object | None:
+def _import(deck: Path, out: Path, ignore: bool, dialect: str = "auto") -> object | None:
     """Import ``deck`` into ``out``; None (after listing them on stderr) when it has unsupported parts and ``ignore``
-    is not given."""
+    is not given. The notes (defaults filled in) are listed too."""
     from .io.deck_import import import_deck
 
-    imported = import_deck(deck, out)
+    imported = import_deck(deck, out, dialect)
+    for line in imported.notes:
+        print(f"covcontact: note: {line}", file=sys.stderr)
     for line in imported.unsupported:
         print(f"covcontact: {'ignored' if ignore else 'unsupported'}: {line}", file=sys.stderr)
     if imported.unsupported and not ignore:
@@ -149,7 +156,7 @@ def _import(deck: Path, out: Path, ignore: bool) -> object | None:
 def cmd_import(args) -> int:
     deck = Path(args.deck)
     out = Path(args.out) if args.out else deck.with_suffix(".toml")
-    imported = _import(deck, out, args.ignore_unsupported)
+    imported = _import(deck, out, args.ignore_unsupported, args.dialect)
     if imported is None:
         for f in [out, out.with_suffix(".nodes.json"), *out.parent.glob(f"{out.stem}.mesh.*.inp")]:
             f.unlink(missing_ok=True)
@@ -160,14 +167,17 @@ def cmd_import(args) -> int:
 
 
 def _run_deck(args) -> int:
-    """``covcontact run DECK.inp``: the deck imported into OUT/deck/, run in one process, the .dat table beside."""
+    """``covcontact run DECK.inp``: the deck imported into OUT/deck/, run in one process, the .dat table and the .frd
+    results beside."""
     from .io.deck_dat import DatTable
+    from .io.frd import FrdFile
     from .io.loader import load_problem
     from .solvers.run import solve_problem
 
     deck = Path(args.problem)
     out = Path(args.out) if args.out else Path("results") / deck.stem
-    imported = _import(deck, out / "deck" / f"{deck.stem}.toml", args.ignore_unsupported)
+    imported = _import(deck, out / "deck" / f"{deck.stem}.toml", args.ignore_unsupported,
+                       getattr(args, "dialect", "auto"))
     if imported is None:
         return 2
     from .io.bodies_input import preload
@@ -175,9 +185,11 @@ def _run_deck(args) -> int:
     preload(imported.read)  # (the meshes the import built: not read back from its files)
     problem = load_problem(imported.problem)
     _check_solver(args.solver or problem.solver.linear)
-    table = DatTable(imported.labels, out / f"{deck.stem}.dat")
+    table = DatTable(imported.labels, out / f"{deck.stem}.dat",
+                     deck={"file": deck.name, "ignored": imported.unsupported, "notes": imported.notes})
+    frd = FrdFile(imported.labels, out / f"{deck.stem}.frd")
     result = solve_problem(problem, out=out, tangent=args.tangent, quiet=args.quiet, linear=args.solver,
-                           resume=args.resume, observers=[table])
+                           resume=args.resume, observers=[table, frd])
     if not args.quiet:
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code

@@ -115,7 +115,9 @@ mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 2, ny = 2, nz =
 [[contact]]
 slave = "punch.zmin"
 master = "base.zmax"
+law = "arctan"
 penalty = 1.0e6
+tension = 0.014285714285714285
 [[dirichlet]]
 set = "base.zmin"
 components = "xyz"
@@ -196,7 +198,11 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
     variants = {
         "exponential": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n0.001, 50.0"),
         "hard": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=HARD"),
-        "tied": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TIED"),
+        "tied": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TIED\n2.0e5\n*FRICTION\n0.5, 2.0e5"),
+        "tabular": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TABULAR\n0., 0.\n5., 0.01, 0\n"
+                    "40., 0.05, 0"),
+        "linear": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=LINEAR\n1.0e6, 0.5, 2e-3"),
+        "linear-default": ("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=LINEAR\n1.0e6"),
         "friction": ("1.0e6\n", "1.0e6\n*FRICTION\n0.2, 5.0e5\n"),
         "plastic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC\n5.0, 0.0\n6.0, 0.1\n*DENSITY\n2.0\n"),
         "kinematic": ("1000.0, 0.3\n", "1000.0, 0.3\n*PLASTIC, HARDENING=KINEMATIC\n5.0, 0.0\n6.0, 0.1\n"),
@@ -218,18 +224,33 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
         if name == "sts-dload":
             body = body.replace("NODE TO SURFACE", "SURFACE TO SURFACE").replace(
                 "*NODE PRINT", "*DLOAD\nPUNCH, P2, 0.5\n*NODE PRINT")
+        if name == "tied":  # (CalculiX ties face-to-face pairs)
+            body = body.replace("NODE TO SURFACE", "SURFACE TO SURFACE").replace(
+                "*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE", "*ELSET, ELSET=PBOT\n101, 102, 103, 104\n"
+                "*SURFACE, NAME=SSLAV\nPBOT, S1")
         deck = tmp_path / f"{name}.inp"
         deck.write_text(body)
         imp = import_deck(deck, tmp_path / name / "p.toml")
         assert imp.unsupported == [], (name, imp.unsupported)
         p = load_problem(imp.problem)
         c = p.contacts[0]
-        if name == "exponential":
-            assert (c.law, c.clearance, c.pressure) == ("exponential", 0.001, 50.0)
+        if name == "exponential":  # a CalculiX deck: CalculiX's curve p0 exp(-ln(100) g / c0)
+            assert (c.law, c.clearance, c.pressure, c.form) == ("exponential", 0.001, 50.0, "calculix")
+            imp = import_deck(deck, tmp_path / name / "a.toml", dialect="abaqus")
+            assert load_problem(imp.problem).contacts[0].form == "abaqus"
         elif name == "hard":  # node slaves: augmented Lagrange, 10 E h of the base (E = 1000, h = 1)
             assert c.method == "augmented" and c.penalty == pytest.approx(1.0e4)
-        elif name == "tied":
-            assert c.law == "tied"
+        elif name == "tied":  # the slope K per area, the stick slope equal to it
+            assert (c.law, c.penalty, c.weighting, c.type) == ("tied", 2.0e5, "area", "sts")
+        elif name == "tabular":  # (pressure, overclosure) lines as [overclosure, pressure] pairs
+            assert c.law == "table" and c.table == ((0.0, 0.0), (0.01, 5.0), (0.05, 40.0))
+        elif name in ("linear", "linear-default"):  # node-to-face: K d (1/2 + atan(d / e) / pi), e = pi sigma_inf / K
+            assert (c.law, c.penalty) == ("arctan", 1.0e6)
+            if name == "linear":
+                assert (c.tension, c.reach) == (0.5, 2e-3) and imp.notes == []
+            else:  # CalculiX's default sigma_inf: E / 70000 of the first material, said in a note
+                assert c.tension == pytest.approx(1000.0 / 70000.0) and c.reach is None
+                assert len(imp.notes) == 1 and "sigma_inf" in imp.notes[0] and "tb" not in imp.notes[0][:0]
         elif name == "tie":
             assert c.law == "tied" and c.tie_tolerance == 0.01 and c.slave == ("PUNCH", "SSLAV")
         elif name == "friction":

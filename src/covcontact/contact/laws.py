@@ -204,12 +204,13 @@ class PressureLaw:
 
     def traction(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(active, sigma, dsigma/dg) per slave: sigma = -w p(-g) the signed normal force (negative in compression),
-        w the area or 1; active where g is below the law's limit and the force compresses."""
+        w the area or 1; active where g is below the law's limit and the force compresses (or, touching or
+        overclosed, is zero: the slope there starts Newton from a touching state)."""
         g = np.asarray(g, dtype=float)
         w = area if self.per_area else np.ones_like(g)
         gg = np.where(np.isfinite(g), g, 0.0)
         p, dp = self.pressure(gg)
-        active = np.isfinite(g) & (g < self.limit(area)) & (p > 0.0)
+        active = np.isfinite(g) & (g < self.limit(area)) & ((p > 0.0) | ((gg <= 0.0) & (p >= 0.0)))
         return active, np.where(active, -w * p, 0.0), np.where(active, w * dp, 0.0)
 
     def equivalents(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -5,8 +5,9 @@ a comment line, ``*INCLUDE, INPUT=file`` reads another file in place (relative t
 inside a keyword's data: the data lines of an included file that come before its first keyword continue the card
 in force, and so do the data lines after the *INCLUDE (as CalculiX reads it: the include is transparent). Keywords,
 parameter names and set names are case-insensitive: they are kept upper-case. A keyword line that ends with a comma
-continues on the next line only when that line starts with a parameter (``NAME=...``): Abaqus continues keyword
-lines so, CalculiX never does (its ``*NODE FILE,`` followed by ``U`` is a keyword and a data line). Data lines are
+continues on the next line only when that line starts with a parameter (``NAME=...``) or holds parameter flags
+only (``GENERATE``): Abaqus continues keyword lines so, CalculiX never does (its ``*NODE FILE,`` followed by ``U``
+is a keyword and a data line). Data lines are
 kept as text with their file and line number, so that the model layer (:mod:`covcontact.io.deck_model`) parses
 large blocks (nodes, elements) in one vectorised pass and still names the file and line of a malformed entry.
 """
@@ -174,11 +175,22 @@ def _read(path: Path, cards: list[Card], stack: list[Path], card: Card | None = 
     return card
 
 
+#: parameters without a value that an Abaqus keyword line may carry on its continuation line
+_FLAGS = {"GENERATE", "NLGEOM", "UNSYMM", "DIRECT", "SMALL SLIDING", "PERTURBATION", "FIXED", "UNSORTED",
+          "INTERNAL", "REMOVE ALL", "REMOVE", "ADJUST"}
+
+
 def _continues(text: str) -> bool:
     """Whether a line after a keyword line that ends with a comma continues it: it starts with a parameter
-    (``NAME=VALUE``), as Abaqus' continuation lines do; a data line (numbers, set names, output variables) does not."""
-    head = text.split(",", 1)[0].strip()
-    return "=" in head and head[:1].isalpha()
+    (``NAME=VALUE``) or holds only parameter flags (GENERATE, NLGEOM, ...), as Abaqus' continuation lines do; a data
+    line (numbers, set names, output variables such as U) does not."""
+    fields = [f.strip() for f in text.split(",") if f.strip()]
+    if not fields:
+        return False
+    head = fields[0]
+    if "=" in head and head[:1].isalpha():
+        return True
+    return all(" ".join(f.upper().split()) in _FLAGS for f in fields)
 
 
 def _data(card: Card | None, raw: list[str], a: int, b: int, path: Path) -> None:

@@ -29,13 +29,17 @@ def fortran_e(x: float) -> str:
 class DatTable(Observer):
     """Writes ``path`` (the .dat table) from the labels file of :func:`covcontact.io.deck_import.import_deck`."""
 
-    def __init__(self, labels: Path, path: Path):
+    def __init__(self, labels: Path, path: Path, deck: dict | None = None):
         self.info = json.loads(Path(labels).read_text())
         self.path = Path(path)
+        self.deck = deck
 
     def started(self, run) -> None:
         if run.model.is_root:
             self.path.write_text("")
+        summary = getattr(run, "summary", None)
+        if self.deck is not None and summary is not None:  # (summary.json: what was ignored and filled in)
+            summary.data["deck"] = dict(self.deck)
 
     def increment_converged(self, run, inc) -> None:
         if not inc.ends_stage:

@@ -34,6 +34,8 @@ class Imported:
     meshes: list[Path]
     labels: Path
     unsupported: list[str] = field(default_factory=list)
+    #: what the deck leaves to defaults and how covcontact fills them in (said before solving, kept in summary.json)
+    notes: list[str] = field(default_factory=list)
     #: each mesh file's Mesh, built while writing it (``bodies_input.preload`` spares reading them back)
     read: dict = field(default_factory=dict, repr=False)
 
@@ -58,17 +60,24 @@ def _table(header: str, entries: dict) -> str:
     return f"{header}\n" + "".join(f"{k} = {_toml(v)}\n" for k, v in entries.items() if v is not None) + "\n"
 
 
-def import_deck(deck: str | Path, out: str | Path) -> Imported:
-    """Write the covcontact problem of ``deck`` as ``out`` (a .toml path; the mesh and the labels beside it)."""
+#: the dialects a deck is read in (docs/input.md, "Dialect"): what a keyword means where the two codes differ
+DIALECTS = ("calculix", "abaqus")
+
+
+def import_deck(deck: str | Path, out: str | Path, dialect: str = "auto") -> Imported:
+    """Write the covcontact problem of ``deck`` as ``out`` (a .toml path; the mesh and the labels beside it).
+    ``dialect``: "calculix", "abaqus" or "auto" (Abaqus where the deck has Abaqus-only keywords such as *PART or
+    *ASSEMBLY, else CalculiX)."""
     deck, out = Path(deck), Path(out)
     m = read_model(deck)
-    return _Writer(m, deck, out).write()
+    return _Writer(m, deck, out, m.dialect if dialect == "auto" else dialect).write()
 
 
 class _Writer:
-    def __init__(self, m: DeckModel, deck: Path, out: Path):
-        self.m, self.deck, self.out = m, deck, out
+    def __init__(self, m: DeckModel, deck: Path, out: Path, dialect: str = "calculix"):
+        self.m, self.deck, self.out, self.dialect = m, deck, out, dialect
         self.unsupported = list(m.unsupported)
+        self.notes: list[str] = list(m.notes)
         if not m.blocks:
             raise DeckError(f"{deck}: no solid elements ({', '.join(ELEMENTS)})")
         self.b = Parts(m)
@@ -472,27 +481,87 @@ class _Writer:
                 entry["type"] = "sts"
             else:  # a node surface: the law's value per node (unit area, as CalculiX takes it); faces: per area
                 entry["weighting"] = "nodal" if sk == "NODE" else "area"
-            if it.behavior == "tied":
+            if kind == "TIE":  # *TIE: CalculiX writes equations; a stiff penalty tie here
                 entry.update({"law": "tied", "penalty": "auto" if sk != "NODE" else self._hard_penalty(mb)})
                 if ties.get(where):
                     entry["tie_tolerance"] = ties[where]
+            elif it.behavior == "tied":
+                if not self._tied_pair(entry, it, sts, where):
+                    continue
             elif it.behavior == "linear":
-                entry["penalty"] = it.values[0]
+                self._linear(entry, it, sts, where)
             elif it.behavior == "exponential":
-                entry.update({"law": "exponential", "clearance": it.values[0], "pressure": it.values[1]})
+                entry.update({"law": "exponential", "clearance": it.values[0], "pressure": it.values[1],
+                              "form": self.dialect})
+            elif it.behavior == "tabular":
+                pts = it.values
+                entry.update({"law": "table", "table": [[pts[j], pts[j + 1]] for j in range(0, len(pts), 2)]})
+                if len(pts) == 2:  # (one point: constant pressure; a second point with the same makes a table)
+                    entry["table"].append([pts[0] + 1.0, pts[1]])
             elif sk == "NODE":  # hard contact, node slaves: augmented Lagrange with 10 E h per node
                 entry.update({"penalty": self._hard_penalty(mb), "method": "augmented"})
             else:
                 entry.update({"penalty": "auto", "method": "augmented"})
             adjust = self.m.pair_adjust.get(where)
-            if adjust is not None and it.behavior != "tied":  # (a node set: its name in the slave body's mesh)
+            if adjust is not None and entry.get("law") != "tied":  # (a node set: its name in the slave body's mesh)
                 entry["adjust"] = _name(adjust) if isinstance(adjust, str) else adjust
-            if it.friction is not None and it.friction[0] > 0 and it.behavior != "tied":
+            if it.friction is not None and it.friction[0] > 0 and entry.get("law") != "tied":
                 entry["friction"] = it.friction[0]
                 if it.friction[1] is not None and it.friction[1] > 0:
                     entry["tangential_penalty"] = it.friction[1]
             text += _table("[[contact]]", entry)
         return text
+
+    def _first_modulus(self) -> float:
+        """The first elastic constant of the first material in the deck (CalculiX's reference for its defaults)."""
+        return next((mat["E"] for mat in self.m.materials.values() if "E" in mat), 0.0)
+
+    def _linear(self, entry: dict, it: Interaction, sts: bool, where: str) -> None:
+        """PRESSURE-OVERCLOSURE=LINEAR as CalculiX reads it: face-to-face pairs the linear penalty law with slope K
+        (per area); node-to-face pairs K d (1/2 + atan(d / e) / pi) with e = pi sigma_inf / K, felt up to the
+        clearance c0 sqrt(area) (law "arctan"). Missing or non-positive K, sigma_inf, c0 take CalculiX's defaults
+        (50 E, E / 70000, 1e-3; E the deck's first elastic constant), each said in the notes."""
+        K, sig, c0 = it.values
+        E = self._first_modulus()
+        if K <= 0.0:
+            K = 50.0 * E
+            self.notes.append(f"{it.where}: *SURFACE BEHAVIOR, LINEAR without a slope K: CalculiX's default 50 E = "
+                              f"{K:g} is used")
+        if sts:
+            entry["penalty"] = K
+            return
+        if sig <= 0.0:
+            sig = E / 70000.0
+            self.notes.append(f"{it.where}: *SURFACE BEHAVIOR, LINEAR without sigma_inf: CalculiX's default E / "
+                              f"70000 = {sig:g} is used")
+        entry.update({"law": "arctan", "penalty": K, "tension": sig})
+        if c0 > 0.0:
+            entry["reach"] = c0
+
+    def _tied_pair(self, entry: dict, it: Interaction, sts: bool, where: str) -> bool:
+        """PRESSURE-OVERCLOSURE=TIED (face-to-face only in CalculiX): the slave faces bonded with the slope K per
+        area in the normal direction and the stick slope of the *FRICTION card tangentially; covcontact's tie has
+        one stiffness in all directions, so a stick slope other than K is refused (listed). Returns False when the
+        pair is left out."""
+        K = it.values[0] if it.values and it.values[0] > 0.0 else 50.0 * self._first_modulus()
+        if not it.values or it.values[0] <= 0.0:
+            self.notes.append(f"{it.where}: *SURFACE BEHAVIOR, TIED without a slope K: CalculiX's default 50 E = "
+                              f"{K:g} is used")
+        if not sts:
+            self.unsupported.append(f"{where}: PRESSURE-OVERCLOSURE=TIED on a NODE TO SURFACE pair (CalculiX ties "
+                                    f"face-to-face pairs only: TYPE=SURFACE TO SURFACE); with --ignore-unsupported "
+                                    f"the pair is left out")
+            return False
+        lam = it.friction[1] if it.friction is not None else None
+        if lam is None:
+            self.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE=TIED needs the stick slope of a *FRICTION card "
+                                    f"(CalculiX stops without it); with --ignore-unsupported K is used tangentially")
+        elif abs(lam - K) > 1e-9 * K:
+            self.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE=TIED with a stick slope ({lam:g}) other than "
+                                    f"its slope K ({K:g}): covcontact's tie has one stiffness in all directions; with "
+                                    f"--ignore-unsupported K is used tangentially too")
+        entry.update({"law": "tied", "penalty": K})
+        return True
 
     def _hard_penalty(self, body: int) -> float:
         """10 E h of the master body (its smallest Young's modulus, h its mean element size), a force per length."""
@@ -574,7 +643,8 @@ class _Writer:
                                       "periods": [d for _, d in self.stage_steps],
                                       "deck_step": [k for k, _ in self.stage_steps]}))
         meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
-        return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)), self.meshes)
+        return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)),
+                        list(dict.fromkeys(self.notes)), self.meshes)
 
     def _write_mesh(self) -> None:
         """One mesh file per body (its nodes, elements, sets and surfaces): bodies of cell types that do not mix

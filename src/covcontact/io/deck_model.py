@@ -32,6 +32,8 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY")
+#: keywords only Abaqus reads: a deck with one of them is read in Abaqus' dialect (import_deck's "auto")
+_ABAQUS_ONLY = ("PART", "END PART", "ASSEMBLY", "END ASSEMBLY", "INSTANCE", "END INSTANCE")
 #: output requests: accepted, *NODE PRINT's U and RF, *EL PRINT's S and *CONTACT PRINT's CSTRESS are tabulated
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
            "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
@@ -106,6 +108,10 @@ class DeckModel:
     rigid_bodies: list[tuple[np.ndarray, int | None, int | None, str]] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
+    #: what the deck leaves to defaults, or reads in a way worth saying (listed before solving, not refused)
+    notes: list[str] = field(default_factory=list)
+    #: "abaqus" where the deck has keywords only Abaqus reads (*PART, *ASSEMBLY, *INSTANCE), else "calculix"
+    dialect: str = "calculix"
 
     def node_index(self) -> np.ndarray:
         """label -> row of X (-1: no such node)."""
@@ -133,6 +139,8 @@ class _Reader(LoadCards):
         while k < len(cards):
             c = cards[k]
             k += 1
+            if c.name in _ABAQUS_ONLY:
+                m.dialect = "abaqus"
             if c.name not in SUPPORTED:
                 m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
                 continue
@@ -434,8 +442,14 @@ class _Reader(LoadCards):
                 mat["unsupported"] = (f"{c.where()}: *ELASTIC, TYPE={c.params['TYPE']} is not supported (only "
                                       f"isotropic elasticity)")
                 return
-            if len(rows) > 1 or len(rows[0]) > 2:
-                self.m.unsupported.append(f"{c.where()}: *ELASTIC: temperature-dependent elasticity is not supported")
+            temps = sorted({c.number(k, 2, r, "the temperature", 0.0) for k, r in enumerate(rows)})
+            if len(rows) > 1 and len(temps) > 1:
+                self.m.unsupported.append(f"{c.where()}: *ELASTIC: temperature-dependent elasticity ({len(temps)} "
+                                          f"temperatures) is not supported; with --ignore-unsupported the first "
+                                          f"line's values are used")
+            elif len(rows) > 1:
+                raise c.fail("isotropic elasticity is one line 'E, nu[, temperature]'; several lines need different "
+                             "temperatures", 1)
             mat["E"] = c.number(0, 0, rows[0], "Young's modulus")
             mat["nu"] = c.number(0, 1, rows[0], "Poisson's ratio")
         elif c.name == "DENSITY":
@@ -446,10 +460,13 @@ class _Reader(LoadCards):
                 self.m.unsupported.append(f"{c.where()}: *PLASTIC, HARDENING={c.params['HARDENING']} is not supported "
                                           f"(isotropic hardening, and linear kinematic hardening)")
                 return
+            temp = [c.number(k, 2, r, "the temperature", 0.0) for k, r in enumerate(rows)]
+            if len(set(temp)) > 1:  # (a table at one temperature is not temperature-dependent)
+                self.m.unsupported.append(f"{c.where()}: *PLASTIC: temperature-dependent hardening ({len(set(temp))} "
+                                          f"temperatures) is not supported; with --ignore-unsupported the table at "
+                                          f"the first temperature, {temp[0]:g}, is used")
             pts = [(c.number(k, 0, r, "the yield stress"), c.number(k, 1, r, "the plastic strain", 0.0))
-                   for k, r in enumerate(rows)]
-            if any(len(r) > 2 for r in rows):
-                self.m.unsupported.append(f"{c.where()}: *PLASTIC: temperature-dependent hardening is not supported")
+                   for k, r in enumerate(rows) if temp[k] == temp[0]]
             if hardening == "KINEMATIC":  # (covcontact's kinematic hardening is linear: two points)
                 if len(pts) != 2 or pts[0][1] != 0.0 or pts[1][1] <= 0.0:
                     self.m.unsupported.append(f"{c.where()}: *PLASTIC, HARDENING=KINEMATIC with other than two points "
@@ -471,17 +488,38 @@ class _Reader(LoadCards):
                            c.number(0, 1, rows[0], "the stick slope") if len(rows[0]) > 1 else None)
             return
         law = c.param("PRESSURE-OVERCLOSURE", "HARD").upper()
-        if law not in ("HARD", "LINEAR", "EXPONENTIAL", "TIED"):
-            self.m.unsupported.append(f"{c.where()}: *SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE={law} is not supported "
-                                      f"(HARD, LINEAR, EXPONENTIAL, TIED are)")
-            return
+        if law not in ("HARD", "LINEAR", "EXPONENTIAL", "TIED", "TABULAR"):
+            raise c.fail(f"PRESSURE-OVERCLOSURE={law} is not a pressure-overclosure law (HARD, LINEAR, EXPONENTIAL, "
+                         f"TABULAR, TIED)")
         it.behavior = law.lower()
-        if law in ("LINEAR", "EXPONENTIAL"):
+        it.where = c.where()
+        if law == "EXPONENTIAL":
             if not rows:
-                raise c.fail(f"PRESSURE-OVERCLOSURE={law} needs its data line")
-            it.values = tuple(c.number(0, j, rows[0], w) for j, w in
-                              enumerate(("the slope" if law == "LINEAR" else "c0",
-                                         "sigma_inf" if law == "LINEAR" else "p0")[: max(1, min(2, len(rows[0])))]))
+                raise c.fail("PRESSURE-OVERCLOSURE=EXPONENTIAL needs its data line 'c0, p0'")
+            it.values = (c.number(0, 0, rows[0], "c0"), c.number(0, 1, rows[0], "p0"))
+            if it.values[0] <= 0.0 or it.values[1] < 0.0:
+                raise c.fail("c0 must exceed zero and p0 must not be negative", 0)
+        elif law in ("LINEAR", "TIED"):
+            # (CalculiX: K, sigma_inf, c0; missing or non-positive values take its defaults, said in the notes)
+            row = rows[0] if rows else []
+            it.values = tuple(c.number(0, j, row, w, 0.0) if j < len(row) else 0.0
+                              for j, w in enumerate(("the slope K", "sigma_inf", "c0")[: 1 if law == "TIED" else 3]))
+        elif law == "TABULAR":
+            pts = []
+            for k, r in enumerate(rows):
+                temp = c.number(k, 2, r, "the temperature", 0.0)
+                if pts and temp != pts[0][2]:
+                    self.m.unsupported.append(f"{c.where(k)}: *SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=TABULAR at "
+                                              f"several temperatures is not supported; with --ignore-unsupported the "
+                                              f"table at the first temperature is used")
+                    break
+                pts.append((c.number(k, 1, r, "the overclosure"), c.number(k, 0, r, "the pressure"), temp))
+            if not pts:
+                raise c.fail("PRESSURE-OVERCLOSURE=TABULAR needs lines 'pressure, overclosure'")
+            for k in range(1, len(pts)):  # (as CalculiX: the overclosures made to increase by at least 1e-10)
+                if pts[k][0] - pts[k - 1][0] < 1e-10:
+                    pts[k] = (pts[k - 1][0] + 1e-10, pts[k][1], pts[k][2])
+            it.values = tuple(v for d, pr, _ in pts for v in (d, pr))
 
     def _equation(self, c: Card) -> None:
         rows = c.rows()
