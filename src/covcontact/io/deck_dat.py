@@ -77,15 +77,22 @@ class DatTable(Observer):
         U = run.u.reshape(-1, 3)
         time = sum(self.info["periods"][:stage]) + self.info["periods"][stage] * inc.lam
         text = []
-        for nset, variables in prints:
+        for nset, variables, *opt in prints:
+            totals = opt[0] if opt else "NO"
             labels = [lab for lab in self.info["nsets"][nset] if lab in where]
             rows = np.array([where[lab] for lab in labels], dtype=np.int64)
             for var in variables:
                 if var not in _BLOCK:
                     continue
                 values = U[rows] if var == "U" else forces[rows]
-                text.append(f"\n {_BLOCK[var]} for set {nset} and time {fortran_e(time)}\n\n")
-                text += [f"{lab:10d}" + "".join(f"{v:14.6E}" for v in row) + "\n" for lab, row in zip(labels, values)]
+                if var != "RF" or totals != "ONLY":
+                    text.append(f"\n {_BLOCK[var]} for set {nset} and time {fortran_e(time)}\n\n")
+                    text += [f"{lab:10d}" + "".join(f"{v:14.6E}" for v in row) + "\n"
+                             for lab, row in zip(labels, values)]
+                if var == "RF" and totals in ("YES", "ONLY"):  # (CalculiX sums the external forces only)
+                    total = values.sum(axis=0) if len(values) else np.zeros(3)
+                    text.append(f"\n total force (fx,fy,fz) for set {nset} and time {fortran_e(time)}\n\n")
+                    text.append("      " + "".join(f"{v:14.6E}" for v in total) + "\n")
         text += self._el_print(model, run, stage, time)
         if stage < len(contact_prints) and "CSTRESS" in contact_prints[stage]:
             text += self._contact_stress(model, run, inc.lam, where, time)

@@ -621,7 +621,7 @@ class _Writer:
             per_body[name] = self.m.node_labels[self.b.of_node == k].tolist()
         ends = [k for k, (s, _) in enumerate(self.stage_steps) if k + 1 == len(self.stage_steps)
                 or self.stage_steps[k + 1][0] != s]  # the stages that end a deck step print its requests
-        prints = [[[nset, list(v)] for nset, v, _ in self.m.steps[s].node_print] if k in ends else []
+        prints = [[[nset, list(v), totals] for nset, v, _, totals in self.m.steps[s].node_print] if k in ends else []
                   for k, (s, _) in enumerate(self.stage_steps)]
         el_prints = [[[elset, list(v)] for elset, v, _ in self.m.steps[s].el_print] if k in ends else []
                      for k, (s, _) in enumerate(self.stage_steps)]

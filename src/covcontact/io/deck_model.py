@@ -58,9 +58,12 @@ class Step:
     boundary_new: bool = False
     loads: list[Load] = field(default_factory=list)
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
-    node_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)  # (nset, variables, where)
+    #: (nset, variables, where, totals: "NO" | "YES" | "ONLY")
+    node_print: list[tuple[str, tuple[str, ...], str, str]] = field(default_factory=list)
     el_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)    # (elset, variables, where)
     contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables (CSTRESS is tabulated)
+    #: which print requests the step itself gives (the others carry over from the step before, as in CalculiX)
+    prints_given: set[str] = field(default_factory=set)
     #: *EQUATION, REMOVE: the dependent (node, dof) of the equations removed from this step on; None: REMOVE ALL
     remove_equations: list | None = field(default_factory=list)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
@@ -266,6 +269,14 @@ class _Reader(LoadCards):
             elif c.name == "END STEP":
                 if self.step is None:
                     raise c.fail("*END STEP without a *STEP")
+                if m.steps:  # print requests a step does not restate carry over from the step before
+                    last = m.steps[-1]
+                    if "node" not in self.step.prints_given:
+                        self.step.node_print = list(last.node_print)
+                    if "el" not in self.step.prints_given:
+                        self.step.el_print = list(last.el_print)
+                    if "contact" not in self.step.prints_given:
+                        self.step.contact_print = last.contact_print
                 m.steps.append(self.step)
                 self.step = None
                 self.changing = None
@@ -275,17 +286,8 @@ class _Reader(LoadCards):
                 self._boundary(c)
             elif c.name in ("CLOAD", "DLOAD"):
                 self._load(c)
-            elif c.name == "NODE PRINT":
-                st = self._in_step(c)
-                variables = tuple(v.upper() for row in c.rows() for v in row)
-                st.node_print.append((c.param("NSET", required=True).upper(), variables, c.where()))
-            elif c.name == "CONTACT PRINT":
-                st = self._in_step(c)
-                st.contact_print += tuple(v.upper() for row in c.rows() for v in row)
-            elif c.name == "EL PRINT":
-                st = self._in_step(c)
-                variables = tuple(v.upper() for row in c.rows() for v in row)
-                st.el_print.append((c.param("ELSET", required=True).upper(), variables, c.where()))
+            elif c.name in ("NODE PRINT", "EL PRINT", "CONTACT PRINT"):
+                self._print(c)
         if self.step is not None:
             raise DeckError(f"{self.step.where}: *STEP without its *END STEP")
         self._nodes_ready(nodes, coords)
@@ -304,6 +306,48 @@ class _Reader(LoadCards):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
+
+    def _print(self, c: Card) -> None:
+        """*NODE PRINT, *EL PRINT, *CONTACT PRINT: the first of a kind in a step replaces the requests carried over
+        from the step before (a bare card, without its set, only clears them: CalculiX's way to stop printing)."""
+        st = self._in_step(c)
+        kind = c.name.split()[0].lower()
+        if kind not in st.prints_given:
+            st.prints_given.add(kind)
+            if kind == "node":
+                st.node_print = []
+            elif kind == "el":
+                st.el_print = []
+            else:
+                st.contact_print = ()
+        variables = tuple(v.upper() for row in c.rows() for v in row)
+        if kind == "contact":
+            st.contact_print += variables
+            self._unprinted(c, variables, ("CSTRESS",))
+            return
+        key = "NSET" if kind == "node" else "ELSET"
+        target = c.param(key)
+        if target is None:
+            if variables:
+                raise c.fail(f"missing parameter {key}= (e.g. *{c.name}, {key}=...); a bare *{c.name} without data "
+                             f"stops the printing")
+            return
+        if kind == "node":
+            totals = c.param("TOTALS", "NO").upper()
+            if totals not in ("NO", "YES", "ONLY"):
+                raise c.fail(f"TOTALS must be NO, YES or ONLY, got {c.params['TOTALS']!r}")
+            st.node_print.append((target.upper(), variables, c.where(), totals))
+            self._unprinted(c, variables, ("U", "RF"))
+        else:
+            st.el_print.append((target.upper(), variables, c.where()))
+            self._unprinted(c, variables, ("S", "PEEQ"))
+
+    def _unprinted(self, c: Card, variables: tuple, printed: tuple) -> None:
+        """Output variables the .dat does not tabulate: a note each (the run goes on; they are not printed)."""
+        for v in variables:
+            if v not in printed:
+                self.m.notes.append(f"{c.where()}: *{c.name} {v}: not printed in the .dat (covcontact tabulates "
+                                    f"{', '.join(printed)} there)")
 
     def _in_step(self, c: Card) -> Step:
         if self.step is None:

@@ -1,0 +1,100 @@
+"""Decks read as CalculiX reads them (docs/input.md, "Abaqus and CalculiX decks"): *INCLUDE inside a keyword's data,
+keyword lines continued only by parameter lines, single-temperature tables, print requests carried from step to step
+(a bare *NODE PRINT stops them), TOTALS, and the laws of *SURFACE BEHAVIOR kept or refused with their lines."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from covcontact.io.deck import DeckError, read_deck
+from covcontact.io.deck_import import import_deck
+from covcontact.io.deck_model import read_model
+from covcontact.io.loader import load_problem
+
+from test_deck import two_block_deck
+
+
+def test_include_inside_data_keeps_file_and_line(tmp_path):
+    """Data lines of an included file continue the card in force, and so do the lines after the *INCLUDE; an error
+    names the included file's line; a missing include names the including line."""
+    (tmp_path / "more.inc").write_text("2, 1, 0, 0\n3, 1, x, 0\n")
+    deck = tmp_path / "d.inp"
+    deck.write_text("*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=more.inc\n4, 0, 1, 0\n")
+    (card,) = read_deck(deck)
+    assert card.data == ["1, 0, 0, 0", "2, 1, 0, 0", "3, 1, x, 0", "4, 0, 1, 0"]
+    assert [card.where(k).split("/")[-1] for k in range(4)] == ["d.inp:2", "more.inc:1", "more.inc:2", "d.inp:4"]
+    with pytest.raises(DeckError, match=r"more\.inc:2: \*NODE: y must be a number"):
+        read_model(deck)
+    deck.write_text("*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=gone.inc\n")
+    with pytest.raises(DeckError, match=r"d\.inp:3: \*INCLUDE, INPUT=gone\.inc: no such file"):
+        read_deck(deck)
+
+
+def test_keyword_continuation_by_dialect(tmp_path):
+    """A keyword line ending with a comma continues on a parameter line (Abaqus), not on a data line (CalculiX's
+    ``*NODE FILE,`` followed by ``U``)."""
+    deck = tmp_path / "d.inp"
+    deck.write_text("*NODE FILE,\nU\n*ELEMENT, TYPE=C3D8,\nELSET=E\n*NSET, NSET=A,\nGENERATE\n1, 4\n")
+    a, b, c = read_deck(deck)
+    assert (a.name, a.params, a.data) == ("NODE FILE", {}, ["U"])
+    assert b.params == {"TYPE": "C3D8", "ELSET": "E"} and c.params == {"NSET": "A", "GENERATE": ""}
+
+
+def test_single_temperature_tables_are_not_temperature_dependent(tmp_path):
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    deck = tmp_path / "t.inp"
+    deck.write_text(text.replace("1000.0, 0.3\n", "1000.0, 0.3, 20.\n*PLASTIC\n5.0, 0.0, 20.\n6.0, 0.1, 20.\n"))
+    imp = import_deck(deck, tmp_path / "a" / "p.toml")
+    assert imp.unsupported == []
+    mat = load_problem(imp.problem).bodies[0].material
+    assert mat.E == 1000.0 and tuple(mat.hardening.stress) == (5.0, 6.0)
+    deck.write_text(text.replace("1000.0, 0.3\n", "1000.0, 0.3, 20.\n900.0, 0.3, 200.\n"))
+    (line,) = import_deck(deck, tmp_path / "b" / "p.toml").unsupported
+    assert "t.inp:" in line and "2 temperatures" in line and "first line's values are used" in line
+
+
+def test_print_requests_carry_over_and_totals(tmp_path):
+    """Step 2 does not restate *NODE PRINT: it prints what step 1 asked (CalculiX's rule); step 3's bare *NODE PRINT
+    stops it. TOTALS=ONLY prints the sum of the forces and not the nodes; the sum is the support's reaction."""
+    step = "*STEP\n*STATIC\n1.0, 1.0\n*BOUNDARY\nTOP, 3, 3, -0.02\n{}*END STEP\n"
+    deck = two_block_deck(tmp_path / "tb.inp", extra_step=step.format("") + step.format("*NODE PRINT\n"))
+    deck.write_text(deck.read_text().replace("*NODE PRINT, NSET=BOTTOM", "*NODE PRINT, NSET=BOTTOM, TOTALS=ONLY"))
+    m = read_model(deck)
+    assert [len(st.node_print) for st in m.steps] == [1, 1, 0]
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "out"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    dat = (tmp_path / "out" / "tb.dat").read_text()
+    heads = [ln for ln in dat.splitlines() if "for set" in ln]
+    assert [h.split(" for set")[0].strip() for h in heads] == ["displacements (vx,vy,vz)", "total force (fx,fy,fz)"] * 2
+    assert heads[1].endswith("0.1000000E+01") and heads[3].endswith("0.2000000E+01")
+    lines = dat.splitlines()
+    total = [float(v) for v in lines[lines.index(heads[3]) + 2].split()]
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    step2 = [s for s in summary["steps"] if s.get("stage") == "step2"][-1]
+    fz = sum(v[2] for k, v in step2["reactions"].items() if k.startswith("BASE.BOTTOM"))
+    assert total[2] == pytest.approx(fz, rel=1e-6) and abs(fz) > 1.0
+    assert summary["deck"]["file"] == "tb.inp" and summary["deck"]["ignored"] == []
+
+
+def test_laws_kept_or_refused(tmp_path):
+    """Every pressure-overclosure law is kept (its values in the problem) or refused with its line; with
+    --ignore-unsupported the substitution is said, and summary.json keeps it."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    deck = tmp_path / "x.inp"
+    deck.write_text(text.replace("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=WAVY"))
+    with pytest.raises(DeckError, match=r"x\.inp:\d+: \*SURFACE BEHAVIOR: PRESSURE-OVERCLOSURE=WAVY is not a"):
+        import_deck(deck, tmp_path / "w" / "p.toml")
+    deck.write_text(text.replace("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=TIED\n1.0e5"))
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o")],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 2 and "TIED on a NODE TO SURFACE pair" in proc.stderr
+    deck.write_text(text.replace("PRESSURE-OVERCLOSURE=LINEAR\n1.0e6", "PRESSURE-OVERCLOSURE=LINEAR"))
+    imp = import_deck(deck, tmp_path / "d" / "p.toml")
+    c = load_problem(imp.problem).contacts[0]
+    assert (c.law, c.penalty) == ("arctan", 50.0 * 1000.0)  # CalculiX's defaults: 50 E, E / 70000
+    assert len(imp.notes) == 2 and all("CalculiX's default" in n for n in imp.notes)
