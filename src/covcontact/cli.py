@@ -1,4 +1,4 @@
-"""Command line: covcontact run | study | check-tangent | compile | info.
+"""Command line: covcontact run | study | check-tangent | compile | info | import | ccx.
 
 Exit codes: 0 done; 1 a step did not converge even after cutbacks (converged steps are written);
 2 bad input or a checkpoint that cannot be resumed (one line on stderr); 3 anything else (a bug: the
@@ -111,6 +111,19 @@ def _parser() -> argparse.ArgumentParser:
                    help="only the warm-up problems whose label contains TEXT (default: all)")
     sub.add_parser("info", help="version, linear solvers, threads",
                    description="Print the version, the linear solvers available here and the thread count.")
+    x = sub.add_parser("ccx", help="run a CalculiX deck as `ccx -i JOB` does (for pre-processors)",
+                       description="Run JOB.inp as CalculiX's `ccx -i JOB` does, for the pre-processors that start "
+                       "ccx (FreeCAD FEM, PrePoMax): writes JOB.dat, JOB.frd, JOB.sta and JOB.cvg beside the deck, "
+                       "CalculiX's lines on standard output, and exits as ccx does: 0 done, 201 an input error "
+                       "(*ERROR lines) or an increment that did not converge. covcontact's own results (summary.json, "
+                       "VTU files) go to JOB.covcontact/ (docs/input.md, \"Abaqus and CalculiX decks\").")
+    x.add_argument("-i", dest="job_i", default=None, metavar="JOB", help="the job: its deck is JOB.inp")
+    x.add_argument("job", nargs="?", default=None, help="the job, as `ccx JOB`")
+    x.add_argument("--out", default=None, metavar="DIR",
+                   help="covcontact's own results (default: JOB.covcontact beside the deck)")
+    x.add_argument("--solver", default=None, metavar="NAME", help=solver)
+    x.add_argument("--ignore-unsupported", action="store_true",
+                   help="go on without what covcontact does not support (each ignored line is a *WARNING)")
     return p
 
 
@@ -192,6 +205,73 @@ def _run_deck(args) -> int:
                            resume=args.resume, observers=[table, frd])
     if not args.quiet:
         print(f"results in {result.out}", file=sys.stderr)
+    return result.exit_code
+
+
+def cmd_ccx(args) -> int:
+    """``covcontact ccx -i JOB``: JOB.inp run as ``ccx -i JOB`` runs it (io/ccx_job.py): JOB.dat, JOB.frd, JOB.sta,
+    JOB.cvg, CalculiX's lines on standard output, its exit codes (0; 201 for an input error or an increment that did
+    not converge; 130 / 143 stopped by a signal)."""
+    import time
+
+    from . import __version__
+    from .io.bodies_input import preload
+    from .io.ccx_job import CcxStatus, banner, finished, start_files
+    from .io.deck_dat import DatTable
+    from .io.deck_import import import_deck
+    from .io.frd import FrdFile
+    from .io.loader import load_problem
+    from .solvers.run import solve_problem
+
+    t0 = time.perf_counter()
+    name = args.job_i or args.job
+    if not name:
+        print("Usage: covcontact ccx -i jobname", flush=True)
+        return 201
+    name = name[:-4] if name.lower().endswith(".inp") else name
+    job = Path(name)
+    deck, dat, frd, sta, cvg = (job.with_name(job.name + ext) for ext in (".inp", ".dat", ".frd", ".sta", ".cvg"))
+    print(banner(__version__), end="", flush=True)
+    try:
+        start_files(sta, cvg)
+        dat.write_text("")
+        frd.unlink(missing_ok=True)
+    except OSError as exc:
+        print(f" *ERROR in openfile: could not open file {exc.filename}", flush=True)
+        return 201
+    if not deck.is_file():
+        print(f" *ERROR in openfile: could not open file {deck}", flush=True)
+        return 201
+    out = Path(args.out) if args.out else job.with_name(job.name + ".covcontact")
+    try:
+        imported = import_deck(deck, out / "deck" / f"{job.name}.toml", "calculix")
+        for line in getattr(imported, "notes", []):
+            print(f" *INFO: {line}", flush=True)
+        for line in imported.unsupported:
+            print(f" *{'WARNING' if args.ignore_unsupported else 'ERROR'}: not supported by covcontact: {line}",
+                  flush=True)
+        if imported.unsupported and not args.ignore_unsupported:
+            print(f" *ERROR: {deck}: {len(imported.unsupported)} unsupported keywords or parameters (listed above); "
+                  f"--ignore-unsupported goes on without them", flush=True)
+            return 201
+        preload(imported.read)
+        problem = load_problem(imported.problem)
+        _check_solver(args.solver or problem.solver.linear)
+        status = CcxStatus(imported.labels, sta, cvg)
+        observers = [DatTable(imported.labels, dat, deck={"file": deck.name, "ignored": imported.unsupported,
+                                                          "notes": list(getattr(imported, "notes", []))}),
+                     FrdFile(imported.labels, frd), status]
+        result = solve_problem(problem, out=out, quiet=True, linear=args.solver, observers=observers)
+    except InputError as exc:
+        print(f" *ERROR reading {deck}: {exc}", flush=True)
+        return 201
+    if result.exit_code == 0:
+        print(finished(time.perf_counter() - t0), flush=True)
+        return 0
+    if result.exit_code == 1:
+        print(f"\n *ERROR: an increment did not converge even after cutbacks ({status.failure}); {frd.name} holds "
+              f"the steps that converged\n", flush=True)
+        return 201
     return result.exit_code
 
 
@@ -404,7 +484,7 @@ def cmd_info(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     handler = {"run": cmd_run, "study": cmd_study, "check-tangent": cmd_check_tangent,
-               "compile": cmd_compile, "info": cmd_info, "import": cmd_import}[args.command]
+               "compile": cmd_compile, "info": cmd_info, "import": cmd_import, "ccx": cmd_ccx}[args.command]
     if args.command not in ("info", "compile"):
         from .compile_notice import install
 

@@ -149,7 +149,6 @@ class FrdFile(Observer):
         self.kode = 0         # result sets written
         self.increments = 0   # converged increments of the deck step in hand
         self.in_step = -1     # that deck step
-        self.sets: list[tuple[int, int, float]] = []  # (deck step, increment, time) of every set written
 
     # -- events ---------------------------------------------------------------------------------------
     def started(self, run) -> None:
@@ -176,14 +175,13 @@ class FrdFile(Observer):
         step = self.deck_step[stage]
         if step != self.in_step:
             self.in_step, self.increments = step, 0
-        self.increments += 1
+        self.increments += max(1, len(getattr(run.newton, "converged_increments", None) or []))  # (as JOB.sta counts)
         last = stage + 1 == len(self.deck_step) or self.deck_step[stage + 1] != step
         if not (inc.ends_stage and last):
             return
         periods = self.info["periods"]
         t = sum(periods[:stage]) + periods[stage] * inc.lam
         text = self._results(run, inc.lam, step + 1, self.increments, t, bool(run.state.dynamics))
-        self.sets.append((step + 1, self.increments, t))
         if run.model.is_root:
             with open(self.path, "a") as fh:
                 fh.write(text)
