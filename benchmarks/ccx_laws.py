@@ -131,10 +131,11 @@ def _step_end_forces(text: str, steps: int) -> list[float]:
     out = {}
     time = None
     for line in text.splitlines():
-        if "for set TOP and time" in line:
+        if line.strip().startswith("total force") and "for set TOP and time" in line:
             time = float(line.split("time")[1])
-        elif line.strip().startswith("total force") and time is not None:
-            out[time] = float(line.split()[-1])
+        elif time is not None and line.strip():
+            out[time] = float(line.split()[2])
+            time = None
     if not out:  # (per-node rows: their sum)
         blocks = dat_blocks(text)
         out = {t: sum(v[2] for v in rows.values()) for (kind, _, t), rows in blocks.items() if kind == "forces"}

@@ -43,18 +43,18 @@ def test_curves_have_calculix_closed_forms():
     p, dp = t.pressure(-dd)
     assert p == pytest.approx([0.0, 0.0, 2.5, 5.0, 17.5, 40.0, 40.0], abs=1e-12)
     assert dp[2] == pytest.approx(5000.0) and dp[4] == pytest.approx(12500.0) and dp[-1] == 0.0
-    # CalculiX's exponential: p0 at zero gap, 1 % of p0 at the clearance c0, nothing beyond c0
+    # CalculiX's exponential: p0 at zero gap, 1 % of p0 at the clearance c0; beyond c0 faded to nothing at 2 c0
     x = laws["calculix_exponential"]
-    p, _ = x.pressure(np.array([0.0, C0, 0.5 * C0]))
-    assert p == pytest.approx([P0, 0.01 * P0, 0.1 * P0], rel=1e-12)
-    act, sig, _ = x.traction(np.array([0.99 * C0, 1.01 * C0]), np.ones(2))
+    p, _ = x.pressure(np.array([0.0, C0, 0.5 * C0, 1.5 * C0]))
+    assert p == pytest.approx([P0, 0.01 * P0, 0.1 * P0, 0.5 * P0 * 100.0 ** -1.5], rel=1e-12)
+    act, sig, _ = x.traction(np.array([1.99 * C0, 2.01 * C0]), np.ones(2))
     assert act.tolist() == [True, False] and sig[1] == 0.0
 
 
 @pytest.mark.parametrize("kind", ["arctan", "table", "calculix_exponential"])
 def test_slopes_against_central_differences(kind):
     law = _laws()[kind]
-    g = np.array([-0.004, -0.0025, -0.0015, -0.0007, -0.0002, 0.0003, 0.0011])
+    g = np.array([-0.004, -0.0025, -0.0015, -0.0007, -0.0002, 0.0003, 0.0011, 0.0031])
     area = np.full(g.size, 0.3)
     h = 1e-9
     act, sig, dsig = law.traction(g, area)

@@ -148,7 +148,9 @@ class PressureLaw:
       (|p| < sigma_inf at clearances up to ``reach`` sqrt(area)) is not transmitted (docs/input.md says so);
     - ``table``: piecewise linear through (d_i, p_i), constant outside the table (CalculiX's TABULAR), felt up to
       the clearance ``reach`` sqrt(area) where p > 0;
-    - ``calculix_exponential``: p = p0 exp(-ln(100) g / c0) for g < c0 (CalculiX's EXPONENTIAL; no force beyond c0).
+    - ``calculix_exponential``: p = p0 exp(-ln(100) g / c0) for g < c0 (CalculiX's EXPONENTIAL), faded linearly to
+      zero between c0 and 2 c0 (CalculiX cuts it off at c0, a jump of 0.01 p0 that its frozen contact elements get
+      over; covcontact keeps the curve continuous instead).
 
     p is a pressure (times the slave's area, ``per_area``) or a force per slave node. The kernels are written for the
     linear law; :meth:`equivalents` gives, at each gap, the linear law with this curve's traction and slope there.
@@ -194,12 +196,17 @@ class PressureLaw:
                                                              self.p[k] + slope * (d - self.d[k])))
             return p, np.where(inside, slope, 0.0)
         p = self.p0 * np.exp(self.beta * d)
-        return p, self.beta * p
+        # beyond c0 (d < -c0) faded linearly to zero at 2 c0: CalculiX's jump from 0.01 p0 to nothing at c0 leaves
+        # no equilibrium for a slave at c0 (CalculiX gets through by freezing its contact elements, which then act
+        # beyond c0 with the curve itself); the fade lies between the two and is continuous
+        fade = np.clip(2.0 + d / self.c0, 0.0, 1.0)
+        dfade = np.where((d < -self.c0) & (d > -2.0 * self.c0), 1.0 / self.c0, 0.0)
+        return p * fade, self.beta * p * fade + p * dfade
 
     def limit(self, area: np.ndarray) -> np.ndarray:
         """The largest clearance at which the law acts on each slave."""
         if self.kind == "calculix_exponential":
-            return np.full(np.shape(area), self.c0)
+            return np.full(np.shape(area), 2.0 * self.c0)
         return self.reach * np.sqrt(np.maximum(area, 0.0))
 
     def traction(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -148,6 +148,9 @@ class _Writer:
             reduced = {ELEMENTS[t][1].get("integration") == "reduced" for t in types}
             if len(reduced) > 1:
                 self.unsupported.append(f"{self.deck}: body {name} mixes C3D20 and C3D20R elements")
+            if len({ELEMENTS[t][1].get("incompatible_modes", False) for t in types if ELEMENTS[t][0] == "hex8"}) > 1:
+                self.unsupported.append(f"{self.deck}: body {name} mixes C3D8I with C3D8 or C3D8R elements")
+            options = {k: v for t in sorted(types) for k, v in ELEMENTS[t][1].items()}  # its element types' options
             secs = [(s, mat, w) for s, mat, w in self.m.sections
                     if np.intersect1d(self.m.elsets.get(s, np.zeros(0, np.int64)), labels).size]
             for s, _, w in self.m.sections:
@@ -163,8 +166,8 @@ class _Writer:
             entries["material"] = self._material(secs[0][1], secs[0][2])
             if len(secs) > 1:
                 entries["materials"] = {_name(s): self._material(mat, w) for s, mat, w in secs[1:]}
-            if True in reduced:
-                entries["options"] = {"integration": "reduced"}
+            if options:
+                entries["options"] = options
             text += _table("[[bodies]]", entries)
         return text
 
@@ -537,6 +540,9 @@ class _Writer:
         entry.update({"law": "arctan", "penalty": K, "tension": sig})
         if c0 > 0.0:
             entry["reach"] = c0
+        self.notes.append(f"{it.where}: *SURFACE BEHAVIOR, LINEAR (node-to-face): the compression branch K d (1/2 + "
+                          f"atan(d / e) / pi) is CalculiX's; its tension tail at clearances below c0 sqrt(area) (at "
+                          f"most sigma_inf = {sig:g} per area) is not transmitted")
 
     def _tied_pair(self, entry: dict, it: Interaction, sts: bool, where: str) -> bool:
         """PRESSURE-OVERCLOSURE=TIED (face-to-face only in CalculiX): the slave faces bonded with the slope K per
