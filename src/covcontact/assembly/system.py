@@ -98,7 +98,12 @@ def _element_body(body, material, cell_type: str, cells: np.ndarray):
         from ..elements.fbar import FbarBody
 
         return FbarBody(cell_type, body.mesh.points, cells, material, **body.options)
-    return SolidBody(cell_type, body.mesh.points, cells, material, **body.options)
+    options = {k: v for k, v in body.options.items() if k != "incompatible_modes"}
+    if body.options.get("incompatible_modes") and cell_type == "hex8":  # (C3D8I; a mixed mesh's other cells plain)
+        from ..elements.incompatible import IncompatibleBody
+
+        return IncompatibleBody(cell_type, body.mesh.points, cells, material)
+    return SolidBody(cell_type, body.mesh.points, cells, material, **options)
 
 
 def make_solid(body, elements: np.ndarray | None = None):

@@ -14,7 +14,7 @@ from .solid import SolidBody, solid_gauss_fields
 def point_stresses(solid, u: np.ndarray, state: dict | None = None) -> np.ndarray:
     """(n_elements, n_points, 6) Cauchy stress (xx, yy, zz, xy, yz, xz) at the Gauss points of a solid body at its
     displacement ``u`` (nnode, 3) and element history ``state``; NaN past a cell's own points (a body whose cell types
-    mix). A ValueError for formulations other than the plain solid (F-bar, solid-shell)."""
+    mix). A ValueError for formulations other than the plain solid and incompatible modes (F-bar, solid-shell)."""
     state = solid.new_state() if state is None else state
     if isinstance(solid, CompositeBody):
         rows = [point_stresses(part, u, solid._views(k, state)[0]) for k, part in enumerate(solid.parts)]
@@ -22,6 +22,8 @@ def point_stresses(solid, u: np.ndarray, state: dict | None = None) -> np.ndarra
         for idx, r in zip(solid.index, rows):
             out[idx, : r.shape[1]] = r
         return out
+    if hasattr(solid, "point_stresses"):  # (an element body with its own Gauss-point stresses: incompatible modes)
+        return solid.point_stresses(u, state)
     if not isinstance(solid, SolidBody):
         raise ValueError(f"stresses at Gauss points are for solid elements, not {type(solid).__name__}")
     u = solid._u(u)

@@ -433,14 +433,21 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
             if mesh.cell_type != "hex8" and options.get("form", "spatial") != "spatial":
                 b.fail(f"F-bar {mesh.cell_type} has the spatial form only; leave out 'form'", "options")
         elif options:
-            unknown = sorted(set(options) - {"integration"})
+            unknown = sorted(set(options) - {"integration", "incompatible_modes"})
             if unknown:
-                b.fail(f"unknown option {unknown[0]!r} for formulation = \"solid\" (known: integration)", "options")
-            if options["integration"] not in ("full", "reduced"):
+                b.fail(f"unknown option {unknown[0]!r} for formulation = \"solid\" (known: integration, "
+                       f"incompatible_modes)", "options")
+            if options.get("integration", "full") not in ("full", "reduced"):
                 b.fail(f"integration must be \"full\" or \"reduced\", got {options['integration']!r}", "options")
-            if options["integration"] == "reduced" and mesh.cell_type != "hex20":
+            if options.get("integration") == "reduced" and mesh.cell_type != "hex20":
                 b.fail(f"integration = \"reduced\" is for hex20 elements (as C3D20R), not {mesh.cell_type}: the "
                        f"others would have zero-energy modes", "options")
+            modes = options.get("incompatible_modes", False)
+            if not isinstance(modes, bool):
+                b.fail(f"incompatible_modes must be true or false, got {modes!r}", "options")
+            if modes and "hex8" not in mesh.cell_types:
+                b.fail(f"incompatible_modes = true is for hex8 elements (as C3D8I), not "
+                       f"{' and '.join(mesh.cell_types)}", "options")
         if materials and material is None:  # every cell in a set: the first set's material stands for the body
             material = next(iter(materials.values()))
         bodies.append(Body(bname, mesh, material, formulation, options, materials))

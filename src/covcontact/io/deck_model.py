@@ -19,6 +19,7 @@ from .deck_loads import Boundary, Load, LoadCards
 #: Abaqus / CalculiX element type -> (covcontact cell type, options); C3D8R is the full-integration hex8 (there is
 #: no hourglass-controlled hex8), C3D20R the reduced hex20
 ELEMENTS = {"C3D8": ("hex8", {}), "C3D8R": ("hex8", {}), "C3D20": ("hex20", {}),
+            "C3D8I": ("hex8", {"incompatible_modes": True}),
             "C3D20R": ("hex20", {"integration": "reduced"}), "C3D10": ("tet10", {}), "C3D4": ("tet4", {}),
             "C3D6": ("wedge6", {})}
 #: nodes per cell (the deck's node order is covcontact's, VTK's, for every one of these cells)
