@@ -324,7 +324,8 @@ def test_amplitudes_cut_a_step_into_stages(tmp_path):
     import json
 
     info = json.loads(imp.labels.read_text())
-    assert info["periods"] == pytest.approx([0.4, 0.6]) and info["node_print"][0] == []  # printed at the step's end
+    assert info["periods"] == pytest.approx([0.4, 0.6])  # printed at every increment and at the step's end only
+    assert info["print_every"] == [1, 1] and info["print_end"] == [False, True]
     deck.write_text(text.replace("AMPLITUDE=A1", "AMPLITUDE=A2"))
     with pytest.raises(DeckError, match="AMPLITUDE=A2: no \\*AMPLITUDE of that name .defined: A1."):
         import_deck(deck, tmp_path / "b" / "p.toml")
@@ -359,7 +360,8 @@ def test_deck_run_equals_the_problem_file_and_writes_the_dat_table(tmp_path):
     got = [v for k, v in ours["steps"][-1]["reactions"].items() if k.startswith("BASE.BOTTOM")]
     assert sum(v[2] for v in got) == pytest.approx(fz, rel=1e-9)
     dat = (tmp_path / "out" / "tb.dat").read_text().splitlines()
-    assert dat[1] == " displacements (vx,vy,vz) for set BOTTOM and time  0.1000000E+01"
+    assert dat[1] == " displacements (vx,vy,vz) for set BOTTOM and time  0.5000000E+00"  # every increment
+    assert " displacements (vx,vy,vz) for set BOTTOM and time  0.1000000E+01" in dat
     rf_at = dat.index(" forces (fx,fy,fz) for set BOTTOM and time  0.1000000E+01")
     rows = [ln.split() for ln in dat[rf_at + 2:] if ln.strip()]
     assert [int(r[0]) for r in rows] == [1, 3, 5, 7, 9, 11, 13, 15, 17]  # the deck's labels of the bottom nodes

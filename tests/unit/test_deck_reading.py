@@ -69,16 +69,38 @@ def test_print_requests_carry_over_and_totals(tmp_path):
                            "--quiet"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     dat = (tmp_path / "out" / "tb.dat").read_text()
-    heads = [ln for ln in dat.splitlines() if "for set" in ln]
-    assert [h.split(" for set")[0].strip() for h in heads] == ["displacements (vx,vy,vz)", "total force (fx,fy,fz)"] * 2
-    assert heads[1].endswith("0.1000000E+01") and heads[3].endswith("0.2000000E+01")
+    heads = [ln for ln in dat.splitlines() if "for set" in ln]  # (every increment of steps 1 and 2, none of 3)
+    n = len(heads) // 2
+    assert n >= 3 and [h.split(" for set")[0].strip() for h in heads] == ["displacements (vx,vy,vz)",
+                                                                          "total force (fx,fy,fz)"] * n
+    times = [float(h.split("time")[1]) for h in heads[1::2]]
+    assert times == sorted(times) and 1.0 in times and times[-1] == 2.0
     lines = dat.splitlines()
-    total = [float(v) for v in lines[lines.index(heads[3]) + 2].split()]
+    total = [float(v) for v in lines[lines.index(heads[-1]) + 2].split()]
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     step2 = [s for s in summary["steps"] if s.get("stage") == "step2"][-1]
     fz = sum(v[2] for k, v in step2["reactions"].items() if k.startswith("BASE.BOTTOM"))
     assert total[2] == pytest.approx(fz, rel=1e-6) and abs(fz) > 1.0
     assert summary["deck"]["file"] == "tb.inp" and summary["deck"]["ignored"] == []
+
+
+def test_time_points_and_frequency(tmp_path):
+    """*TIME POINTS: the step cut at its points and printed exactly there and at the step's end; FREQUENCY=2: every
+    second increment and the step's end."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    deck = tmp_path / "t.inp"
+    deck.write_text(text.replace("*STEP, NLGEOM", "*TIME POINTS, NAME=TP, GENERATE\n0.3, 0.7, 0.4\n*STEP, NLGEOM")
+                    .replace("*NODE PRINT, NSET=BOTTOM", "*NODE PRINT, NSET=BOTTOM, TIME POINTS=TP"))
+    assert subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "a"),
+                           "--quiet"], capture_output=True, timeout=600).returncode == 0
+    times = [ln[-14:] for ln in (tmp_path / "a" / "t.dat").read_text().splitlines() if ln.startswith(" displacements")]
+    assert times == [" 0.3000000E+00", " 0.7000000E+00", " 0.1000000E+01"]
+    deck.write_text(text.replace("*STATIC\n0.5, 1.0\n", "*STATIC, DIRECT\n0.2, 1.0\n")
+                    .replace("*NODE PRINT, NSET=BOTTOM", "*NODE PRINT, NSET=BOTTOM, FREQUENCY=2"))
+    assert subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "b"),
+                           "--quiet"], capture_output=True, timeout=600).returncode == 0
+    times = [ln[-14:] for ln in (tmp_path / "b" / "t.dat").read_text().splitlines() if ln.startswith(" displacements")]
+    assert times == [" 0.4000000E+00", " 0.8000000E+00", " 0.1000000E+01"]
 
 
 def test_laws_kept_or_refused(tmp_path):

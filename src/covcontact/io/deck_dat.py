@@ -33,6 +33,7 @@ class DatTable(Observer):
         self.info = json.loads(Path(labels).read_text())
         self.path = Path(path)
         self.deck = deck
+        self.count: dict[int, int] = {}  # converged increments of each deck step so far
 
     def started(self, run) -> None:
         if run.model.is_root:
@@ -41,8 +42,21 @@ class DatTable(Observer):
         if self.deck is not None and summary is not None:  # (summary.json: what was ignored and filled in)
             summary.data["deck"] = dict(self.deck)
 
+    def _due(self, inc) -> bool:
+        """Whether this converged increment prints: the end of a step or of a time point, or every Nth increment
+        of the deck step (FREQUENCY; CalculiX's default: every increment)."""
+        stage = inc.state.stage
+        steps = self.info.get("deck_step", [])
+        ends = self.info.get("print_end")
+        if ends is None or stage >= len(ends):  # (a labels file without output times: the step's end)
+            return bool(inc.ends_stage)
+        deck_step = steps[stage]
+        self.count[deck_step] = self.count.get(deck_step, 0) + 1
+        every = self.info["print_every"][stage]
+        return bool(inc.ends_stage and ends[stage]) or (every > 0 and self.count[deck_step] % every == 0)
+
     def increment_converged(self, run, inc) -> None:
-        if not inc.ends_stage:
+        if not self._due(inc):
             return
         stage = inc.state.stage
         prints = self.info["node_print"][stage] if stage < len(self.info["node_print"]) else []

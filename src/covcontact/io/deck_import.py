@@ -208,6 +208,8 @@ class _Writer:
         first: dict[tuple, object] = {}   # key -> first-stage entry (dict)
         stages: list[dict] = []
         self.stage_steps: list[tuple[int, float]] = []   # per covcontact stage: (deck step, duration)
+        self.print_end: list[bool] = []   # per stage: its end is an output time (the step's end, a time point)
+        self.print_every: list[int] = []  # per stage: output every Nth increment of the deck step (0: at ends only)
         self.stage_jump: list[bool] = []                  # per covcontact stage: its loads applied at once
         active: dict[tuple, float] = {}   # boundary key (body, set, dof) -> value held at the end of the last step
         loads: dict[tuple, float] = {}    # load key -> value at the end of the last step
@@ -255,7 +257,15 @@ class _Writer:
                 if amp is not None:
                     times = np.asarray(amp[0]) - (total if amp[2] else 0.0)
                     breaks |= {float(t) for t in times if 0.0 < t < period * (1 - 1e-12)}
+            points = set()
+            if step.time_points is not None:  # output exactly at the time points: the step cut there
+                times, on_total = self.m.time_points[step.time_points]
+                times = np.asarray(times) - (total if on_total else 0.0)
+                points = {float(t) for t in times if 0.0 < t < period * (1 - 1e-12)}
+                breaks |= points
             breaks = sorted(breaks)
+            self.print_end += [tau in points or tau == breaks[-1] for tau in breaks]
+            self.print_every += [0 if step.time_points is not None else step.frequency] * len(breaks)
             prev_b = {k: spec[0] for k, spec in bspec.items()}
             prev_l = {k: spec[0] for k, spec in lspec.items()}
             for j, tau in enumerate(breaks):
@@ -625,14 +635,12 @@ class _Writer:
         per_body = {}
         for k, name in enumerate(self.body_names):
             per_body[name] = self.m.node_labels[self.b.of_node == k].tolist()
-        ends = [k for k, (s, _) in enumerate(self.stage_steps) if k + 1 == len(self.stage_steps)
-                or self.stage_steps[k + 1][0] != s]  # the stages that end a deck step print its requests
-        prints = [[[nset, list(v), totals] for nset, v, _, totals in self.m.steps[s].node_print] if k in ends else []
-                  for k, (s, _) in enumerate(self.stage_steps)]
-        el_prints = [[[elset, list(v)] for elset, v, _ in self.m.steps[s].el_print] if k in ends else []
-                     for k, (s, _) in enumerate(self.stage_steps)]
-        contact_prints = [list(self.m.steps[s].contact_print) if k in ends else []
-                          for k, (s, _) in enumerate(self.stage_steps)]
+        # every stage of a deck step prints its requests: at the increments FREQUENCY picks and where a step or a
+        # time point ends (print_every, print_end)
+        prints = [[[nset, list(v), totals] for nset, v, _, totals in self.m.steps[s].node_print]
+                  for s, _ in self.stage_steps]
+        el_prints = [[[elset, list(v)] for elset, v, _ in self.m.steps[s].el_print] for s, _ in self.stage_steps]
+        contact_prints = [list(self.m.steps[s].contact_print) for s, _ in self.stage_steps]
         wanted = {p[0] for per_step in prints for p in per_step}
         missing = sorted(wanted - set(self.m.nsets))
         if missing:
@@ -647,7 +655,8 @@ class _Writer:
                                       "elsets": {k: self.m.elsets[k].tolist() for k in sorted(el_wanted)},
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
                                       "periods": [d for _, d in self.stage_steps],
-                                      "deck_step": [k for k, _ in self.stage_steps]}))
+                                      "deck_step": [k for k, _ in self.stage_steps],
+                                      "print_end": self.print_end, "print_every": self.print_every}))
         meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
         return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)),
                         list(dict.fromkeys(self.notes)), self.meshes)

@@ -32,7 +32,8 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
-             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY")
+             "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY",
+             "TIME POINTS")
 #: keywords only Abaqus reads: a deck with one of them is read in Abaqus' dialect (import_deck's "auto")
 _ABAQUS_ONLY = ("PART", "END PART", "ASSEMBLY", "END ASSEMBLY", "INSTANCE", "END INSTANCE")
 #: output requests: accepted, *NODE PRINT's U and RF, *EL PRINT's S and *CONTACT PRINT's CSTRESS are tabulated
@@ -65,6 +66,10 @@ class Step:
     contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables (CSTRESS is tabulated)
     #: which print requests the step itself gives (the others carry over from the step before, as in CalculiX)
     prints_given: set[str] = field(default_factory=set)
+    #: FREQUENCY of the output (every Nth increment and the step's end; carried over from step to step)
+    frequency: int = 1
+    #: TIME POINTS= of the output: the name of a *TIME POINTS (output there and at the step's end), or None
+    time_points: str | None = None
     #: *EQUATION, REMOVE: the dependent (node, dof) of the equations removed from this step on; None: REMOVE ALL
     remove_equations: list | None = field(default_factory=list)
     friction: dict[str, float] = field(default_factory=dict)  # *CHANGE FRICTION: interaction -> new mu
@@ -112,6 +117,8 @@ class DeckModel:
     rigid_bodies: list[tuple[np.ndarray, int | None, int | None, str]] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
+    #: *TIME POINTS: name -> (times, on the total time?)
+    time_points: dict[str, tuple[np.ndarray, bool]] = field(default_factory=dict)
     #: what the deck leaves to defaults, or reads in a way worth saying (listed before solving, not refused)
     notes: list[str] = field(default_factory=list)
     #: "abaqus" where the deck has keywords only Abaqus reads (*PART, *ASSEMBLY, *INSTANCE), else "calculix"
@@ -138,6 +145,7 @@ class _Reader(LoadCards):
         self.step: Step | None = None
         self.changing: str | None = None  # the interaction of the step's *CHANGE FRICTION
         self.node_cards: list[str] = []
+        self.frequency = 1  # (FREQUENCY stays in force from step to step until another is given)
         nodes, coords = [], []
         k = 0
         while k < len(cards):
@@ -246,7 +254,7 @@ class _Reader(LoadCards):
                 if inc is not None and not inc.strip().isdigit():
                     raise c.fail(f"INC must be a whole number, got {inc!r}")
                 self.step = Step(c.where(), "NLGEOM" in c.params and c.params["NLGEOM"].upper() != "NO",
-                                 (1.0, 1.0, None, None), False)
+                                 (1.0, 1.0, None, None), False, frequency=self.frequency)
             elif c.name in ("STATIC", "DYNAMIC"):
                 st = self._in_step(c)
                 if c.name == "DYNAMIC":
@@ -287,7 +295,11 @@ class _Reader(LoadCards):
                 self._boundary(c)
             elif c.name in ("CLOAD", "DLOAD"):
                 self._load(c)
-            elif c.name in ("NODE PRINT", "EL PRINT", "CONTACT PRINT"):
+            elif c.name == "TIME POINTS":
+                self._time_points(c)
+            if c.name in _OUTPUT and self.step is not None:
+                self._frequency(c)
+            if c.name in ("NODE PRINT", "EL PRINT", "CONTACT PRINT"):
                 self._print(c)
         if self.step is not None:
             raise DeckError(f"{self.step.where}: *STEP without its *END STEP")
@@ -307,6 +319,43 @@ class _Reader(LoadCards):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
+
+    def _time_points(self, c: Card) -> None:
+        """*TIME POINTS, NAME=, TIME=TOTAL TIME, GENERATE: the times (step time unless TIME=TOTAL TIME)."""
+        name = c.param("NAME", required=True).upper()
+        time = " ".join(c.param("TIME", "STEP TIME").upper().split())
+        if time not in ("STEP TIME", "TOTAL TIME"):
+            raise c.fail(f"TIME must be STEP TIME or TOTAL TIME, got {c.params['TIME']!r}")
+        v = numbers(c, None, "the times")
+        if "GENERATE" in c.params:
+            if v.size % 3:
+                raise c.fail("GENERATE takes lines 'start, end, increment'")
+            parts = []
+            for a, b, d in v.reshape(-1, 3):
+                if d <= 0 or b < a:
+                    raise c.fail("GENERATE needs start <= end and an increment > 0")
+                parts.append(np.arange(a, b + 0.5 * d, d))
+            v = np.concatenate(parts) if parts else v
+        self.m.time_points[name] = (np.unique(v), time == "TOTAL TIME")
+
+    def _frequency(self, c: Card) -> None:
+        """FREQUENCY= and TIME POINTS= of an output request: the step's output increments (the last FREQUENCY
+        applies to all output, and stays from step to step, as in CalculiX)."""
+        if "FREQUENCY" in c.params:
+            try:
+                n = int(c.params["FREQUENCY"])
+            except ValueError:
+                raise c.fail(f"FREQUENCY must be a whole number, got {c.params['FREQUENCY']!r}") from None
+            if n < 0:
+                raise c.fail(f"FREQUENCY must be >= 0, got {n}")
+            if n > 0:
+                self.frequency = self.step.frequency = n
+                self.step.time_points = None
+        if "TIME POINTS" in c.params:
+            name = c.params["TIME POINTS"].upper()
+            if name not in self.m.time_points:
+                raise c.fail(f"TIME POINTS={c.params['TIME POINTS']}: no *TIME POINTS of that name above")
+            self.step.time_points = name
 
     def _print(self, c: Card) -> None:
         """*NODE PRINT, *EL PRINT, *CONTACT PRINT: the first of a kind in a step replaces the requests carried over
