@@ -53,7 +53,8 @@ from covcontact.contact.friction_kernels import (
 from covcontact.contact.geometry import facet_geometry
 from covcontact.contact.laws import is_active, linear_equivalent
 from covcontact.contact.profile import profile_closest, profile_derivative
-from covcontact.contact.projection import DEGENERATE, project_on_facet
+from covcontact.contact.projection import CONVERGED, DEGENERATE, project_on_facet
+from covcontact.contact.surface import edge_closest_point
 from covcontact.fem.shapes import NODES
 
 __all__ = [
@@ -366,14 +367,6 @@ def _traction_vector(T, rho_cov):
     return np.linalg.solve(a, T) @ rho_cov
 
 
-def _facet_frame(xyz, xi):
-    nen = xyz.shape[0]
-    rho, rc, n = np.zeros(3), np.zeros((2, 3)), np.zeros(3)
-    facet_geometry(xyz, xi[0], xi[1], np.empty(nen), np.empty((nen, 2)), np.empty((nen, 2, 2)), rho, rc,
-                   np.empty((2, 2)), np.empty((2, 2)), n, np.empty((2, 2)))
-    return rho, rc, n
-
-
 def node_to_surface_friction(
     master_xyz, slave_xyz, eps_n, eps_t, mu, history=None, xi0=None
 ) -> FrictionResult:
@@ -404,7 +397,7 @@ def node_to_surface_friction(
     g, state = friction_element(xyz, xs, xi, eps, et, m, hist, R, K, ho)
     RN, KN = np.zeros(size), np.zeros((size, size))
     contact_element(xyz, xs, xi, eps, CASE_EXACT, False, RN, KN, np.zeros((1, 1, 1)))
-    _, rc, nrm = _facet_frame(xyz, xi)
+    _, rc, nrm, _ = _facet_frame(xyz, xi)
     T = ho[H_T:H_T + 2].copy()
     return FrictionResult(
         gap=float(g), xi=xi, normal=nrm, inside=bool(np.all(np.abs(xi) <= 1.0 + INSIDE_TOL)), residual=R,
@@ -435,17 +428,96 @@ def surface_friction(surface, slave_xyz, eps_n, eps_t, mu, history=None, lam: fl
         traction_vector=_traction_vector(T, pr.rho_cov), history=ho)
 
 
-def transfer_history(history, master_xyz, xi0=None) -> np.ndarray:
+#: how far beyond its edges (element coordinates) a history point may lie on the facet's continuation: the
+#: continuation is the facet's polynomial carried on past its edges, which folds (rho_1 x rho_2 = 0) at a distance that
+#: depends on the facet's shape; the quadrilaterals of a tri3 or tri6 patch (docs/theory.md section 19) fold at their
+#: outer corner xi = (2, 2), one facet size away
+TRANSFER_BAND = 0.5
+#: ... and there the area element must be at least this share of the facet centre's, with the same orientation
+_TRANSFER_AREA = 0.05
+
+
+def _facet_frame(xyz, xi):
+    """(rho, rho_cov, n) of facet ``xyz`` at ``xi``; ValueError where the facet is degenerate there."""
+    nen = xyz.shape[0]
+    rho, rc, n = np.zeros(3), np.zeros((2, 3)), np.zeros(3)
+    area = facet_geometry(xyz, xi[0], xi[1], np.empty(nen), np.empty((nen, 2)), np.empty((nen, 2, 2)), rho, rc,
+                          np.empty((2, 2)), np.empty((2, 2)), n, np.empty((2, 2)))
+    if area == 0.0:
+        raise ValueError("degenerate master facet (zero area element at the point)")
+    return rho, rc, n, area
+
+
+def _regular_at(xyz, xi) -> bool:
+    """Whether the facet's continuation is regular at ``xi``: within TRANSFER_BAND of the facet, its area element at
+    least _TRANSFER_AREA of the centre's and its normal on the centre's side."""
+    if not (np.all(np.isfinite(xi)) and np.max(np.abs(xi)) <= 1.0 + TRANSFER_BAND):
+        return False
+    try:
+        _, _, n0, a0 = _facet_frame(xyz, np.zeros(2))
+        _, _, n1, a1 = _facet_frame(xyz, xi)
+    except ValueError:
+        return False
+    return bool(a1 >= _TRANSFER_AREA * a0 and n1 @ n0 > 0.0)
+
+
+def _closest_on_facet(xyz, point, xi0) -> np.ndarray:
+    """The element coordinates (in [-1, 1]^2) of the point of the facet itself (not its continuation) closest to
+    ``point``: a projection that converges inside, else the closest of its edge curves' points."""
+    best, best_d2 = None, np.inf
+    for start in (xi0, np.zeros(2)):
+        xi = np.array(start, dtype=np.float64)
+        status, _ = project_on_facet(xyz, point, xi)
+        if status == CONVERGED and np.max(np.abs(xi)) <= 1.0 + INSIDE_TOL:
+            xi = np.clip(xi, -1.0, 1.0)
+            rho = _facet_frame(xyz, xi)[0]
+            best, best_d2 = xi, float(np.sum((point - rho) ** 2))
+            break
+    corners = NODES["quad4"].astype(np.float64)
+    c = np.empty(3)
+    for e in range(4):
+        t, d2 = edge_closest_point(xyz, e, point, c)
+        if d2 < best_d2:
+            best_d2 = d2
+            best = 0.5 * (1.0 - t) * corners[e] + 0.5 * (1.0 + t) * corners[(e + 1) % 4]
+    return best
+
+
+def _anchored(xyz, point, t_vec, eps_t, xi0) -> np.ndarray:
+    """The history on facet ``xyz`` (its configuration of the history) of a tangential spring anchored at ``point``
+    that holds the traction vector ``t_vec``.
+
+    The anchor is the projection of ``point`` on the facet, where that lies on the facet or on its regular
+    continuation near it (``_regular_at``). Farther away (a slave that crossed more than the facet next to its old one
+    in a step; near a fold of the continuation the frame is singular, beyond it the projection meaningless) the
+    anchor is the facet's own closest point rho_a and the spring's stretch between the two points goes into the
+    traction: t_a = t_vec - eps_t (rho_a - point), which gives the same trial traction t - eps_T (rho - anchor) at
+    every contact point on a plane (to first order on a curved facet)."""
+    xi = np.array(xi0, dtype=np.float64)
+    status, _ = project_on_facet(xyz, point, xi)
+    if status == DEGENERATE or not (status == CONVERGED and _regular_at(xyz, xi)):
+        xi = _closest_on_facet(xyz, point, np.clip(np.nan_to_num(np.asarray(xi0, dtype=np.float64)), -1.0, 1.0))
+    rho, rc, _, _ = _facet_frame(xyz, xi)
+    return make_history(xi, rc @ (t_vec - eps_t * (rho - point)), rho, rc)
+
+
+def transfer_history(history, master_xyz, xi0=None, eps_t: float = 0.0) -> np.ndarray:
     """Move a facet history to another facet (a slave node changed facets).
 
     ``master_xyz`` are the new facet's nodes in the configuration of the history (the last converged
     step). The old contact point rho_n is projected onto the new facet, and the old traction vector
     t_n = T_k a_(n)^kl rho_l^(n) is re-expressed there: T'_i = t_n . rho'_i (tangential part).
+
+    Where rho_n lies farther from the new facet than its regular continuation reaches (``TRANSFER_BAND`` beyond its
+    edges), the history is anchored at the new facet's closest point rho_a instead, with the traction
+    t_n - ``eps_t`` (rho_a - rho_n): ``eps_t`` is the slave's tangential penalty (0 drops the slip between the two
+    points). ValueError where the new facet is degenerate.
     """
     hist = _check_friction(1.0, 0.0, history)[2]
     if hist[H_FLAG] == 0.0:
         return hist
-    xyz = _as_points(master_xyz, lambda s: s in ((4, 3), (9, 3)), "master_xyz (expected (4, 3) or (9, 3))")
+    xyz = np.ascontiguousarray(_as_points(master_xyz, lambda s: s in ((4, 3), (9, 3)),
+                                          "master_xyz (expected (4, 3) or (9, 3))"))
     rho_n = hist[H_RHO:H_RHO + 3].copy()
     rc_n = hist[H_RHO_COV:H_RHO_COV + 6].reshape(2, 3)
     t_n = _traction_vector(hist[H_T:H_T + 2], rc_n)
@@ -454,20 +526,20 @@ def transfer_history(history, master_xyz, xi0=None) -> np.ndarray:
         xi = NODES["quad4" if xyz.shape[0] == 4 else "quad9"][k].astype(np.float64).copy()
     else:
         xi = _as_points(xi0, lambda s: s == (2,), "xi0 (expected (2,))").copy()
-    if project_on_facet(xyz, rho_n, xi)[0] == DEGENERATE:
-        raise ValueError("degenerate master facet (zero area element at the projection)")
-    rho, rc, _ = _facet_frame(xyz, xi)
-    return make_history(xi, rc @ t_n, rho, rc)
+    return _anchored(xyz, rho_n, t_n, float(eps_t), xi)
 
 
-def start_history(master_xyz, slave_xyz, xi0) -> np.ndarray:
+def start_history(master_xyz, slave_xyz, xi0, eps_t: float = 0.0) -> np.ndarray:
     """The history of a slave new to contact: its projection on the facet ``master_xyz`` (in the configuration where
-    the step started, with the slave at ``slave_xyz`` there) as the stick point, zero traction; no history (a
-    frictionless start, state NEW) where the facet is degenerate there."""
+    the step started, with the slave at ``slave_xyz`` there) as the stick point, zero traction (anchored on the
+    facet as ``transfer_history`` does where that projection lies beyond the facet's regular continuation); no
+    history (a frictionless start, state NEW) where the facet is degenerate there."""
     xyz = np.ascontiguousarray(master_xyz, dtype=np.float64)
+    xs = np.ascontiguousarray(slave_xyz, dtype=np.float64)
     xi = np.array(xi0, dtype=np.float64)
-    if project_on_facet(xyz, np.ascontiguousarray(slave_xyz, dtype=np.float64), xi)[0] == DEGENERATE or not np.all(
-            np.isfinite(xi)):
+    if not (np.all(np.isfinite(xi)) and np.all(np.isfinite(xs)) and np.all(np.isfinite(xyz))):
         return new_history()
-    rho, rc, _ = _facet_frame(xyz, xi)
-    return make_history(xi, (0.0, 0.0), rho, rc)
+    try:
+        return _anchored(xyz, xs, np.zeros(3), float(eps_t), xi)
+    except (ValueError, np.linalg.LinAlgError):
+        return new_history()

@@ -108,7 +108,11 @@ def facet_geometry(xyz, xi1, xi2, N, dN, ddN, rho, rho_cov, a_cov, a_con, n, h_c
     c2 = rho_cov[0, 0] * rho_cov[1, 1] - rho_cov[0, 1] * rho_cov[1, 0]
     area = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
     ref = np.sqrt(a_cov[0, 0] * a_cov[1, 1])
-    if not (area > DEGENERATE_TOL * ref) or not np.isfinite(area):
+    # det a = area^2 in exact arithmetic, but a_11 a_22 - a_12^2 loses it to cancellation once area / ref falls
+    # below about 1e-8 (near a fold of a facet's continuation beyond its edges): there it can be zero or negative
+    # although area passed the test, so the inverse is taken only where det is positive too
+    det = a_cov[0, 0] * a_cov[1, 1] - a_cov[0, 1] * a_cov[1, 0]
+    if not (area > DEGENERATE_TOL * ref) or not np.isfinite(area) or not (det > 0.0):
         for p in range(3):
             n[p] = 0.0
         for i in range(2):
@@ -119,7 +123,6 @@ def facet_geometry(xyz, xi1, xi2, N, dN, ddN, rho, rho_cov, a_cov, a_con, n, h_c
     n[0] = c0 / area
     n[1] = c1 / area
     n[2] = c2 / area
-    det = a_cov[0, 0] * a_cov[1, 1] - a_cov[0, 1] * a_cov[1, 0]
     a_con[0, 0] = a_cov[1, 1] / det
     a_con[1, 1] = a_cov[0, 0] / det
     a_con[0, 1] = -a_cov[0, 1] / det

@@ -333,14 +333,15 @@ class ContactManager:
         hist = c.hist[idx].copy()
         if x_commit is not None and p.kind == "nts":
             for j in np.flatnonzero(hist[:, -1] == 0.0):
-                hist[j] = start_history(x_commit[p.surface.faces[facets[j]]], x_commit[p.slaves[idx[j]]], xi[j])
+                hist[j] = start_history(x_commit[p.surface.faces[facets[j]]], x_commit[p.slaves[idx[j]]], xi[j],
+                                        float(p.eps_t[idx[j]]))
         moved = np.flatnonzero((hist[:, -1] > 0.0) & (c.hist_facet[idx] != facets))
         for j in moved:
             if x_commit is None:
                 hist[j] = 0.0
                 continue
-            try:
-                hist[j] = transfer_history(hist[j], x_commit[p.surface.faces[facets[j]]], xi[j])
+            try:  # (the slave's tangential penalty: an old point far off the new facet is anchored on it)
+                hist[j] = transfer_history(hist[j], x_commit[p.surface.faces[facets[j]]], xi[j], float(p.eps_t[idx[j]]))
             except ValueError:
                 hist[j] = 0.0
         return hist
