@@ -346,6 +346,11 @@ def test_attempts_of_a_step():
     assert incs[0][-1].iterations == 6
     broken = increments([ok, fail, fail], [(0.0, 0.5)], 0.0, 1.0)
     assert [(a.converged, a.lam0, a.dlam) for a in broken[1]] == [(False, 0.5, 0.5), (False, 0.5, 0.25)]
+    # an Uzawa update that fails fails its attempt: cut back, the half converges
+    uzawa_fails = StepOutcome(False, 5, augmentation=1)
+    incs = increments([ok, uzawa_fails, ok], [(0.0, 0.5)], 0.0, 1.0)
+    assert [[(a.number, a.converged, a.dlam, a.iterations) for a in inc] for inc in incs] == \
+        [[(1, False, 1.0, 9), (2, True, 0.5, 4)]]
 
 
 def test_number_formats():

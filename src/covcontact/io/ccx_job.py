@@ -73,25 +73,29 @@ class Attempt:
 
 def increments(outcomes: list, converged: list, lam_a: float, target: float) -> list[list[Attempt]]:
     """The increments of one covcontact step in CalculiX's sense, each the list of its attempts (the last converged,
-    except in a step that failed): ``outcomes`` Newton's solves in order, ``converged`` the (start, end) load
-    factors of the increments that converged (``Newton.converged_increments``), ``target`` the step's aim."""
+    except in a step that failed): ``outcomes`` Newton's solves in order (an attempt, then its Uzawa updates),
+    ``converged`` the (start, end) load factors of the increments that converged (``Newton.converged_increments``),
+    ``target`` the step's aim. An attempt converged when it and all its Uzawa updates did."""
+    groups: list[list] = []
+    for o in outcomes:
+        if o.augmentation > 0 and groups:
+            groups[-1].append(o)
+        else:
+            groups.append([o])
     out: list[list[Attempt]] = []
     current: list[Attempt] = []
     pending = iter(converged)
     lam0, size = lam_a, target - lam_a
-    for o in outcomes:
-        if o.augmentation > 0 and out and out[-1][-1].converged and not current:
-            out[-1][-1].outcomes.append(o)  # an Uzawa update of the increment that converged just before
-            continue
-        if o.converged:
+    for group in groups:
+        if all(o.converged for o in group):
             s, e = next(pending, (lam0, lam0 + size))
             for k, failed in enumerate(reversed(current)):  # each cutback halved the increment
                 failed.lam0, failed.dlam = s, (e - s) * 2.0 ** (k + 1)
-            current.append(Attempt(s, e - s, len(current) + 1, True, [o]))
+            current.append(Attempt(s, e - s, len(current) + 1, True, group))
             out.append(current)
             current, lam0, size = [], e, e - s
         else:
-            current.append(Attempt(lam0, min(size, target - lam0), len(current) + 1, False, [o]))
+            current.append(Attempt(lam0, min(size, target - lam0), len(current) + 1, False, group))
             size /= 2.0
     if current:
         out.append(current)

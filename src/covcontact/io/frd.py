@@ -167,6 +167,7 @@ class FrdFile(Observer):
         while lines and lines[-1].strip() in ("9999", ""):
             lines.pop()
         self.path.write_text("".join(lines))
+        # (the increments of a deck step resumed in its middle are counted from the resume on)
         self.counter = sum(1 for ln in lines if ln.startswith("    1PSTEP"))
         self.kode = len({ln[7:12] for ln in lines if ln.startswith("  100CL")})
 
