@@ -335,7 +335,7 @@ def test_body_option_checks(tmp_path):
 
 def cantilever_deck(element: str, nx: int = 5, L: float = 10.0) -> str:
     """A cantilever 10 x 1 x 1 of ``nx`` bricks, clamped, bent by a tip load (NLGEOM; tip deflection about 10 %
-    of the length), the tip displacements printed."""
+    of the length), the tip displacements and the stresses at the Gauss points printed."""
     nid = {}
     lines = ["*HEADING", f"cantilever of {element} bricks under a tip load", "*NODE"]
     for i in range(nx + 1):
@@ -352,27 +352,33 @@ def cantilever_deck(element: str, nx: int = 5, L: float = 10.0) -> str:
               "*NSET, NSET=TIP", ", ".join(str(nid[nx, j, k]) for j in range(2) for k in range(2)),
               "*MATERIAL, NAME=STEEL", "*ELASTIC", "1000., 0.3", "*SOLID SECTION, ELSET=BEAM, MATERIAL=STEEL",
               "*BOUNDARY", "FIX, 1, 3", "*STEP, NLGEOM", "*STATIC", "0.25, 1.", "*CLOAD", "TIP, 3, 0.0625",
-              "*NODE PRINT, NSET=TIP", "U", "*END STEP"]
+              "*NODE PRINT, NSET=TIP", "U", "*EL PRINT, ELSET=BEAM", "S", "*END STEP"]
     return "\n".join(lines) + "\n"
 
 
-def last_block(dat: Path) -> dict[int, np.ndarray]:
-    """Node -> (3,) displacement of the last block of a .dat table."""
+def last_block(dat: Path, what: str = "displacements") -> dict:
+    """Node -> (3,) displacement (or (element, point) -> (6,) stress) of the last such block of a .dat table."""
     text = dat.read_text()
-    block_text = text[text.rindex("displacements"):].splitlines()[1:]
+    block_text = text[text.rindex(what):].splitlines()[1:]
     rows = [ln.split() for ln in block_text if ln.strip()]
-    return {int(r[0]): np.array([float(v) for v in r[1:4]]) for r in rows}
+    rows = rows[: next((k for k, r in enumerate(rows) if not r[0].lstrip("-").isdigit()), len(rows))]
+    if what == "displacements":
+        return {int(r[0]): np.array([float(v) for v in r[1:4]]) for r in rows}
+    return {(int(r[0]), int(r[1])): np.array([float(v) for v in r[2:8]]) for r in rows}
 
 
-#: CalculiX 2.20 (ccx -i, this deck with C3D8I): the tip displacements at time 1
+#: CalculiX 2.20 (ccx -i, this deck with C3D8I): the tip displacements at time 1 and the stress (xx, yy, zz, xy, xz,
+#: yz) at the first two Gauss points of element 1
 CCX_C3D8I = {21: (1.653649e-02, 1.794293e-04, 9.728022e-01), 22: (-1.298013e-01, -1.682173e-04, 9.620260e-01),
              23: (1.653649e-02, -1.794293e-04, 9.728022e-01), 24: (-1.298013e-01, 1.682173e-04, 9.620260e-01)}
+CCX_C3D8I_S = {(1, 1): (8.159321, 1.972876, 0.1905352, 0.1206317, 0.3918434, 0.2650428),
+               (1, 2): (7.356977, 0.1946891, -0.4433498, 0.1469368, 0.5066384, -0.2553325)}
 
 
 def test_deck_of_c3d8i_runs_and_agrees_with_calculix(tmp_path):
-    """``covcontact run`` on a deck of C3D8I bricks: the tip displacements within 1e-3 (relative to the largest) of
-    CalculiX's (stored; compared with a fresh ccx run too when ccx is installed). The same deck with C3D8 bends
-    far less (locking), so the element type reached the body."""
+    """``covcontact run`` on a deck of C3D8I bricks: the tip displacements and the stresses at the Gauss points within
+    1e-3 (relative to the largest) of CalculiX's (stored; compared with a fresh ccx run too when ccx is installed).
+    The same deck with C3D8 bends far less (locking), so the element type reached the body."""
     from covcontact.cli import main
 
     deck = tmp_path / "cant.inp"
@@ -380,17 +386,20 @@ def test_deck_of_c3d8i_runs_and_agrees_with_calculix(tmp_path):
     assert main(["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     assert "incompatible_modes = true" in (tmp_path / "out" / "deck" / "cant.toml").read_text()
     ours = last_block(tmp_path / "out" / "cant.dat")
-    refs = [{n: np.array(v) for n, v in CCX_C3D8I.items()}]
+    ours_s = last_block(tmp_path / "out" / "cant.dat", "stresses")
+    assert len(ours_s) == 40
+    refs = [({n: np.array(v) for n, v in CCX_C3D8I.items()}, {k: np.array(v) for k, v in CCX_C3D8I_S.items()})]
     if shutil.which("ccx"):
         ccx_dir = tmp_path / "ccx"
         ccx_dir.mkdir()
         (ccx_dir / "cant.inp").write_text(deck.read_text())
         subprocess.run(["ccx", "-i", "cant"], cwd=ccx_dir, capture_output=True, timeout=120, check=True)
-        refs.append(last_block(ccx_dir / "cant.dat"))
-    for ref in refs:
+        refs.append((last_block(ccx_dir / "cant.dat"), last_block(ccx_dir / "cant.dat", "stresses")))
+    for ref, ref_s in refs:
         scale = max(np.abs(v).max() for v in ref.values())
-        err = max(np.abs(ours[n] - ref[n]).max() for n in ref) / scale
-        assert err <= 1e-3  # measured 4e-7
+        assert max(np.abs(ours[n] - ref[n]).max() for n in ref) <= 1e-3 * scale  # measured 4e-7
+        scale = max(np.abs(v).max() for v in ref_s.values())
+        assert max(np.abs(ours_s[k] - ref_s[k]).max() for k in ref_s) <= 1e-3 * scale  # measured 9e-7
     deck8 = tmp_path / "cant8.inp"
     deck8.write_text(cantilever_deck("C3D8"))
     assert main(["run", str(deck8), "--out", str(tmp_path / "out8"), "--quiet"]) == 0
