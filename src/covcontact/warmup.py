@@ -4,9 +4,10 @@ numba compiles a kernel the first time it is called and keeps the machine code i
 ``__pycache__`` folders of the installed package, or ``NUMBA_CACHE_DIR``). A new installation's first run
 therefore pays the compilation of every kernel it meets (docs/performance.md, "Cold start"). This module
 runs a handful of tiny problems that together call every compiled kernel with the argument types real runs
-use: each element family (hex8, hex27, F-bar hex8, solid-shells hex8 and hex18, elastic and plastic), each
-material, each kind of master surface (deformable facets quad4 and quad9, rigid meshes, analytic plane,
-cylinder and sphere), friction, the output fields. Run once after installing; later runs load the cache.
+use: each element family (hex8, hex27, F-bar hex8, hex8 with incompatible modes, solid-shells hex8 and hex18,
+elastic and plastic), each material, each kind of master surface (deformable facets quad4 and quad9, rigid
+meshes, analytic plane, cylinder and sphere), friction, the output fields. Run once after installing; later runs
+load the cache.
 """
 
 from __future__ import annotations
@@ -210,6 +211,21 @@ value = 0.01
 set = "cap.zmax"
 components = "xyz"
 value = [0.0, 0.0, -0.01]
+"""),
+    ("hex8 with incompatible modes (C3D8I), J2", """
+[[bodies]]
+name = "beam"
+element = "hex8"
+options = { incompatible_modes = true }
+material = { model = "j2", E = 1000.0, nu = 0.3, yield_stress = 2.0, hardening = { law = "linear", modulus = 50.0 } }
+mesh = { generator = "block", lx = 4.0, ly = 1.0, lz = 1.0, nx = 2, ny = 1, nz = 1 }
+[[dirichlet]]
+set = "beam.xmin"
+components = "xyz"
+[[force]]
+set = "beam.xmax"
+value = [0.0, 0.0, -1.0]
+distribution = "total"
 """),
 )
 
