@@ -103,23 +103,35 @@ LAWS = {"arctan": 'law = "arctan"\npenalty = 1.0e4\ntension = 2.0',
         "calculix_exponential": 'law = "exponential"\nform = "calculix"\nclearance = 0.002\npressure = 3.0'}
 
 
-@pytest.mark.parametrize("kind", sorted(LAWS))
+#: the arctan law's tension: the punch pulled off the base by 0.002 (clearances within reach sqrt(area))
+PULL = ('law = "arctan"\npenalty = 1.0e4\ntension = 2.0\nreach = 0.05', 0.002)
+
+
+@pytest.mark.parametrize("kind", sorted(LAWS) + ["pull"])
 def test_exact_tangent_of_each_law(tmp_path, kind):
     """Two deformable blocks pressed together (slave nodes on master facets, edges and vertices): the assembled
     exact tangent against central differences of the residual at 1e-6."""
     path = tmp_path / "p.toml"
-    path.write_text(PUNCH.replace("LAW", LAWS[kind]))
+    text = PUNCH.replace("LAW", LAWS[kind]) if kind != "pull" else \
+        PUNCH.replace("LAW", PULL[0]).replace("value = [0.0, 0.0, -0.004]", "value = [0.0, 0.0, 0.002]")
+    path.write_text(text)
     rep = check_tangent(load_problem(path), step=2, columns=None)
     assert rep["converged"], rep
     assert rep["relative_error"] <= 1e-6, rep["relative_error"]
 
 
-@pytest.mark.parametrize("kind", sorted(LAWS))
+@pytest.mark.parametrize("kind", sorted(LAWS) + ["pull"])
 def test_rigidly_pressed_punch_carries_the_law(tmp_path, kind):
     """A punch moved down rigidly (every node prescribed) onto a base much stiffer than the contact: each slave
     node's overclosure is the punch's travel, so the reaction is sum_i A_i p(d) (A_i the nodes' tributary areas,
     summing to the punch's face)."""
-    text = PUNCH.replace("LAW", LAWS[kind]).replace('set = "punch.zmax"', 'set = "punch.all"')
+    d = 0.004
+    law = _laws()[kind] if kind != "pull" else PressureLaw("arctan", True, slope=K, tension=SIG_INF, reach=0.05)
+    text = PUNCH.replace("LAW", LAWS[kind] if kind != "pull" else PULL[0]).replace('set = "punch.zmax"',
+                                                                                  'set = "punch.all"')
+    if kind == "pull":  # (lifted: every node at a clearance, pulled by the tension)
+        d = -PULL[1]
+        text = text.replace("value = [0.0, 0.0, -0.004]", "value = [0.0, 0.0, 0.002]")
     text = text.replace("E = 1000.0, nu = 0.3 }\nmesh = { generator = \"block\", lx = 2.0",
                         "E = 1.0e16, nu = 0.3 }\nmesh = { generator = \"block\", lx = 2.0")
     path = tmp_path / "p.toml"
@@ -127,9 +139,9 @@ def test_rigidly_pressed_punch_carries_the_law(tmp_path, kind):
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 0
     s = json.loads((out / "summary.json").read_text())
-    d = 0.004
-    law = _laws()[kind]
     for step, frac in zip(s["steps"], (0.5, 1.0)):
         p, _ = law.pressure(np.array([-frac * d]))
-        force = abs(step["contact_force"][2]) if isinstance(step["contact_force"], list) else None
+        force = step["contact_force"][2]  # (on the slave nodes: up where the curve pushes, down where it pulls)
         assert force == pytest.approx(1.0 * p[0], rel=1e-6), (kind, step["contact_force"])
+        if kind == "pull":
+            assert p[0] < 0.0 and step["active_contacts"] == 9

@@ -144,8 +144,7 @@ class PressureLaw:
     """A pressure-overclosure curve p(d) of the overclosure d = -g (docs/theory.md, "Pressure-overclosure laws"):
 
     - ``arctan``: p = K d (1/2 + atan(d / e) / pi), e = pi sigma_inf / K (CalculiX's node-to-face LINEAR law with
-      its tension sigma_inf at large clearance); the kernels carry compression only, so the tension tail
-      (|p| < sigma_inf at clearances up to ``reach`` sqrt(area)) is not transmitted (docs/input.md says so);
+      its tension, tending to sigma_inf at large clearance, up to the clearance ``reach`` sqrt(area));
     - ``table``: piecewise linear through (d_i, p_i), constant outside the table (CalculiX's TABULAR), felt up to
       the clearance ``reach`` sqrt(area) where p > 0;
     - ``calculix_exponential``: p = p0 exp(-ln(100) g / c0) for g < c0 (CalculiX's EXPONENTIAL), faded linearly to
@@ -211,13 +210,14 @@ class PressureLaw:
 
     def traction(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(active, sigma, dsigma/dg) per slave: sigma = -w p(-g) the signed normal force (negative in compression),
-        w the area or 1; active where g is below the law's limit and the force compresses (or, touching or
-        overclosed, is zero: the slope there starts Newton from a touching state)."""
+        w the area or 1; active where g is below the law's limit and the force is not zero (or, touching or
+        overclosed, is zero: the slope there starts Newton from a touching state). A positive sigma pulls
+        (the arctan law's tension at a clearance)."""
         g = np.asarray(g, dtype=float)
         w = area if self.per_area else np.ones_like(g)
         gg = np.where(np.isfinite(g), g, 0.0)
         p, dp = self.pressure(gg)
-        active = np.isfinite(g) & (g < self.limit(area)) & ((p > 0.0) | ((gg <= 0.0) & (p >= 0.0)))
+        active = np.isfinite(g) & (g < self.limit(area)) & ((p != 0.0) | (gg <= 0.0))
         return active, np.where(active, -w * p, 0.0), np.where(active, w * dp, 0.0)
 
     def equivalents(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -220,7 +220,12 @@ class ContactManager:
             active = ok & is_active(res.g, t.multiplier, p.eps, p.band)
             eps_s, lam_s = linear_equivalents(res.g, t.multiplier, p.eps, p.band) if p.band != 0.0 else \
                 (p.eps, t.multiplier)
-        idx = np.flatnonzero(active & (res.kind == FACET))
+        facet_points = active & (res.kind == FACET)
+        if p.law is not None:  # (a curve's tension at a clearance: the kernels' linear law, split in two, below)
+            pull = facet_points & (lam_s + eps_s * np.where(ok, res.g, 0.0) > 0.0)
+            facet_points &= ~pull
+            self._pull(p, xe, res, np.flatnonzero(pull), eps_s, lam_s, case, t, want_K, want_parts, ev)
+        idx = np.flatnonzero(facet_points)
         if idx.size:
             conn = np.hstack([p.surface.faces[res.facet[idx]], p.slaves[idx][:, None]])
             xi = np.ascontiguousarray(res.xi[idx])
@@ -267,6 +272,45 @@ class ContactManager:
             self._add(ev.blocks, conn, R, K if want_K else None, xe)
             if want_parts:
                 ev.parts[0].add(conn, np.zeros_like(R), K)
+
+    def _pull(self, p: Pass, xe, res, idx, eps_s, lam_s, case, t: PassState, want_K, want_parts,
+              ev: ContactEvaluation) -> None:
+        """Facet points where a pressure-overclosure curve pulls (sigma = lam' + eps' g > 0: CalculiX's tension at a
+        clearance). The kernels act only where their linear law pushes, but their residual and every tangent part
+        are linear in (eps', lam') (eps' g_e = lam' + eps' g and each term carries eps' or eps' g_e), so the pull is
+        the sum of two pushing laws with the same g: (2 eps', -2 eps' g - c) and (-eps', lam' + 2 eps' g + c), both
+        with g_e < 0 for c = eps' |g| + |lam'| > 0. Frictionless (a pull carries no friction)."""
+        if not idx.size:
+            return
+        nen = p.surface.nen
+        nd = 3 * (nen + 1)
+        conn = np.hstack([p.surface.faces[res.facet[idx]], p.slaves[idx][:, None]])
+        facet_conn = np.ascontiguousarray(conn[:, :nen])
+        slaves = np.ascontiguousarray(conn[:, nen])
+        xi = np.ascontiguousarray(res.xi[idx])
+        e, lam, g0 = eps_s[idx], lam_s[idx], res.g[idx]
+        c = e * np.abs(g0) + np.abs(lam) + 1e-300
+        R = np.zeros((idx.size, nd))
+        K = np.zeros((idx.size, nd, nd))
+        P = np.zeros((idx.size, 4, nd, nd)) if want_parts else np.zeros((1, 4, 1, 1))
+        g = np.zeros(idx.size)
+        for e_j, l_j in ((2.0 * e, -2.0 * e * g0 - c), (-e, lam + 2.0 * e * g0 + c)):
+            Rj = np.zeros((idx.size, nd))
+            Kj = np.zeros((idx.size, nd, nd))
+            Pj = np.zeros_like(P)
+            contact_batch(xe, facet_conn, slaves, xi, np.ascontiguousarray(e_j), case, want_parts, Rj, Kj, Pj, g,
+                          np.ascontiguousarray(l_j))
+            R += Rj
+            K += Kj
+            P += Pj
+        if want_parts:
+            for j in range(4):
+                ev.parts[j].add(conn, np.zeros_like(R), P[:, j])
+        t.gap[idx] = g
+        t.force[idx] = -R[:, -3:]
+        t.status[idx] = 0
+        t.hist[idx] = 0.0
+        self._add(ev.blocks, conn, R, K if want_K else None, xe)
 
     @staticmethod
     def _face_to_face(own: np.ndarray, res, held: np.ndarray) -> None:
@@ -331,7 +375,7 @@ class ContactManager:
         history) sticks from where the step found it: its projection on its facet in the committed configuration,
         zero traction (so a contact that closes in a step carries friction in that step already)."""
         hist = c.hist[idx].copy()
-        if x_commit is not None and p.kind == "nts":
+        if x_commit is not None:
             for j in np.flatnonzero(hist[:, -1] == 0.0):
                 hist[j] = start_history(x_commit[p.surface.faces[facets[j]]], x_commit[p.slaves[idx[j]]], xi[j],
                                         float(p.eps_t[idx[j]]))

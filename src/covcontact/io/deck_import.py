@@ -532,7 +532,7 @@ class _Writer:
     def _linear(self, entry: dict, it: Interaction, sts: bool, where: str) -> None:
         """PRESSURE-OVERCLOSURE=LINEAR as CalculiX reads it: face-to-face pairs the linear penalty law with slope K
         (per area); node-to-face pairs K d (1/2 + atan(d / e) / pi) with e = pi sigma_inf / K, felt up to the
-        clearance c0 sqrt(area) (law "arctan"). Missing or non-positive K, sigma_inf, c0 take CalculiX's defaults
+        clearance c0 sqrt(area) (law "arctan", its tension at clearances included). Missing or non-positive K, sigma_inf, c0 take CalculiX's defaults
         (50 E, E / 70000, 1e-3; E the deck's first elastic constant), each said in the notes."""
         K, sig, c0 = it.values
         E = self._first_modulus()
@@ -550,9 +550,6 @@ class _Writer:
         entry.update({"law": "arctan", "penalty": K, "tension": sig})
         if c0 > 0.0:
             entry["reach"] = c0
-        self.notes.append(f"{it.where}: *SURFACE BEHAVIOR, LINEAR (node-to-face): the compression branch K d (1/2 + "
-                          f"atan(d / e) / pi) is CalculiX's; its tension tail at clearances below c0 sqrt(area) (at "
-                          f"most sigma_inf = {sig:g} per area) is not transmitted")
 
     def _tied_pair(self, entry: dict, it: Interaction, sts: bool, where: str) -> bool:
         """PRESSURE-OVERCLOSURE=TIED (face-to-face only in CalculiX): the slave faces bonded with the slope K per
