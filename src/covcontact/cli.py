@@ -1,8 +1,9 @@
 """Command line: covcontact run | study | check-tangent | compile | info | import | ccx.
 
 Exit codes: 0 done; 1 a step did not converge even after cutbacks (converged steps are written);
-2 bad input or a checkpoint that cannot be resumed (one line on stderr); 3 anything else (a bug: the
-traceback is printed); 130 / 143 stopped by SIGINT / SIGTERM (files valid, summary status "interrupted").
+2 bad input or a checkpoint that cannot be resumed (one line on stderr); 3 anything else (a bug: one line on
+stderr, the traceback in the run's traceback.txt, summary status "failed"); 130 / 143 stopped by SIGINT / SIGTERM
+(files valid, summary status "interrupted").
 """
 
 from __future__ import annotations
@@ -502,9 +503,32 @@ def main(argv: list[str] | None = None) -> int:
         except OSError:
             pass
         return 141  # 128 + SIGPIPE, as the shell reports a program stopped by a closed pipe
-    except Exception:
-        traceback.print_exc()
+    except Exception as exc:  # a bug: one line, the traceback in a file
+        print(f"covcontact: internal error: {_one_line(exc)}", file=sys.stderr)
         return 3
+
+
+def _one_line(exc: BaseException) -> str:
+    """An unexpected exception in one line: its type and message, where it was raised, and the file that holds its
+    traceback (the run's ``traceback.txt`` beside summary.json, else a temporary file)."""
+    root = exc
+    while isinstance(root, SystemError) and (root.__cause__ or root.__context__) is not None:
+        root = root.__cause__ or root.__context__  # numba wraps an exception of compiled code in a SystemError
+    frames = traceback.extract_tb(exc.__traceback__)
+    where = f" at {Path(frames[-1].filename).name}:{frames[-1].lineno} in {frames[-1].name}" if frames else ""
+    path = getattr(exc, "covcontact_traceback", None)
+    if path is None:
+        try:
+            import tempfile
+
+            with tempfile.NamedTemporaryFile("w", prefix="covcontact-traceback-", suffix=".txt", delete=False) as fh:
+                fh.write("".join(traceback.format_exception(exc)))
+            path = fh.name
+        except OSError:
+            path = None
+    message = " ".join(str(root).split()) or "(no message)"
+    return (f"{type(root).__name__}: {message}{where} (a bug, exit 3"
+            + (f"; traceback in {path})" if path else ")"))
 
 
 def entry() -> None:

@@ -71,10 +71,30 @@ class Summary(Observer):
     def increment_failed(self, run, inc) -> None:
         self._add(inc)
 
-    def ended(self, run, status: str) -> None:
+    def _status(self, run, status: str) -> None:
+        """``status`` and ``converged``; of a failed run also ``reason``, ``last_converged`` (step, stage, load factor,
+        time of the last converged step; step 0: none) and ``failed_step`` (a step that did not converge) or ``error``
+        (an exception: type, message, where, the traceback's file)."""
         s = self.data
         s["status"] = status
         s["converged"] = status == "completed"
+        if status == "failed":
+            failure = getattr(run, "failure", None) or {"reason": "unknown"}
+            s["reason"] = failure["reason"]
+            s["last_converged"] = run.last_converged()
+            for key in ("failed_step", "error"):
+                if key in failure:
+                    s[key] = failure[key]
+
+    def ended_status(self, run, status: str) -> None:
+        """The status alone, written: what a run that an exception ended records when the other observers cannot
+        finish."""
+        self._status(run, status)
+        self._write()
+
+    def ended(self, run, status: str) -> None:
+        s = self.data
+        self._status(run, status)
         lin = run.newton.linear
         if "parallel" in s:
             s["parallel"]["linear"] = {"analyses": lin.n_analyses, "factorizations": lin.n_factorizations,
@@ -164,7 +184,8 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
         cd.update(blk.solid.plastic_fields(est))
         cd["body_id"] = np.full(body.mesh.n_cells, body_id, dtype=float)
         blocks += body_blocks(body.mesh, blk.offset, cd)
-    fields = model.contact.node_fields(state.contact)  # (gap, pressure, status) over the extended nodes
+    per_pass: dict = {}  # (each pass's own fields, for slave surfaces in several pairs)
+    fields = model.contact.node_fields(state.contact, per_pass)  # (gap, pressure, status) over the extended nodes
     if model.contact.passes:  # the slave surfaces with their facets' mean contact pressure
         for faces, pressure in model.contact.facet_fields(state.contact, fields[1]):
             keep = (faces < n).all(axis=1)
@@ -177,7 +198,7 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
         pdata["velocity"] = state.dynamics["v"].reshape(-1, 3)[:n].copy()
         pdata["acceleration"] = state.dynamics["a"].reshape(-1, 3)[:n].copy()
     extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, fields)
-    pdata.update(model.contact.point_data(n, state.contact, fields) if model.contact.passes else {})
+    pdata.update(model.contact.point_data(n, state.contact, fields, per_pass) if model.contact.passes else {})
     if extra_pts is not None and len(extra_pts):
         m = len(extra_pts)
         points = np.vstack([points, extra_pts])

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import sys
 import time
+import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,8 +21,9 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from ..io import checkpoint
+from ..io.checkpoint import CheckpointError
 from ..io.observers import Checkpoints, Convergence, Pictures, Progress, Results, Summary
-from ..io.output import ResultWriter
+from ..io.output import ResultWriter, atomic_write_text
 from .choice import auto_line, distributes, run_solver
 from .model import Model
 from .newton import Newton
@@ -127,6 +129,8 @@ class Run:
         self.total_time = 0.0
         self.stop_status: str | None = None  # set by an observer to end the run after the current step
         self.control_state: dict = {}  # the increment control's state of a resumed stage (from the checkpoint)
+        #: why a failed run failed (summary.json: ``reason``, ``failed_step`` or ``error``; ``last_converged``)
+        self.failure: dict | None = None
         self.partition = model.partition_report()  # collective under mpiexec
         root = model.is_root
         writer = ResultWriter(out) if root else None
@@ -167,6 +171,19 @@ class Run:
 
     # ------------------------------------------------------------------------------------------
     def execute(self, resume: bool) -> Result:
+        """Run (or resume) to the end. Every way out leaves summary.json with the run's status: ``completed``,
+        ``failed`` (a step that did not converge after its cutbacks, or an exception: the exception is raised again
+        once the summary says so) or ``interrupted``; a checkpoint that cannot be resumed leaves the folder as it
+        was."""
+        try:
+            return self._execute(resume)
+        except CheckpointError:
+            raise
+        except Exception as exc:
+            self._crashed(exc)
+            raise
+
+    def _execute(self, resume: bool) -> Result:
         status, code = "completed", 0
         if resume:
             self._resume()
@@ -193,6 +210,7 @@ class Run:
         if self.problem.solver.factorization_precision == "single" and newton.linear.precision_report() is None:
             self.warnings.append(f'factorization_precision = "single" is for PARDISO; the linear solver '
                                  f'{newton.linear.name} factorises in double precision')
+        self._forget_crash()
         self.emit("started")
 
     def _resume(self) -> None:
@@ -208,6 +226,7 @@ class Run:
         self.strategy.check_resumed(model, state, self.out)
         self.u, self.state = u, state
         model.set_stage(state)
+        self._forget_crash()
         self.emit("resumed")
 
     def _stages(self, stops) -> str:
@@ -240,6 +259,10 @@ class Run:
                 inc = self.procedure.advance(self.u, self.state, *nxt)
                 with stops.critical():
                     if not inc.success:
+                        failed = {"step": inc.step, "stage": spec.name, "load_factor": inc.lam}
+                        failed.update({k: inc.entry[k] for k in ("time", "increment") if k in inc.entry})
+                        self.failure = {"reason": f"step {inc.step} (load factor {inc.lam:.4g}) failed after "
+                                                  f"{inc.cutbacks} cutbacks: {inc.why}", "failed_step": failed}
                         self.emit("increment_failed", inc)
                         return "failed"
                     self.state = inc.state
@@ -248,6 +271,50 @@ class Run:
                 if self.stop_status is not None:
                     return self.stop_status
         return "completed"
+
+    def _forget_crash(self) -> None:
+        """The traceback.txt of an earlier run in the folder goes (it would belong to none of this run's files)."""
+        if self.model.is_root:
+            (self.out / "traceback.txt").unlink(missing_ok=True)
+
+    def last_converged(self) -> dict:
+        """The committed state's step (0: none converged yet), its stage, load factor and (dynamic stages) time."""
+        st = self.state
+        out = {"step": int(st.step), "stage": self.model.stages[st.stage].name, "load_factor": float(st.lam)}
+        if st.dynamics and "time" in st.dynamics:
+            out["time"] = float(st.dynamics["time"])
+        return out
+
+    def _crashed(self, exc: BaseException) -> None:
+        """An exception ends the run: summary.json says ``failed`` with the exception and the last converged step,
+        and the traceback goes to ``traceback.txt`` beside it (named on ``exc`` as ``covcontact_traceback``)."""
+        root = exc
+        while isinstance(root, SystemError) and (root.__cause__ or root.__context__) is not None:
+            root = root.__cause__ or root.__context__  # numba wraps an exception of compiled code so
+        frames = traceback.extract_tb(exc.__traceback__)
+        where = ""
+        if frames:
+            f = frames[-1]
+            path = Path(f.filename)
+            parts = path.parts
+            name = "/".join(parts[parts.index("covcontact") + 1:]) if "covcontact" in parts else path.name
+            where = f"{name}:{f.lineno} in {f.name}"
+        message = " ".join(str(root).split())
+        error = {"type": type(root).__name__, "message": message, "where": where}
+        if self.model.is_root:
+            path = self.out / "traceback.txt"
+            try:
+                self.out.mkdir(parents=True, exist_ok=True)
+                atomic_write_text(path, "".join(traceback.format_exception(exc)))
+                error["traceback"] = path.name
+                exc.covcontact_traceback = str(path)
+            except OSError:  # (a folder that cannot take it: the summary is what matters)
+                pass
+        self.failure = {"reason": f"{error['type']}: {message}" + (f" ({where})" if where else ""), "error": error}
+        try:
+            self._end("failed")
+        except Exception:  # noqa: BLE001  (an observer that cannot finish after the error: the summary alone)
+            self.summary.ended_status(self, "failed")
 
     def _end(self, status: str) -> None:
         timing = dict(self.newton.timing)
