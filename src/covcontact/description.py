@@ -71,6 +71,7 @@ class RigidBody:
     mass: float | None = None           # dynamics: the mass of a body with free translations
     inertia: tuple | None = None        # dynamics: principal moments about the reference point (x, y, z axes)
     attach: tuple = ()                  # (body, node set) pairs of deformable nodes that move with the body
+    attach_components: tuple = (0, 1, 2)  # the attached nodes' components that follow it (0..2; the others free)
 
     def reference_point(self) -> np.ndarray:
         if self.reference is not None:

@@ -142,6 +142,7 @@ class System:
         for ref, rb in zip(self.reference, [rb for rb in rigid if rb.free or rb.attach]):
             if rb.attach:
                 ref.attached = np.unique(np.concatenate([self.global_nodes(b, s) for b, s in rb.attach]))
+                ref.attached_components = tuple(rb.attach_components)
         self.n_nodes = offset + 2 * len(self.reference)
         self.n_dofs = 3 * self.n_nodes
         self.X = np.zeros((self.n_nodes, 3))

@@ -119,6 +119,8 @@ class ReferenceBody:
     inertia: np.ndarray = field(default_factory=lambda: np.zeros(3))  # principal moments about X_ref (on B)
     #: global ids of the deformable nodes attached to the body (``covcontact.solvers.constraints.RigidLinks``)
     attached: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    #: the components (0..2) of the attached nodes that follow the body (the others stay free)
+    attached_components: tuple = (0, 1, 2)
 
     def pose(self, x: np.ndarray) -> Pose:
         """The pose at the system positions x (N, 3): A's position is p, B's is theta."""

@@ -24,6 +24,7 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         if any(x.name == rname for x in rigid) or any(x.name == rname for x in bodies):
             r.fail(f"duplicate body name {rname!r}", "name")
         attach = _attach(r, bodies)
+        attach_components = _attach_components(r, attach)
         shape = r.get("shape", "str", "", choices=RIGID_SHAPES) if attach else r.get("shape", "str", choices=RIGID_SHAPES)
         params: dict = {}
         mesh = None
@@ -75,8 +76,22 @@ def read_rigid(top: Section, base: Path, bodies: list) -> list[RigidBody]:
         r.done()
         rigid.append(RigidBody(rname, motion=motion, mesh=mesh, shape=shape, params=params, free=free,
                                force=force, moment=moment, reference=reference, mass=mass, inertia=inertia,
-                               attach=attach))
+                               attach=attach, attach_components=attach_components))
     return rigid
+
+
+def _attach_components(r: Section, attach: tuple) -> tuple:
+    """``attach_components = ["x", "z"]``: the components of the attached nodes that follow the body (default all
+    three; the others stay free: a deck's *KINEMATIC coupling of some dofs)."""
+    if not r.has("attach_components"):
+        return (0, 1, 2)
+    given = names(r, "attach_components")
+    if not attach:
+        r.fail("is for a body with attach (the attached nodes' components that follow it)", "attach_components")
+    if not given or any(n not in ("x", "y", "z") for n in given) or len(set(given)) != len(given):
+        r.fail(f"must name some of x, y, z, each once (the attached nodes' components that follow the body), got "
+               f"{list(given)}", "attach_components")
+    return tuple(sorted("xyz".index(n) for n in given))
 
 
 def _attach(r: Section, bodies: list) -> tuple:
@@ -136,11 +151,14 @@ def _read_profile(r: Section) -> dict:
 
 
 def check_attached(top: Section, rigid: list, bodies: list, dirichlet: list, equations: list) -> None:
-    """Attached nodes follow their rigid body alone: not prescribed by a Dirichlet condition, not the dependent dof
-    of an equation, not attached to two bodies (one line naming both)."""
+    """Attached nodes follow their rigid body alone (in the components it holds, ``attach_components``): not
+    prescribed there by a Dirichlet condition, not the dependent dof of an equation there, not attached to two bodies
+    (one line naming both)."""
     meshes = {b.name: b.mesh for b in bodies}
     owner: dict = {}
+    held: dict = {}
     for i, r in enumerate(rigid):
+        held[r.name] = set(r.attach_components)
         for bname, sname in r.attach:
             for node in meshes[bname].node_sets[sname]:
                 prev = owner.setdefault((bname, int(node)), r.name)
@@ -150,16 +168,17 @@ def check_attached(top: Section, rigid: list, bodies: list, dirichlet: list, equ
     if not owner:
         return
     for i, bc in enumerate(dirichlet):
-        hit = [int(n) for n in meshes[bc.body].node_sets[bc.set] if (bc.body, int(n)) in owner]
+        hit = [int(n) for n in meshes[bc.body].node_sets[bc.set] if (bc.body, int(n)) in owner
+               and held[owner[(bc.body, int(n))]] & set(bc.components)]
         if hit:
             top.fail(f"set {bc.body}.{bc.set} holds node {hit[0]} attached to rigid body "
                      f"{owner[(bc.body, hit[0])]!r}: an attached node follows its body; prescribe the rigid body's "
                      f"motion instead", f"dirichlet[{i}].set")
     for i, eq in enumerate(equations):
-        bname, sname = eq.terms[0][0], eq.terms[0][1]
+        bname, sname, comp = eq.terms[0][0], eq.terms[0][1], eq.terms[0][2]
         if bname not in meshes:
             continue
         node = int(meshes[bname].node_sets[sname][0])
-        if (bname, node) in owner:
+        if (bname, node) in owner and comp in held[owner[(bname, node)]]:
             top.fail(f"its first (dependent) term is node {node} of body {bname!r}, attached to rigid body "
                      f"{owner[(bname, node)]!r}; put another term first", f"equation[{i}]")

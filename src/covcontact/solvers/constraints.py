@@ -82,6 +82,11 @@ class RigidLinks:
     the tangent P^T K P plus the part from the rotation's second derivative on B,
     sum T^T [f_i]_x [R Y_i]_x T + d(T^T m)/d theta with m = sum R Y_i x f_i. The attached dofs drop out (the solver
     treats them as constrained) and are set from (t, theta) before every evaluation (``complete``).
+
+    A body may hold only some components of its attached nodes (``attached_components``, a deck's *KINEMATIC with
+    some of the dofs 1-3): only those are eliminated (nonlinear equations u_ik = [t + (R(theta) - I) Y_i]_k, as
+    CalculiX's kinematic coupling writes them); the others stay unknowns of their own. P has rows at the eliminated
+    dofs alone, and the second-order part takes the forces there alone (it is linear in the f_i).
     """
 
     #: the second-order part on theta is not symmetric
@@ -90,14 +95,15 @@ class RigidLinks:
     def __init__(self, system):
         n = system.n_dofs
         self.n = n
-        self.links = []  # (reference body, attached global nodes, Y)
+        self.links = []  # (reference body, attached global nodes, Y, the components that follow the body)
         self.mask = np.zeros(n, dtype=bool)
         for ref in system.reference:
             nodes = np.asarray(getattr(ref, "attached", ()), dtype=np.int64)
             if nodes.size == 0:
                 continue
-            self.links.append((ref, nodes, system.X[nodes] - ref.origin))
-            self.mask[(3 * nodes[:, None] + np.arange(3)).ravel()] = True
+            comps = np.asarray(getattr(ref, "attached_components", (0, 1, 2)), dtype=np.int64)
+            self.links.append((ref, nodes, system.X[nodes] - ref.origin, comps))
+            self.mask[(3 * nodes[:, None] + comps).ravel()] = True
         self.dependent = np.flatnonzero(self.mask)
         keep = np.flatnonzero(~self.mask)
         self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
@@ -108,9 +114,9 @@ class RigidLinks:
         """Set the attached nodes' displacements (in place) from their bodies' (t, theta)."""
         from ..motion import rotation_matrix
 
-        for k, (ref, nodes, Y) in enumerate(self.links):
+        for k, (ref, nodes, Y, comps) in enumerate(self.links):
             t, theta = u[3 * ref.A: 3 * ref.A + 3], u[3 * ref.B: 3 * ref.B + 3].copy()
-            u.reshape(-1, 3)[nodes] = t + Y @ rotation_matrix(theta).T - Y
+            u.reshape(-1, 3)[nodes[:, None], comps] = (t + Y @ rotation_matrix(theta).T - Y)[:, comps]
             self._theta[k] = theta
 
     def _map(self):
@@ -119,16 +125,16 @@ class RigidLinks:
         from ..motion import rotation_matrix
 
         rows, cols, vals, parts = [], [], [], []
-        for (ref, nodes, Y), theta in zip(self.links, self._theta):
+        for (ref, nodes, Y, comps), theta in zip(self.links, self._theta):
             T = tangent_map(theta)
             ry = Y @ rotation_matrix(theta).T
-            B = -skew(ry) @ T                                      # (m, 3, 3)
-            r0 = 3 * nodes[:, None] + np.arange(3)                 # (m, 3)
+            B = (-skew(ry) @ T)[:, comps, :]                       # (m, c, 3): the eliminated rows
+            r0 = 3 * nodes[:, None] + comps                        # (m, c)
             rows += [r0.ravel(), np.repeat(r0.ravel(), 3)]
-            cols += [np.tile(3 * ref.A + np.arange(3), len(nodes)),
-                     np.tile(3 * ref.B + np.arange(3), 3 * len(nodes))]
+            cols += [np.tile(3 * ref.A + comps, len(nodes)),
+                     np.tile(3 * ref.B + np.arange(3), r0.size)]
             vals += [np.ones(r0.size), B.ravel()]
-            parts.append((ref, nodes, ry, T, theta))
+            parts.append((ref, nodes, ry, T, theta, comps))
         P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                           shape=(self.n, self.n)) + self._keep
         return P.tocsr(), parts
@@ -154,8 +160,9 @@ class RigidLinks:
             return Rn, None
         K = Pt @ K @ P + self.unit
         G_rows, G_cols, G_vals = [], [], []
-        for ref, nodes, ry, T, theta in parts:
-            f = R.reshape(-1, 3)[nodes]
+        for ref, nodes, ry, T, theta, comps in parts:
+            f = np.zeros((len(nodes), 3))
+            f[:, comps] = R.reshape(-1, 3)[nodes][:, comps]   # (the forces at the eliminated components)
             G = T.T @ np.einsum("mij,mjk->ik", skew(f), skew(ry)) @ T
             G += np.einsum("i,ijk->jk", np.cross(ry, f).sum(axis=0), tangent_map_derivatives(theta))
             b = 3 * ref.B + np.arange(3)

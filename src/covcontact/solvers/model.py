@@ -288,7 +288,9 @@ class Model:
             R = self.evaluate(u.copy(), lam, state, want_K=False, raw=True)[0].reshape(-1, 3)
             for ref in self.system.reference:
                 if ref.attached.size:
-                    f = R[ref.attached]
+                    f = np.zeros((ref.attached.size, 3))
+                    comps = list(ref.attached_components)  # (the components the body holds)
+                    f[:, comps] = R[ref.attached][:, comps]
                     ry = x[ref.attached] - x[ref.A]
                     out[ref.name]["attached_force"] = (-f.sum(axis=0)).tolist()
                     out[ref.name]["attached_moment"] = (-np.cross(ry, f).sum(axis=0)).tolist()
