@@ -524,8 +524,9 @@ class ContactManager:
     def step_report(self, x: np.ndarray, lam: float, state: ContactState) -> dict:
         return report.step_report(self, x, lam, state)
 
-    def point_data(self, n_nodes: int, state: ContactState, fields: tuple | None = None) -> dict:
-        return report.point_data(self, n_nodes, state, fields)
+    def point_data(self, n_nodes: int, state: ContactState, fields: tuple | None = None,
+                   per_pass: dict | None = None) -> dict:
+        return report.point_data(self, n_nodes, state, fields, per_pass)
 
     def facet_fields(self, state: ContactState, nodal_pressure: np.ndarray | None = None) -> list:
         """(slave faces, mean contact pressure per facet) of every pass with a slave face set; ``nodal_pressure``
@@ -534,10 +535,10 @@ class ContactManager:
             nodal_pressure = self.node_fields(state)[1]
         return report.facet_pressure(self, state, nodal_pressure)
 
-    def node_fields(self, state: ContactState):
+    def node_fields(self, state: ContactState, per_pass: dict | None = None):
         """(gap, pressure, status) over the extended node numbering (deformable nodes, then the nodes of rigid
-        meshes), for the result files."""
-        return report.node_fields(self, self.num.n_ext, state)
+        meshes), for the result files; ``per_pass`` receives each pass's own."""
+        return report.node_fields(self, self.num.n_ext, state, per_pass)
 
 
 __all__ = ["CASE_A", "ContactEvaluation", "ContactManager"]

@@ -65,31 +65,42 @@ def step_report(manager, x: np.ndarray, lam: float, state: ContactState) -> dict
             "contribution_percent": contrib, "pairs": pairs}
 
 
-def node_fields(manager, n: int, state: ContactState) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def node_fields(manager, n: int, state: ContactState, per_pass: dict | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gap, contact pressure (force over tributary area) and status (-1 not a slave, 0 inactive, 1 active)
     of nodes 0..n-1 of the extended numbering, from the slaves of all ranks. Segment-to-surface points give the
     nodes of their facets the lumped L2 projection of their values (:meth:`.points.VirtualPoints.smooth`); a node
-    is active where an active point's pressure reaches it."""
+    is active where an active point's pressure reaches it. A node that is a slave of several passes (a surface in
+    several pairs) gets the smallest gap, the sum of the pressures and the highest status; ``per_pass`` (a dict)
+    receives each pass's own (gap, pressure, status) by pass name."""
     gap = np.full(n, np.nan)
     pressure = np.zeros(n)
     status = np.full(n, -1.0)
     every = manager.gather(_point_rows(manager, state))
     for k, p in enumerate(manager.passes):
         sl, g, act, fn, area = (np.concatenate([e[k][j] for e in every]) for j in range(5))
+        pg = np.full(n, np.nan)
+        pp = np.zeros(n)
+        ps = np.full(n, -1.0)
         if p.kind == "sts":
             pts = manager.points
             fin = np.isfinite(g)
-            pg, touched = pts.smooth(sl, area * fin, np.where(fin, g, 0.0), n)
-            pp, has = pts.smooth(sl, area, np.where(act, fn, 0.0), n)
+            sg, touched = pts.smooth(sl, area * fin, np.where(fin, g, 0.0), n)
+            sp, has = pts.smooth(sl, area, np.where(act, fn, 0.0), n)
             on, _ = pts.smooth(sl, area, act.astype(float), n)
-            gap[touched] = pg[touched]
-            pressure[has] = pp[has]
-            status[has] = np.where(on[has] > 0.0, 1.0, 0.0)
-            continue
-        sel = sl < n
-        gap[sl[sel]] = np.where(np.isfinite(g[sel]), g[sel], np.nan)
-        status[sl[sel]] = np.where(act[sel], 1.0, 0.0)
-        pressure[sl[sel]] = np.where(act[sel], fn[sel], 0.0)
+            pg[touched] = sg[touched]
+            pp[has] = sp[has]
+            ps[has] = np.where(on[has] > 0.0, 1.0, 0.0)
+        else:
+            sel = sl < n
+            pg[sl[sel]] = np.where(np.isfinite(g[sel]), g[sel], np.nan)
+            ps[sl[sel]] = np.where(act[sel], 1.0, 0.0)
+            pp[sl[sel]] = np.where(act[sel], fn[sel], 0.0)
+        gap = np.fmin(gap, pg)
+        pressure += pp
+        status = np.maximum(status, ps)
+        if per_pass is not None:
+            per_pass[p.name] = (pg, pp, ps)
     return gap, pressure, status
 
 
@@ -125,11 +136,25 @@ def facet_pressure(manager, state: ContactState, nodal: np.ndarray) -> list[tupl
     return out
 
 
-def point_data(manager, n_nodes: int, state: ContactState, fields: tuple | None = None) -> dict:
+def point_data(manager, n_nodes: int, state: ContactState, fields: tuple | None = None,
+               per_pass: dict | None = None) -> dict:
     """Gap, contact pressure and status per deformable node (from :func:`node_fields` over the extended nodes,
-    ``fields``, when the caller has them)."""
-    gap, pressure, status = node_fields(manager, manager.num.n_ext, state) if fields is None else fields
-    return {"gap": gap[:n_nodes], "contact_pressure": pressure[:n_nodes], "contact_status": status[:n_nodes]}
+    ``fields`` and its ``per_pass``, when the caller has them). Where a node is a slave of several passes (a slave
+    surface in several pairs), each pass's own fields too: ``gap[NAME]``, ``contact_pressure[NAME]``,
+    ``contact_status[NAME]``."""
+    if fields is None or per_pass is None:
+        per_pass = {}
+        fields = node_fields(manager, manager.num.n_ext, state, per_pass)
+    gap, pressure, status = fields
+    out = {"gap": gap[:n_nodes], "contact_pressure": pressure[:n_nodes], "contact_status": status[:n_nodes]}
+    if len(per_pass) > 1:
+        slave_of = sum((ps[:n_nodes] >= 0).astype(int) for _, _, ps in per_pass.values())
+        if np.any(slave_of > 1):
+            for name, (pg, pp, ps) in per_pass.items():
+                out[f"gap[{name}]"] = pg[:n_nodes]
+                out[f"contact_pressure[{name}]"] = pp[:n_nodes]
+                out[f"contact_status[{name}]"] = ps[:n_nodes]
+    return out
 
 
 #: a slave node deeper inside its master than this fraction of the node spacing at the start is warned about
