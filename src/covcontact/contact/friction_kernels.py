@@ -362,7 +362,8 @@ def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_
         return g, SLIP
     if hist[H_FLAG] == 0.0:
         return g, NEW
-    # old traction convected with the master: t' = T_k a^kl rho_l at xi_n (current configuration)
+    # old traction convected with the master: t' = T_k a^kl rho_l at xi_n (current configuration); a degenerate frame
+    # there (a fold of the facet's continuation: transfer_history keeps xi_n off them) leaves the element new
     if facet_geometry(xyz, hist[H_XI], hist[H_XI + 1], No[:nen], dNo[:nen], ddNo[:nen], rhoo, rho1o,
                       ao, aoi, nrmo, ho) == 0.0:
         return g, NEW
