@@ -120,3 +120,25 @@ def test_laws_kept_or_refused(tmp_path):
     c = load_problem(imp.problem).contacts[0]
     assert (c.law, c.penalty) == ("arctan", 50.0 * 1000.0)  # CalculiX's defaults: 50 E, E / 70000
     assert len(imp.notes) == 2 and all("CalculiX's default" in n for n in imp.notes)
+
+
+def test_pairs_on_elements_not_read_are_listed_not_crashed(tmp_path):
+    """A slave node surface of shell (S4) nodes and a master SPOS face of a shell: the pairs cannot be built, so
+    they are listed with their lines (before: an IndexError); with --ignore-unsupported the rest runs."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    text = text.replace("*NODE, NSET=NALL\n", "*NODE, NSET=NALL\n9101, 0.,0.,3.\n9102, 1.,0.,3.\n9103, 1.,1.,3.\n"
+                        "9104, 0.,1.,3.\n")
+    text = text.replace("*ELEMENT, TYPE=C3D8, ELSET=BASE", "*ELEMENT, TYPE=S4, ELSET=PLATE\n9001, 9101, 9102, 9103, "
+                        "9104\n*ELEMENT, TYPE=C3D8, ELSET=BASE")
+    deck = tmp_path / "s4.inp"
+    deck.write_text(text.replace("*NSET, NSET=NSLAVE\n", "*NSET, NSET=NSLAVE\n9101, 9102, 9103, 9104\n*NSET, NSET=X\n"))
+    lines = import_deck(deck, tmp_path / "a" / "p.toml").unsupported
+    assert any("TYPE=S4 is not supported" in ln for ln in lines)
+    assert any("SSLAV's nodes belong to elements covcontact does not read" in ln for ln in lines)
+    deck.write_text(text.replace("BASETOP, S2", "9001, SPOS"))
+    lines = import_deck(deck, tmp_path / "b" / "p.toml").unsupported
+    assert any("SPOS, a shell face" in ln for ln in lines) and any("the surface SMAST has no faces" in ln for ln in lines)
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
+                           "--ignore-unsupported", "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["status"] == "completed"

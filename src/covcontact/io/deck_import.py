@@ -95,6 +95,11 @@ class _Writer:
             idx = self.b.el_index[els[(els >= 0) & (els < self.b.el_index.size)]]
             if idx.size < els.size or np.any(idx < 0):
                 bad = [int(e) for e in els if e < 0 or e >= self.b.el_index.size or self.b.el_index[e] < 0]
+                skipped = [e for e in bad if e in m.skipped_elements]
+                if skipped:  # (a surface on elements not read: the surface cannot be built; listed)
+                    self.unsupported.append(f"{where}: {letter}{face} on element {skipped[0]}, a "
+                                            f"{m.skipped_elements[skipped[0]]} (not read)")
+                    continue
                 raise DeckError(f"{where}: element {bad[0]} is not defined")
             for cell in set(cell_of[idx]):
                 if not 1 <= face <= NFACES[cell]:
@@ -477,11 +482,19 @@ class _Writer:
             mk, mrefs = self.m.surfaces[master]
             if mk != "ELEMENT":
                 raise DeckError(f"{where}: the master surface {master} must be an element surface (faces)")
+            if self._on_skipped([master, slave], where):
+                continue
             mb = self._surface_body(master, mrefs, where)
             sk, sref = self.m.surfaces[slave]
             sts = kind in ("SURFACE TO SURFACE", "TIE") and sk == "ELEMENT"
             if sk == "NODE":
                 targets = self._node_targets(slave, sref, where)
+                if not targets:  # (nodes of elements not read, e.g. shells: the pair cannot be built)
+                    what = "elements covcontact does not read" if set(sref.tolist()) & self.m.skipped_nodes else \
+                        "no element"
+                    self.unsupported.append(f"{where}: the slave surface {slave}'s nodes belong to {what}; with "
+                                            f"--ignore-unsupported the pair is left out")
+                    continue
                 if len(targets) > 1:
                     raise DeckError(f"{where}: the slave surface {slave} lies on several parts of the mesh")
                 sb = targets[0][0]
@@ -524,6 +537,23 @@ class _Writer:
                     entry["tangential_penalty"] = it.friction[1]
             text += _table("[[contact]]", entry)
         return text
+
+    def _on_skipped(self, names: list[str], where: str) -> bool:
+        """Whether one of the element surfaces ``names`` is empty or lies on elements not read (shells, beams): then
+        the pair is listed as unsupported (left out with --ignore-unsupported)."""
+        for name in names:
+            kind, refs = self.m.surfaces[name]
+            if kind != "ELEMENT":
+                continue
+            els = np.concatenate([e for e, _, _ in refs]) if refs else np.zeros(0, np.int64)
+            gone = [int(e) for e in els if int(e) in self.m.skipped_elements]
+            if gone or not els.size:
+                what = f"element {gone[0]}, a {self.m.skipped_elements[gone[0]]} (not read)" if gone else \
+                    "no faces covcontact reads"
+                self.unsupported.append(f"{where}: the surface {name} has {what}; with --ignore-unsupported the pair "
+                                        f"is left out")
+                return True
+        return False
 
     def _first_modulus(self) -> float:
         """The first elastic constant of the first material in the deck (CalculiX's reference for its defaults)."""

@@ -117,6 +117,9 @@ class DeckModel:
     rigid_bodies: list[tuple[np.ndarray, int | None, int | None, str]] = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
+    #: elements of types covcontact does not read (listed as unsupported): label -> type; and their nodes
+    skipped_elements: dict[int, str] = field(default_factory=dict)
+    skipped_nodes: set[int] = field(default_factory=set)
     #: *TIME POINTS: name -> (times, on the total time?)
     time_points: dict[str, tuple[np.ndarray, bool]] = field(default_factory=dict)
     #: what the deck leaves to defaults, or reads in a way worth saying (listed before solving, not refused)
@@ -452,6 +455,15 @@ class _Reader(LoadCards):
         if etype not in ELEMENTS:
             self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported (covcontact reads "
                                       f"{', '.join(ELEMENTS)})")
+            cont = False
+            for line in c.data:  # (their labels and nodes: a surface or set on them is named as such later)
+                fields = [f.strip() for f in line.split(",") if f.strip()]
+                if not cont and fields and fields[0].isdigit():
+                    self.m.skipped_elements[int(fields[0])] = etype
+                    self.m.skipped_nodes.update(int(f) for f in fields[1:] if f.isdigit())
+                elif cont:
+                    self.m.skipped_nodes.update(int(f) for f in fields if f.isdigit())
+                cont = line.rstrip().endswith(",")
             return
         cell = ELEMENTS[etype][0]
         a = numbers(c, 1 + NNODE[cell], f"a {etype} element (label and {NNODE[cell]} nodes)", integer=True)
@@ -512,6 +524,10 @@ class _Reader(LoadCards):
             return
         refs = []
         for k, row in enumerate(c.rows()):
+            if len(row) >= 2 and row[1].upper() in ("SPOS", "SNEG"):  # (a shell's sides: shells are not read)
+                self.m.unsupported.append(f"{c.where(k)}: *SURFACE {name}: {row[1].upper()}, a shell face (shell "
+                                          f"elements are not read)")
+                continue
             if len(row) < 2 or not row[1].upper().startswith("S") or not row[1][1:].isdigit():
                 raise c.fail("an element surface line is 'element set or label, S1..S6'", k)
             ref = row[0].upper()
