@@ -17,7 +17,7 @@ from .element import CASES
 from .facets import patch_count, quad_patches
 from .points import VirtualPoints, gauss_points
 from .selfcontact import excluded_facets
-from .surface import MeshSurface, facet_sizes, tributary_area
+from .surface import MeshSurface, facet_sizes, slave_area
 from .tied import tie
 from .laws import PressureLaw
 from .tool_profile import Profile
@@ -156,11 +156,12 @@ def _auto_penalty(num: Numbering, pair, slave, master) -> float:
 
 def _slaves(num: Numbering, pair, faces: np.ndarray | None, nodes: np.ndarray | None, X) -> tuple:
     """(slave ids, area per slave, each point's facet or None) of slave ``faces`` (extended ids, None for a node set)
-    and ``nodes``: the nodes with their tributary areas (nts), or the faces' Gauss points with their weights (sts)."""
+    and ``nodes``: the nodes with their tributary areas (nts; ``slave_area``, positive on tri6 and quad8 faces too),
+    or the faces' Gauss points with their weights (sts)."""
     if pair.type == "sts":
         conn, N, weight, facet = gauss_points(X, faces, pair.order)
         return num.points.add(conn, N), weight, facet
-    area = tributary_area(X, faces)[nodes] if faces is not None else np.ones(len(nodes))
+    area = slave_area(X, faces)[nodes] if faces is not None else np.ones(len(nodes))
     return nodes, area, None
 
 
@@ -193,6 +194,9 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
     if pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
         if slave_faces is None:
             raise ValueError(f"contact {pair.name}: area weighting needs a face set named {slave[1]!r}")
+        if pair.type == "nts" and np.any(area <= 0.0):  # tri6 corner nodes (slave_area): no contact, as in CalculiX
+            keep = area > 0.0
+            slaves, area = slaves[keep], area[keep]
         eps = penalty * area
     else:
         eps = np.full(len(slaves), float(penalty))

@@ -162,6 +162,42 @@ def tributary_area(x_nodes: np.ndarray, faces: np.ndarray, n_gauss: int | None =
     return np.bincount(faces.ravel(), contrib.ravel(), minlength=x.shape[0])
 
 
+#: the share of a tri6 and a quad8 face's area that each of its nodes takes as a node-to-surface slave (CalculiX's
+#: spring areas of node-to-face penalty contact): tri6 corners 0 and mid-nodes 1/3, the nodal forces of a uniform
+#: pressure (so a uniform pressure crosses the contact uniformly); quad8 corners 1/100 and mid-nodes 24/100, where
+#: those nodal forces (-1/12, 1/3) would pull at the corners
+SLAVE_AREA_SHARES = {6: np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0]) / 3.0,
+                     8: np.array([1.0, 1.0, 1.0, 1.0, 24.0, 24.0, 24.0, 24.0]) / 100.0}
+
+
+def slave_area(x_nodes: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Per-node area of the slave nodes of a surface (node-to-surface contact: the penalty per area and the contact
+    pressure of a node take it); non-negative, summing to the surface's area.
+
+    Faces of linear cells and quad9 faces: the integral of N_a over the faces around node a (``tributary_area``).
+    tri6 and quad8 faces, whose corner shape functions integrate to zero (tri6) or to -1/12 of the face (quad8), so
+    that a corner node would take no or a pulling force: each face's area (its own rule) shared out in the fixed
+    proportions ``SLAVE_AREA_SHARES`` (CalculiX's): a tri6 corner node takes none (it carries no contact force, as in
+    CalculiX; an area-weighted pass leaves such nodes out).
+
+    Args:
+        x_nodes: (n, 3) positions. faces: (nf, nen) node ids of one face type.
+
+    Returns:
+        (n,) areas (zero off the faces).
+    """
+    faces = np.asarray(faces, dtype=np.int64)
+    nen = faces.shape[1]
+    if nen not in SLAVE_AREA_SHARES:
+        return tributary_area(x_nodes, faces)
+    x = np.asarray(x_nodes, dtype=np.float64)
+    _, dN, w = any_face(nen)
+    t = np.einsum("pad,fai->fpdi", dN, x[faces])
+    area = np.linalg.norm(np.cross(t[:, :, 0, :], t[:, :, 1, :]), axis=2) @ w  # (nf,)
+    contrib = area[:, None] * SLAVE_AREA_SHARES[nen][None, :]
+    return np.bincount(faces.ravel(), contrib.ravel(), minlength=x.shape[0])
+
+
 # Lagrange (p(-1), p(0), p(1)) -> Bernstein control values of a 1D quadratic
 _L2B = np.array([[1.0, 0.0, 0.0], [-0.5, 2.0, -0.5], [0.0, 0.0, 1.0]])
 # quad9 node -> (i, j) position in a 3 x 3 grid ordered -1, 0, 1 per direction

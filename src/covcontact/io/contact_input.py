@@ -184,11 +184,6 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                 what = 'weighting = "area"' if weighting == "area" else 'penalty = "auto"'
                 c.fail(f"{what} needs the slave's faces, but {slave[0]}.{slave[1]} is a node set only: give a "
                        f'face set of {slave[0]!r} ({faces}) or weighting = "nodal"', "slave")
-            if owner is not None and ctype == "nts" and owner.face_sets[slave[1]].shape[1] in (6, 8):
-                kind = "tri6" if owner.face_sets[slave[1]].shape[1] == 6 else "quad8"
-                c.fail(f"area weighting on {kind} faces gives their corner nodes a zero (tri6) or negative (quad8) "
-                       f"tributary area, so no or a pulling contact force: use weighting = \"nodal\" with a penalty "
-                       f"per node (segment-to-surface on these faces is not there yet)", "slave")
         tangent = c.get("tangent", "str", "a", choices=TANGENT_CASES)
         two_pass = c.get("two_pass", "bool", False)
         mu = c.get("friction", "float", 0.0, nonnegative=True)
