@@ -45,7 +45,8 @@ def test_a_step_that_does_not_converge_is_recorded(tmp_path, capsys):
     assert s["status"] == "failed" and s["converged"] is False
     assert s["last_converged"] == {"step": 1, "stage": "stage1", "load_factor": 0.02}
     assert s["failed_step"] == {"step": 2, "stage": "stage1", "load_factor": 1.0}
-    assert s["reason"].startswith("step 2 (load factor 1) failed after") and "no convergence in 4 iterations" in s["reason"]
+    assert s["reason"].startswith("step 2 (load factor 1) failed after")
+    assert "no convergence in 4 iterations" in s["reason"]
     assert "error" not in s
     assert [st["converged"] for st in s["steps"]] == [True, False]
     assert "failed after" in err

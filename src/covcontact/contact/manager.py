@@ -385,7 +385,8 @@ class ContactManager:
                 hist[j] = 0.0
                 continue
             try:  # (the slave's tangential penalty: an old point far off the new facet is anchored on it)
-                hist[j] = transfer_history(hist[j], x_commit[p.surface.faces[facets[j]]], xi[j], float(p.eps_t[idx[j]]))
+                hist[j] = transfer_history(hist[j], x_commit[p.surface.faces[facets[j]]], xi[j],
+                                           float(p.eps_t[idx[j]]))
             except ValueError:
                 hist[j] = 0.0
         return hist
