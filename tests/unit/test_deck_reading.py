@@ -142,3 +142,21 @@ def test_pairs_on_elements_not_read_are_listed_not_crashed(tmp_path):
                            "--ignore-unsupported", "--quiet"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     assert json.loads((tmp_path / "o" / "summary.json").read_text())["status"] == "completed"
+
+
+def test_controls_raise_the_iteration_limits(tmp_path):
+    """*CONTROLS, PARAMETERS=TIME INCREMENTATION: I_C (4th value) and I_A (8th) above covcontact's limits become
+    [solver] max_iterations and max_cutbacks; below them covcontact's are kept (said); FIELD is a note."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    deck = tmp_path / "c.inp"
+    deck.write_text(text.replace("*STATIC\n", "*CONTROLS, PARAMETERS=TIME INCREMENTATION\n4, 8, 9, 60, 10, 4, 0, "
+                                 "12, 5, 3\n*CONTROLS, PARAMETERS=FIELD\n0.01\n*STATIC\n"))
+    imp = import_deck(deck, tmp_path / "a" / "p.toml")
+    s = load_problem(imp.problem).solver
+    assert (s.max_iterations, s.max_cutbacks) == (60, 12)
+    assert any("PARAMETERS=FIELD" in n for n in imp.notes)
+    deck.write_text(text.replace("*STATIC\n", "*CONTROLS, PARAMETERS=TIME INCREMENTATION\n4, 8, 9, 16, 10, 4, 0, "
+                                 "5\n*STATIC\n"))
+    imp = import_deck(deck, tmp_path / "b" / "p.toml")
+    s = load_problem(imp.problem).solver
+    assert (s.max_iterations, s.max_cutbacks) == (25, 6) and sum("is below covcontact's" in n for n in imp.notes) == 2

@@ -438,7 +438,7 @@ _TRANSFER_AREA = 0.05
 
 
 def _facet_frame(xyz, xi):
-    """(rho, rho_cov, n) of facet ``xyz`` at ``xi``; ValueError where the facet is degenerate there."""
+    """(rho, rho_cov, n, area element) of facet ``xyz`` at ``xi``; ValueError where the facet is degenerate there."""
     nen = xyz.shape[0]
     rho, rc, n = np.zeros(3), np.zeros((2, 3)), np.zeros(3)
     area = facet_geometry(xyz, xi[0], xi[1], np.empty(nen), np.empty((nen, 2)), np.empty((nen, 2, 2)), rho, rc,

@@ -555,6 +555,20 @@ class _Writer:
                 return True
         return False
 
+    def _solver(self) -> str:
+        """[solver] from *CONTROLS, TIME INCREMENTATION: CalculiX's I_C and I_A where they exceed covcontact's own
+        limits (25 iterations, 6 cutbacks: a deck that allows more gets more; fewer is not imposed, since covcontact's
+        iterations are not CalculiX's)."""
+        from ..description import SolverOptions
+
+        d = SolverOptions()
+        entries = {k: v for k, v in self.m.controls.items() if v > getattr(d, k)}
+        for k, v in self.m.controls.items():
+            if v <= getattr(d, k):
+                self.notes.append(f"{self.deck}: *CONTROLS, TIME INCREMENTATION: {k} {v} is below covcontact's "
+                                  f"{getattr(d, k)}, which is kept")
+        return _table("[solver]", entries) if entries else ""
+
     def _first_modulus(self) -> float:
         """The first elastic constant of the first material in the deck (CalculiX's reference for its defaults)."""
         return next((mat["E"] for mat in self.m.materials.values() if "E" in mat), 0.0)
@@ -653,7 +667,7 @@ class _Writer:
         self.unsupported += self.rigid.unsupported
         first = self.m.steps[0]
         head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(
-            first, self.stage_steps[0][1], self.stage_jump[0]) if first.dynamic else {})})
+            first, self.stage_steps[0][1], self.stage_jump[0]) if first.dynamic else {})}) + self._solver()
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + rigid
                             + contacts + conds + stages)

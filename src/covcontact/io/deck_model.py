@@ -120,6 +120,8 @@ class DeckModel:
     #: elements of types covcontact does not read (listed as unsupported): label -> type; and their nodes
     skipped_elements: dict[int, str] = field(default_factory=dict)
     skipped_nodes: set[int] = field(default_factory=set)
+    #: *CONTROLS, TIME INCREMENTATION: "max_iterations" (I_C), "max_cutbacks" (I_A), the largest given
+    controls: dict[str, int] = field(default_factory=dict)
     #: *TIME POINTS: name -> (times, on the total time?)
     time_points: dict[str, tuple[np.ndarray, bool]] = field(default_factory=dict)
     #: what the deck leaves to defaults, or reads in a way worth saying (listed before solving, not refused)
@@ -298,6 +300,8 @@ class _Reader(LoadCards):
                 self._boundary(c)
             elif c.name in ("CLOAD", "DLOAD"):
                 self._load(c)
+            elif c.name == "CONTROLS":
+                self._controls(c)
             elif c.name == "TIME POINTS":
                 self._time_points(c)
             if c.name in _OUTPUT and self.step is not None:
@@ -322,6 +326,24 @@ class _Reader(LoadCards):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
+
+    def _controls(self, c: Card) -> None:
+        """*CONTROLS, PARAMETERS=TIME INCREMENTATION: CalculiX's I_C (the most iterations of an increment) and I_A
+        (the most cutbacks of an increment) raise covcontact's own limits (the largest over the deck); other
+        parameters (FIELD, LINE SEARCH, CONTACT, RESET) leave covcontact's own criteria, said in a note."""
+        kind = " ".join(c.param("PARAMETERS", "").upper().split())
+        if kind == "TIME INCREMENTATION":
+            values = [f for row in c.rows() for f in row]
+            for j, key in ((3, "max_iterations"), (7, "max_cutbacks")):
+                if j < len(values) and values[j]:
+                    try:
+                        v = int(float(values[j]))
+                    except ValueError:
+                        raise c.fail(f"TIME INCREMENTATION value {j + 1} must be a number, got {values[j]!r}") from None
+                    self.m.controls[key] = max(v, self.m.controls.get(key, 0))
+            return
+        what = f"PARAMETERS={kind}" if kind else ("RESET" if "RESET" in c.params else "without PARAMETERS")
+        self.m.notes.append(f"{c.where()}: *CONTROLS, {what}: covcontact's own Newton criteria apply ([solver])")
 
     def _time_points(self, c: Card) -> None:
         """*TIME POINTS, NAME=, TIME=TOTAL TIME, GENERATE: the times (step time unless TIME=TOTAL TIME)."""
