@@ -5,6 +5,7 @@ keyword lines continued only by parameter lines, single-temperature tables, prin
 from __future__ import annotations
 
 import json
+from pathlib import Path
 import subprocess
 import sys
 
@@ -160,3 +161,18 @@ def test_controls_raise_the_iteration_limits(tmp_path):
     imp = import_deck(deck, tmp_path / "b" / "p.toml")
     s = load_problem(imp.problem).solver
     assert (s.max_iterations, s.max_cutbacks) == (25, 6) and sum("is below covcontact's" in n for n in imp.notes) == 2
+
+
+def test_surface_to_surface_decks_search_along_newton_corrections(tmp_path):
+    """CalculiX searches along its Newton corrections in static face-to-face penalty contact: a deck with a surface-
+    to-surface pair gets [solver] line_search; the example deck (a punch pressed and dragged with friction, the
+    frictional contact sticking from touchdown) runs to the end."""
+    for pair, expect in (("SURFACE TO SURFACE", True), ("NODE TO SURFACE", False)):
+        imp = import_deck(two_block_deck(tmp_path / f"{expect}.inp", pair=pair), tmp_path / f"{expect}" / "p.toml")
+        assert load_problem(imp.problem).solver.line_search is expect
+    example = Path(__file__).resolve().parents[2] / "examples" / "decks" / "punch_slide.inp"
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(example), "--out", str(tmp_path / "o"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert s["status"] == "completed" and sum(st["cutbacks"] for st in s["steps"]) == 0

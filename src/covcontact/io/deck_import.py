@@ -558,11 +558,15 @@ class _Writer:
     def _solver(self) -> str:
         """[solver] from *CONTROLS, TIME INCREMENTATION: CalculiX's I_C and I_A where they exceed covcontact's own
         limits (25 iterations, 6 cutbacks: a deck that allows more gets more; fewer is not imposed, since covcontact's
-        iterations are not CalculiX's)."""
+        iterations are not CalculiX's); and the line search where the deck has surface-to-surface pairs and static
+        steps, as CalculiX searches along its Newton corrections in static face-to-face penalty contact."""
         from ..description import SolverOptions
 
         d = SolverOptions()
         entries = {k: v for k, v in self.m.controls.items() if v > getattr(d, k)}
+        if any(kind == "SURFACE TO SURFACE" for _, kind, _, _, _ in self.m.pairs) and any(
+                not st.dynamic for st in self.m.steps):  # (CalculiX's line search of face-to-face penalty contact)
+            entries["line_search"] = True
         for k, v in self.m.controls.items():
             if v <= getattr(d, k):
                 self.notes.append(f"{self.deck}: *CONTROLS, TIME INCREMENTATION: {k} {v} is below covcontact's "
