@@ -21,6 +21,7 @@ from .deck import DeckError
 from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
+from .deck_coupling import DeckCouplings
 from .deck_rigid import DeckRigid
 
 _COMP = "xyz"
@@ -83,6 +84,7 @@ class _Writer:
         self.b = Parts(m)
         self.body_names = self._body_names()
         self.rigid = DeckRigid(m, self.b)
+        self.couplings = DeckCouplings(m, self.b, self.rigid, self.unsupported, self.notes, dialect)
         self._eq_removed: set[str] = set()   # the equations stages removed so far
         self.extra_nsets: dict[str, np.ndarray] = {}
         self.extra_elsets: dict[str, np.ndarray] = {}
@@ -290,7 +292,7 @@ class _Writer:
                 self.stage_jump.append(jump)
 
                 stage_name = f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else "")
-                rigid_v, rigid_l = {}, {}
+                rigid_v, rigid_l, dist_l = {}, {}, {}
                 for key, spec in bspec.items():
                     if key[0] == "rigid":  # a rigid body's REF or ROT node: its motion (DeckRigid)
                         if key in late or spec[1] is None:
@@ -332,6 +334,9 @@ class _Writer:
                     if key[0] == "rforce":
                         rigid_l[key[1:]] = prev_l[key] = v
                         continue
+                    if key[0] == "dforce":  # a *DISTRIBUTING coupling's REF NODE: its nodes' forces (DeckCouplings)
+                        dist_l[key[1:]] = prev_l[key] = v
+                        continue
                     if key not in names:
                         names[key] = f"{ {'cload': 'f', 'dload': 'p'}.get(key[0], 'g') }{len(names) + 1}"
                         first[key] = self._load_entry(key, names[key], v if (s, j) == (0, 0) else 0.0)
@@ -344,6 +349,7 @@ class _Writer:
                 self.stage_steps.append((s, duration))
                 motions, rigid_targets = self.rigid.stage(rigid_v, rigid_l)
                 targets.update(rigid_targets)
+                targets.update(self.couplings.stage(dist_l))
                 if (s, j) == (0, 0):
                     continue
                 st = {"name": stage_name, **self._timing(step, duration, jump)}
@@ -405,14 +411,12 @@ class _Writer:
 
     def _boundary_keys(self, b: Boundary, where: dict) -> dict:
         out = {}
-        labels, rigid = self.rigid.split(b.nodes)
-        for r, off in rigid:
-            for d in b.dofs:
-                key = ("rigid", r, off + d - 1)
-                where.setdefault(key, b.where)
-                out[key] = 0.0 if b.value is None else b.value
+        labels, keys = self.couplings.boundary_keys(b)  # (reference nodes' dofs 1-6: deck_coupling)
+        for key in keys:
+            where.setdefault(key, b.where)
+            out[key] = 0.0 if b.value is None else b.value
         for body, set_name in self._node_targets(b.name, labels, b.where):
-            for d in b.dofs:
+            for d in (d for d in b.dofs if d <= 3):
                 key = (body, set_name, d - 1)
                 where.setdefault(key, b.where)
                 out[key] = 0.0 if b.value is None else b.value
@@ -420,10 +424,11 @@ class _Writer:
 
     def _load_keys(self, ld: Load):
         if ld.kind == "cload":
-            labels, rigid = self.rigid.split(ld.nodes)
-            for r, off in rigid:
-                yield ("rforce", r, off + ld.dof - 1)
-            targets = self._node_targets(ld.target, labels, ld.where) if labels.size else []
+            labels, rigid = self.couplings.load_keys(ld)  # (reference nodes' dofs 1-6: deck_coupling)
+            yield from rigid
+            if ld.dof > 3 or (labels.size == 0 and ld.nodes.size > 0):
+                return  # (moments act on reference nodes alone; what they refuse is listed)
+            targets = self._node_targets(ld.target, labels, ld.where)
             if not targets and not rigid:
                 raise DeckError(f"{ld.where}: *CLOAD on nodes of no element ({ld.target})")
             for body, set_name in targets:
@@ -668,6 +673,7 @@ class _Writer:
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
         rigid = "".join(_table("[[rigid]]", e) for e in self.rigid.entries(self.extra_nsets, self._ref))
+        conds += "".join(_table("[[force]]", e) for e in self.couplings.entries(self.extra_nsets, self._ref))
         self.unsupported += self.rigid.unsupported
         first = self.m.steps[0]
         head = _table("[problem]", {"name": _name(self.deck.stem), **(self._timing(

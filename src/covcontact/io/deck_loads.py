@@ -14,7 +14,8 @@ from .deck import Card
 
 @dataclass
 class Boundary:
-    """A *BOUNDARY entry: node labels, dofs (1..3) and value (None: fixed at zero)."""
+    """A *BOUNDARY entry: node labels, dofs (1..6: 4-6 the rotations of a reference node) and value (None: fixed at
+    zero)."""
 
     nodes: np.ndarray
     dofs: tuple[int, ...]
@@ -32,7 +33,7 @@ class Load:
 
     kind: str            # "cload" | "dload" | "grav" | "centrif"
     target: str          # set name or label as written
-    dof: int             # CLOAD: 1..3; DLOAD: face number 1..6
+    dof: int             # CLOAD: 1..6 (4-6: a moment on a reference node); DLOAD: face number 1..6
     value: float
     where: str
     nodes: np.ndarray | None = None
@@ -74,9 +75,10 @@ class LoadCards:
             first = int(c.number(k, 1, row, "the first dof"))
             last = int(c.number(k, 2, row, "the last dof", first))
             value = c.number(k, 3, row, "the value") if len(row) > 3 and row[3] else None
-            dofs = tuple(d for d in range(first, last + 1) if 1 <= d <= 3)
-            if any(d > 3 for d in range(first, last + 1)):
-                self.m.unsupported.append(f"{c.where(k)}: *BOUNDARY on dofs above 3 (rotations, temperature)")
+            # (dofs 4-6: a reference node's rotations, else listed at import: covcontact.io.deck_coupling)
+            dofs = tuple(d for d in range(first, last + 1) if 1 <= d <= 6)
+            if any(d > 6 for d in range(first, last + 1)):
+                self.m.unsupported.append(f"{c.where(k)}: *BOUNDARY on dofs above 6 (temperature, ...)")
             if dofs:
                 out.append(Boundary(self._resolve_nodes(c, k, row[0]), dofs, value, c.where(k), row[0].upper(),
                                     c.param("AMPLITUDE"), "FIXED" in c.params, self._delay(c)))
@@ -98,8 +100,9 @@ class LoadCards:
                 if len(row) < 3:
                     raise c.fail("a *CLOAD line is 'node or set, dof, magnitude'", k)
                 dof = int(c.number(k, 1, row, "the dof"))
-                if not 1 <= dof <= 3:
-                    self.m.unsupported.append(f"{c.where(k)}: *CLOAD on dof {dof} (only forces 1..3)")
+                if not 1 <= dof <= 6:  # (4-6: a moment on a reference node, else listed at import)
+                    self.m.unsupported.append(f"{c.where(k)}: *CLOAD on dof {dof} (forces 1..3, moments 4..6 on a "
+                                              f"reference node)")
                     continue
                 st.loads.append(Load("cload", row[0].upper(), dof, c.number(k, 2, row, "the magnitude"), c.where(k),
                                      nodes=self._resolve_nodes(c, k, row[0]), amplitude=c.param("AMPLITUDE"),

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .deck import Card, DeckError, numbers, read_deck
+from .deck_coupling import COUPLING_CARDS, read_coupling_card
 from .deck_loads import Boundary, Load, LoadCards
 
 #: Abaqus / CalculiX element type -> (covcontact cell type, options); C3D8R is the full-integration hex8 (there is
@@ -33,7 +34,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY",
-             "TIME POINTS")
+             "TIME POINTS") + COUPLING_CARDS
 #: keywords only Abaqus reads: a deck with one of them is read in Abaqus' dialect (import_deck's "auto")
 _ABAQUS_ONLY = ("PART", "END PART", "ASSEMBLY", "END ASSEMBLY", "INSTANCE", "END INSTANCE")
 #: output requests: accepted, *NODE PRINT's U and RF, *EL PRINT's S and *CONTACT PRINT's CSTRESS are tabulated
@@ -115,6 +116,8 @@ class DeckModel:
     model_boundary: list[Boundary] = field(default_factory=list)
     #: *RIGID BODY: (node labels, REF NODE label or None, ROT NODE label or None, where)
     rigid_bodies: list[tuple[np.ndarray, int | None, int | None, str]] = field(default_factory=list)
+    #: *COUPLING with *KINEMATIC (also in rigid_bodies) or *DISTRIBUTING (covcontact.io.deck_coupling.Coupling)
+    couplings: list = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
     #: elements of types covcontact does not read (listed as unsupported): label -> type; and their nodes
@@ -160,6 +163,9 @@ class _Reader(LoadCards):
                 m.dialect = "abaqus"
             if c.name not in SUPPORTED:
                 m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
+                continue
+            if c.name in COUPLING_CARDS:  # (deck_coupling checks its own parameters)
+                read_coupling_card(self, c, cards[k] if k < len(cards) else None)
                 continue
             self._check_params(c)
             if c.name == "HEADING":

@@ -1,9 +1,11 @@
 """A deck's *RIGID BODY as covcontact rigid bodies with attached nodes (docs/input.md, "Abaqus and CalculiX decks").
 
 A *RIGID BODY's nodes (NSET=, or the nodes of ELSET=) are attached to a ``[[rigid]]`` body whose reference point is
-its REF NODE; the REF NODE's three dofs are the body's translation and the ROT NODE's three its rotation vector
-(CalculiX's convention). A *BOUNDARY on either node prescribes that component (the body's ``motion``, a stage's
-``motions``), a *CLOAD on it applies the body's force or moment; the components never prescribed are ``free``.
+its REF NODE; the REF NODE's dofs 1-3 are the body's translation and the ROT NODE's three its rotation vector
+(CalculiX's convention), as are the REF NODE's dofs 4-6 (Abaqus'; ``covcontact.io.deck_coupling``, which also adds
+the *KINEMATIC couplings as such bodies). A *BOUNDARY on either node prescribes that component (the body's
+``motion``, a stage's ``motions``), a *CLOAD on it applies the body's force or moment; the components never
+prescribed are ``free``.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .deck import DeckError
+from .deck_coupling import coupled_components, coupling_names
 
 _NAMES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -32,7 +35,12 @@ class DeckRigid:
                     raise DeckError(f"{where}: {key}={lab}: node {lab} is already the reference or rotation node of a "
                                     f"rigid body; give each body its own")
                 self.by_label[lab] = (r, off)
-        self.names = [f"RIGID{r + 1}" for r in range(len(m.rigid_bodies))]
+        # (a *COUPLING with *KINEMATIC: named after its CONSTRAINT NAME; its nodes may follow some components only)
+        self.names = coupling_names(m, [f"RIGID{r + 1}" for r in range(len(m.rigid_bodies))])
+        self.components = coupled_components(m)
+        # (a *KINEMATIC coupling of some dofs: the translations its nodes do not follow move nothing, they are held
+        # where nothing prescribes them, as CalculiX leaves such a dof out)
+        self.idle = {r: [c for c in range(3) if c not in comps] for r, comps in self.components.items()}
         # each body's reference point: its REF NODE, or (without one: its translation can be neither prescribed nor
         # loaded) the centroid of its nodes
         self.origins = [m.X[index[ref]] if ref is not None else m.X[index[nodes]].mean(axis=0)
@@ -63,7 +71,7 @@ class DeckRigid:
                 d = [values.get((r, c), 0.0) - prev_v.get((r, c), 0.0) for c in range(6)]
                 if any(d):
                     motions[name] = {"translation": d[:3], "rotation": d[3:], "center": self.origins[r].tolist()}
-            new = [loads.get((r, c), 0.0) for c in range(6)]
+            new = [0.0 if c in self.idle.get(r, ()) else loads.get((r, c), 0.0) for c in range(6)]
             if new != [prev_l.get((r, c), 0.0) for c in range(6)]:
                 targets[name] = {"force": new[:3], "moment": new[3:]}
         return motions, targets
@@ -91,14 +99,21 @@ class DeckRigid:
             if not attach:
                 raise DeckError(f"{where}: the rigid body holds no node of an element")
             origin = self.origins[r]
-            free = [_NAMES[c] for c in range(6) if (r, c) not in prescribed]
+            idle = self.idle.get(r, [])
+            free = [_NAMES[c] for c in range(6) if (r, c) not in prescribed and c not in idle]
             entry = {"name": self.names[r], "attach": attach, "reference": origin.tolist()}
+            if r in self.components:
+                entry["attach_components"] = [_NAMES[c] for c in self.components[r]]
             vals = [first_v.get((r, c), 0.0) for c in range(6)]
             if any(vals):
                 entry["motion"] = {"translation": vals[:3], "rotation": vals[3:], "center": origin.tolist()}
             if free:
                 entry["free"] = free
             loads = [first_l.get((r, c), 0.0) for c in range(6)]
+            if any((r, c) in v for v in self.stage_loads for c in idle):
+                self.unsupported.append(f"{where}: a *CLOAD on a translation of the REF NODE that the *KINEMATIC "
+                                        f"coupling's nodes do not follow (it moves nothing)")
+                loads = [0.0 if c in idle else v for c, v in enumerate(loads)]
             bad = [c for v in self.stage_loads for (q, c) in v if q == r and (r, c) in prescribed]
             if bad:
                 self.unsupported.append(f"{where}: a *CLOAD on the prescribed component {_NAMES[bad[0]]} of the rigid "

@@ -109,6 +109,10 @@ class RigidLinks:
         self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
         self.unit = sp.diags(self.mask.astype(float)).tocsr()
         self._theta = [np.zeros(3) for _ in self.links]  # each body's rotation vector at the last ``complete``
+        # the bodies' dofs (t, theta): their diagonal kept in the pattern (a component no eliminated dof depends on,
+        # such as a translation a partial coupling does not hold, has no entries; prescribed, it needs its diagonal)
+        self._ref_dofs = np.array([3 * node + k for ref, *_ in self.links for node in (ref.A, ref.B)
+                                   for k in range(3)], dtype=np.int64)
 
     def complete(self, u: np.ndarray) -> None:
         """Set the attached nodes' displacements (in place) from their bodies' (t, theta)."""
@@ -172,7 +176,19 @@ class RigidLinks:
         K = (K + sp.csr_matrix((np.concatenate(G_vals), (np.concatenate(G_rows), np.concatenate(G_cols))),
                                shape=K.shape)).tocsr()
         K.sort_indices()
-        return Rn, K
+        return Rn, _with_diagonal(K, self._ref_dofs)
+
+
+def _with_diagonal(K, dofs: np.ndarray):
+    """K with the diagonal entries of ``dofs`` in its pattern (explicit zeros where they were missing)."""
+    missing = [int(i) for i in dofs if i not in K.indices[K.indptr[i]: K.indptr[i + 1]]]
+    if not missing:
+        return K
+    C = K.tocoo()
+    K = sp.coo_matrix((np.concatenate([C.data, np.zeros(len(missing))]),
+                       (np.concatenate([C.row, missing]), np.concatenate([C.col, missing]))), shape=K.shape).tocsr()
+    K.sort_indices()
+    return K
 
 
 class ChainedConstraints:
