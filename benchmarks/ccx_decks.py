@@ -42,36 +42,108 @@ def _text(path: Path) -> str | None:
     return None
 
 
-def dat_blocks(text: str) -> dict[tuple[str, str, float], dict[int, np.ndarray]]:
-    """The displacement, force and stress blocks of a .dat file: (kind, set, time) -> node label (stresses: (element
-    label, integration point)) -> values."""
+#: the blocks compared, by the start of their header: kind, and how a row is keyed ("node": its first number, "point":
+#: element and integration point, "single": one row)
+_HEADS = (("displacements", "displacements", "node"), ("forces", "forces", "node"), ("stresses", "stresses", "point"),
+          ("equivalent plastic strain", "equivalent", "point"), ("strains", "strains", "point"),
+          ("internal energy density", "energy density", "point"), ("internal energy", "internal energy", "node"),
+          ("total internal energy", "total internal energy", "single"), ("volume", "volume", "node"),
+          ("total volume", "total volume", "single"))
+#: *CONTACT PRINT blocks: header start -> (kind of the first value, kind of the tangential pair's magnitude)
+_CONTACT = (("contact stress", ("contact", "tangential")), ("relative contact displacement", ("clearance", "slip")),
+            ("contact print energy", ("contact energy", None)))
+
+
+def dat_blocks(text: str) -> dict[tuple[str, str, float], dict]:
+    """The blocks of a .dat file that the survey compares: (kind, set, time) -> row key -> values. Nodal blocks (U, RF)
+    and element blocks (ELSE, EVOL) by label, Gauss-point blocks (S, E, PEEQ, ENER) by (element, integration point),
+    totals as one row. *CONTACT PRINT: CSTR's pressure ("contact") and |tangential traction| ("tangential"), CDIS's
+    clearance ("clearance") and |tangential displacement| ("slip"), CELS ("contact energy"), per slave node, or per
+    slave face (element, face) of surface-to-surface contact, whose integration points are each code's own (the mean
+    over the face's points; energies: their sum); their totals ("total contact energy", "contact elements": CNUM).
+    *SECTION PRINT: the surface's force ("section force"), moment about its centre ("section moment"), centre and
+    area."""
     out: dict = {}
-    key = None
+    key, mode, section, faces, table = None, None, 0, {}, []
+
+    def flush():  # surface-to-surface rows: the mean (energies: the sum) of each face's points
+        for k, rows in faces.items():
+            out[k] = {f: (np.sum(v, axis=0) if k[0] == "contact energy" else np.mean(v, axis=0)) for f, v in rows.items()}
+        faces.clear()
+
     for line in text.splitlines():
-        if line.strip().startswith("contact stress") and " and time " in line:  # press and |tangential| per node
-            key = ("contact", "ALL", float(line.split("time")[1]))
-            out[key] = {}
-            out[("tangential", "ALL", key[2])] = {}
+        s = line.strip()
+        if "all contact elements and time" in line or s.startswith("total contact spring energy for time") or \
+                s.startswith("total number of contact elements for time"):
+            flush()
+            time = float(line.split("time")[-1])
+            key, mode = None, None
+            for head, kinds in _CONTACT:
+                if s.startswith(head):
+                    mode = ("face", kinds) if "element+face" in s else ("slave", kinds)
+                    key = (kinds[0], "ALL", time)
+                    for kind in kinds:
+                        if kind:
+                            (faces if mode[0] == "face" else out)[(kind, "ALL", time)] = {}
+            if s.startswith("total contact spring energy"):
+                key, mode = ("total contact energy", "ALL", time), ("single", None)
+                out[key] = {}
+            elif s.startswith("total number of contact elements"):
+                key, mode = ("contact elements", "ALL", time), ("single", None)
+                out[key] = {}
+            continue
+        if s.startswith("statistics for surface set ") and " and time " in s:
+            flush()
+            key = (None, s.split("set ")[1].split()[0], float(line.split("time")[1]))
+            mode, section = ("section", None), 0
             continue
         if "for set " in line and " and time " in line:  # (CalculiX writes PEEQ's header without a space)
-            kind = line.split()[0]
+            flush()
+            kind, how = next(((k, h) for head, k, h in sorted(_HEADS, key=lambda x: -len(x[0])) if s.startswith(head)),
+                             (None, None))
             key = (kind, line.split("for set ")[1].split()[0], float(line.split("time")[1]))
-            out[key] = {} if kind in ("displacements", "forces", "stresses", "equivalent") else None
+            mode = (how, None) if kind else None
+            if kind:
+                out[key] = {}
             continue
-        if key is None or out.get(key) is None or not line.strip():
+        if key is None or mode is None or not s:
             continue
         f = line.split()
         try:
-            if key[0] in ("stresses", "equivalent"):  # (per integration point; "equivalent": PEEQ)
+            if mode[0] == "section":
+                if not f[0][-1].isdigit():   # (the table's text lines)
+                    continue
+                table = [float(x) for x in f] if section == 0 else table + [float(x) for x in f]
+                section += 1
+                if section == 4:   # force, moment about the origin; centre, normal; moment about the centre; area, ...
+                    name, time = key[1], key[2]
+                    force, area = np.array(table[:3]), table[15]
+                    out[("section force", name, time)] = {0: force}
+                    out[("section centre", name, time)] = {0: np.array(table[6:9])}
+                    out[("section area", name, time)] = {0: np.array([area])}
+                    # (the moment about the centre beside the force times the section's size, its scale: a moment
+                    # that vanishes is compared on that scale)
+                    out[("section moment", name, time)] = {0: np.array(table[12:15]),
+                                                           1: np.full(3, np.linalg.norm(force) * np.sqrt(area))}
+            elif mode[0] == "point":
                 out[key][(int(f[0]), int(f[1]))] = np.array([float(v) for v in f[2:8]])
-            elif key[0] == "contact":  # the tangential axes are each code's own: their magnitude
-                v = [float(x) for x in f[1:4]]
-                out[key][int(f[0])] = np.array([v[0]])
-                out[("tangential", "ALL", key[2])][int(f[0])] = np.array([np.hypot(v[1], v[2])])
+            elif mode[0] == "single":
+                out[key][0] = np.array([float(v) for v in f])
+            elif mode[0] in ("slave", "face"):
+                label = int(f[0]) if mode[0] == "slave" else (int(f[0]), int(f[1]))
+                v = [float(x) for x in f[1 if mode[0] == "slave" else 2:]]
+                first, tang = mode[1]
+                rows = [(first, np.array(v[:1]))] + ([(tang, np.array([np.hypot(v[1], v[2])]))] if tang else [])
+                for kind, val in rows:
+                    if mode[0] == "slave":
+                        out[(kind, "ALL", key[2])][label] = val
+                    else:
+                        faces[(kind, "ALL", key[2])].setdefault(label, []).append(val)
             else:
                 out[key][int(f[0])] = np.array([float(v) for v in f[1:4]])
-        except (ValueError, IndexError):
+        except (ValueError, IndexError, KeyError):
             key = None
+    flush()
     return {k: v for k, v in out.items() if v}
 
 

@@ -569,7 +569,7 @@ def test_contact_print_tabulates_contact_stresses(tmp_path):
                            "--quiet"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     lines = (tmp_path / "out" / "tb.dat").read_text().splitlines()
-    at = lines.index(" contact stress (slave node,press,tang1,tang2) for all contact elements and time  0.1000000E+01")
+    at = lines.index(" contact stress (slave node,press,tang1,tang2) for all contact elements and time 0.1000000E+01")
     rows = []
     for ln in lines[at + 2:]:
         if not ln.strip():

@@ -688,10 +688,18 @@ class _Writer:
             per_body[name] = self.m.node_labels[self.b.of_node == k].tolist()
         # every stage of a deck step prints its requests: at the increments FREQUENCY picks and where a step or a
         # time point ends (print_every, print_end)
-        prints = [[[nset, list(v), totals] for nset, v, _, totals in self.m.steps[s].node_print]
+        # each request with its place among the step's print cards (CalculiX prints them in the order of its cards,
+        # the ones carried over from earlier steps first), its totals, and the step's *SECTION PRINT surfaces
+        order = self._print_order()
+        prints = [[[nset, list(v), totals, order[w]] for nset, v, w, totals in self.m.steps[s].node_print]
                   for s, _ in self.stage_steps]
-        el_prints = [[[elset, list(v)] for elset, v, _ in self.m.steps[s].el_print] for s, _ in self.stage_steps]
+        el_prints = [[[elset, list(v), totals, order[w]] for elset, v, w, totals in self.m.steps[s].el_print]
+                     for s, _ in self.stage_steps]
         contact_prints = [list(self.m.steps[s].contact_print) for s, _ in self.stage_steps]
+        contact_cards = [[self.m.steps[s].contact_card[1], order.get(self.m.steps[s].contact_card[0], 0)]
+                         for s, _ in self.stage_steps]
+        section_prints = [[[surf, name, list(v), order[w]] for surf, name, v, w in self.m.steps[s].section_print
+                           if self._section_surface(surf, w)] for s, _ in self.stage_steps]
         wanted = {p[0] for per_step in prints for p in per_step}
         missing = sorted(wanted - set(self.m.nsets))
         if missing:
@@ -702,7 +710,10 @@ class _Writer:
             raise DeckError(f"{self.deck}: *EL PRINT names the element set {missing[0]!r}, which no *ELSET defines")
         labels.write_text(json.dumps({"bodies": per_body, "node_print": prints, "rigid": self.rigid.labels(),
                                       "elements": self.element_labels, "el_print": el_prints,
-                                      "contact_print": contact_prints,
+                                      "contact_print": contact_prints, "contact_card": contact_cards,
+                                      "contact_pairs": self._contact_pairs(),
+                                      "section_print": section_prints,
+                                      "surfaces": self._surface_faces(section_prints),
                                       "elsets": {k: self.m.elsets[k].tolist() for k in sorted(el_wanted)},
                                       "nsets": {k: self.m.nsets[k].tolist() for k in sorted(wanted)},
                                       "periods": [d for _, d in self.stage_steps],
@@ -712,17 +723,65 @@ class _Writer:
         return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)),
                         list(dict.fromkeys(self.notes)), self.meshes)
 
+    def _print_order(self) -> dict[str, int]:
+        """The rank of every print card (by its "file:line") in the order of the deck."""
+        wheres = {w for st in self.m.steps for w in [p[2] for p in st.node_print] + [p[2] for p in st.el_print]
+                  + [p[3] for p in st.section_print] + ([st.contact_card[0]] if st.contact_card[0] else [])}
+
+        def key(w: str):
+            file, _, line = w.rpartition(":")
+            return (file, int(line) if line.isdigit() else 0)
+
+        return {w: k + 1 for k, w in enumerate(sorted(wheres, key=key))}
+
+    def _section_surface(self, name: str, where: str) -> bool:
+        """Whether *SECTION PRINT's surface is an element face surface (else a note: nothing printed, as CalculiX
+        warns and prints nothing)."""
+        kind = self.m.surfaces.get(name, (None,))[0]
+        if kind is None:
+            raise DeckError(f"{where}: *SECTION PRINT names the surface {name!r}, which no *SURFACE defines")
+        if kind != "ELEMENT":
+            self.notes.append(f"{where}: *SECTION PRINT, SURFACE={name}: a node surface; section forces need element "
+                              f"faces (nothing printed, as in CalculiX)")
+            return False
+        return True
+
+    def _contact_pairs(self) -> dict[str, str]:
+        """The contact pairs the .dat's *CONTACT PRINT tabulates (those of *CONTACT PAIR: a *TIE is CalculiX's
+        equations, no contact elements) by covcontact's pair name: "node" (slave nodes) or the deck's name of the
+        element surface whose faces' integration points are the slaves (surface-to-surface)."""
+        out = {}
+        for k, (_, kind, slave, _, _) in enumerate(self.m.pairs):
+            sts = kind == "SURFACE TO SURFACE" and self.m.surfaces[slave][0] == "ELEMENT"
+            out[f"pair{k + 1}"] = slave if sts else "node"
+        return out
+
+    def _surface_faces(self, section_prints: list) -> dict[str, list[list[int]]]:
+        """(element label, face number) of every face of the element surfaces the .dat needs: those of *SECTION PRINT
+        and the slave surfaces of surface-to-surface pairs."""
+        names = {p[0] for per_stage in section_prints for p in per_stage}
+        names |= {v for v in self._contact_pairs().values() if v != "node"}
+        return {name: [[int(e), int(face)] for els, face, _ in self.m.surfaces[name][1] for e in els]
+                for name in sorted(names)}
+
     def _write_mesh(self) -> None:
         """One mesh file per body (its nodes, elements, sets and surfaces): bodies of cell types that do not mix
         (a hex20 part and a tet10 part) each read on their own. ``self.meshes``: each file's Mesh, built from the
         same content without reading the file back (``covcontact run DECK.inp`` hands them to the loader)."""
         from ..mesh.io import mesh_from_meshio
 
+        import dataclasses
+
         self.meshes = {}
         self.element_labels = {}  # body -> the deck's element labels in the mesh's element order
+        # (a surface only *SECTION PRINT names may cut through a body: the .dat reads its faces from the labels file)
+        sections = {s[0] for st in self.m.steps for s in st.section_print}
+        used = {name for pair in self.m.pairs for name in pair[2:4]} | {name for tie in self.m.ties for name in tie[1:3]}
+        model = dataclasses.replace(self.m, surfaces={name: v for name, v in self.m.surfaces.items()
+                                                      if name in used or name not in sections})
         for k in range(self.b.n):
             path = self.mesh_path.with_suffix(f".{k + 1}.inp")
-            content = body_content(self.m, self.b, k, self.extra_nsets, self.extra_elsets, self.extra_surfaces)
+            content = body_content(model, self.b, k, self.extra_nsets, self.extra_elsets, self.extra_surfaces)
             self.element_labels[self.body_names[k]] = np.concatenate([lab for _, lab, _ in content["blocks"]]).tolist()
             path.write_text(body_text(content))
             self.meshes[path] = mesh_from_meshio(body_meshio(content), path, surfaces=(surface_refs(content), {}))

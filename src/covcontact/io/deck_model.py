@@ -34,12 +34,13 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY",
-             "TIME POINTS") + COUPLING_CARDS
+             "TIME POINTS", "SECTION PRINT") + COUPLING_CARDS
 #: keywords only Abaqus reads: a deck with one of them is read in Abaqus' dialect (import_deck's "auto")
 _ABAQUS_ONLY = ("PART", "END PART", "ASSEMBLY", "END ASSEMBLY", "INSTANCE", "END INSTANCE")
-#: output requests: accepted, *NODE PRINT's U and RF, *EL PRINT's S and *CONTACT PRINT's CSTRESS are tabulated
+#: output requests: accepted; the .dat tabulates what _print lists for *NODE PRINT, *EL PRINT, *CONTACT PRINT and
+#: *SECTION PRINT
 _OUTPUT = ("NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
-           "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART")
+           "ELEMENT OUTPUT", "CONTACT OUTPUT", "OUTPUT", "RESTART", "SECTION PRINT")
 #: parameters that do not change what covcontact computes (solver, output and bookkeeping choices)
 _HARMLESS = {"NSET", "ELSET", "NAME", "GENERATE", "TYPE", "INPUT", "FREQUENCY", "GLOBAL", "TOTALS", "OUTPUT",
              "SOLVER", "INC", "NLGEOM", "OP", "INTERACTION", "MATERIAL", "PRESSURE-OVERCLOSURE", "UNSYMM", "READ",
@@ -63,8 +64,11 @@ class Step:
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     #: (nset, variables, where, totals: "NO" | "YES" | "ONLY")
     node_print: list[tuple[str, tuple[str, ...], str, str]] = field(default_factory=list)
-    el_print: list[tuple[str, tuple[str, ...], str]] = field(default_factory=list)    # (elset, variables, where)
-    contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables (CSTRESS is tabulated)
+    el_print: list[tuple[str, tuple[str, ...], str, str]] = field(default_factory=list)  # (elset, variables, where, totals)
+    contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables
+    contact_card: tuple[str, str] = ("", "NO")   # where the step's *CONTACT PRINT is, its TOTALS
+    #: *SECTION PRINT: (surface, NAME, variables, where)
+    section_print: list[tuple[str, str, tuple[str, ...], str]] = field(default_factory=list)
     #: which print requests the step itself gives (the others carry over from the step before, as in CalculiX)
     prints_given: set[str] = field(default_factory=set)
     #: FREQUENCY of the output (every Nth increment and the step's end; carried over from step to step)
@@ -296,7 +300,9 @@ class _Reader(LoadCards):
                     if "el" not in self.step.prints_given:
                         self.step.el_print = list(last.el_print)
                     if "contact" not in self.step.prints_given:
-                        self.step.contact_print = last.contact_print
+                        self.step.contact_print, self.step.contact_card = last.contact_print, last.contact_card
+                    if "section" not in self.step.prints_given:
+                        self.step.section_print = list(last.section_print)
                 m.steps.append(self.step)
                 self.step = None
                 self.changing = None
@@ -312,7 +318,7 @@ class _Reader(LoadCards):
                 self._time_points(c)
             if c.name in _OUTPUT and self.step is not None:
                 self._frequency(c)
-            if c.name in ("NODE PRINT", "EL PRINT", "CONTACT PRINT"):
+            if c.name in ("NODE PRINT", "EL PRINT", "CONTACT PRINT", "SECTION PRINT"):
                 self._print(c)
         if self.step is not None:
             raise DeckError(f"{self.step.where}: *STEP without its *END STEP")
@@ -328,7 +334,7 @@ class _Reader(LoadCards):
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
                     c.name == "CONTACT PAIR" and p in ("ADJUST", "SMALL SLIDING")) or (
                     c.name == "EQUATION" and p in ("REMOVE", "REMOVE ALL")) or (
-                    c.name == "PLASTIC" and p == "HARDENING"):
+                    c.name == "PLASTIC" and p == "HARDENING") or (c.name == "SECTION PRINT" and p == "SURFACE"):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
@@ -389,22 +395,40 @@ class _Reader(LoadCards):
             self.step.time_points = name
 
     def _print(self, c: Card) -> None:
-        """*NODE PRINT, *EL PRINT, *CONTACT PRINT: the first of a kind in a step replaces the requests carried over
-        from the step before (a bare card, without its set, only clears them: CalculiX's way to stop printing)."""
+        """*NODE PRINT, *EL PRINT, *CONTACT PRINT, *SECTION PRINT: the first of a kind in a step replaces the requests
+        carried over from the step before (a bare card, without its set, only clears them: CalculiX's way to stop
+        printing). CalculiX reads contact variables by their first four letters (CSTRESS is CSTR, CDISP CDIS) and
+        section variables by SOF, SOM, SOAREA (one table of the surface's forces and moments for all three)."""
         st = self._in_step(c)
         kind = c.name.split()[0].lower()
+        totals = c.param("TOTALS", "NO").upper()
+        if totals not in ("NO", "YES", "ONLY"):
+            raise c.fail(f"TOTALS must be NO, YES or ONLY, got {c.params['TOTALS']!r}")
         if kind not in st.prints_given:
             st.prints_given.add(kind)
             if kind == "node":
                 st.node_print = []
             elif kind == "el":
                 st.el_print = []
+            elif kind == "section":
+                st.section_print = []
             else:
-                st.contact_print = ()
+                st.contact_print, st.contact_card = (), (c.where(), "NO")
         variables = tuple(v.upper() for row in c.rows() for v in row)
         if kind == "contact":
             st.contact_print += variables
-            self._unprinted(c, variables, ("CSTRESS",))
+            st.contact_card = (st.contact_card[0], totals if totals != "NO" else st.contact_card[1])
+            self._unprinted(c, variables, ("CSTR", "CDIS", "CELS", "CNUM"), prefix=True)
+            return
+        if kind == "section":
+            surface, name = c.param("SURFACE"), c.param("NAME")
+            if name is None:
+                raise c.fail("missing parameter NAME= (CalculiX requires it)")
+            if surface is None:
+                self.m.notes.append(f"{c.where()}: *SECTION PRINT without SURFACE=: nothing printed (as CalculiX)")
+                return
+            st.section_print.append((surface.upper(), name.upper(), variables, c.where()))
+            self._unprinted(c, variables, ("SOF", "SOM", "SOAREA"), prefix=True)
             return
         key = "NSET" if kind == "node" else "ELSET"
         target = c.param(key)
@@ -414,19 +438,18 @@ class _Reader(LoadCards):
                              f"stops the printing")
             return
         if kind == "node":
-            totals = c.param("TOTALS", "NO").upper()
-            if totals not in ("NO", "YES", "ONLY"):
-                raise c.fail(f"TOTALS must be NO, YES or ONLY, got {c.params['TOTALS']!r}")
             st.node_print.append((target.upper(), variables, c.where(), totals))
             self._unprinted(c, variables, ("U", "RF"))
         else:
-            st.el_print.append((target.upper(), variables, c.where()))
-            self._unprinted(c, variables, ("S", "PEEQ"))
+            st.el_print.append((target.upper(), variables, c.where(), totals))
+            self._unprinted(c, variables, ("S", "E", "PEEQ", "ENER", "ELSE", "EVOL"))
 
-    def _unprinted(self, c: Card, variables: tuple, printed: tuple) -> None:
-        """Output variables the .dat does not tabulate: a note each (the run goes on; they are not printed)."""
+    def _unprinted(self, c: Card, variables: tuple, printed: tuple, prefix: bool = False) -> None:
+        """Output variables the .dat does not tabulate: a note each (the run goes on; they are not printed).
+        ``prefix``: a variable that starts with one of ``printed`` is printed (CalculiX's reading of contact and
+        section variables)."""
         for v in variables:
-            if v not in printed:
+            if not (any(v.startswith(p) for p in printed) if prefix else v in printed):
                 self.m.notes.append(f"{c.where()}: *{c.name} {v}: not printed in the .dat (covcontact tabulates "
                                     f"{', '.join(printed)} there)")
 
