@@ -189,14 +189,18 @@ def test_frd_results_against_dat_vtu_and_equilibrium(deck_run):
     out, _, _ = deck_run
     frd = read_frd(out / "blocks.frd")
     names = [s.name for s in frd.sets]
-    assert names == ["DISP", "STRESS", "TOSTRAIN", "FORC", "PE"] * 2
-    assert [(s.step, s.time) for s in frd.blocks("DISP")] == [(1, 1.0), (2, 2.0)]
+    summary = json.loads((out / "summary.json").read_text())
+    converged = [s for s in summary["steps"] if s["converged"]]
+    # a result set at every converged increment, as the .dat prints (CalculiX's default FREQUENCY=1)
+    assert names == ["DISP", "STRESS", "TOSTRAIN", "FORC", "PE"] * len(converged)
+    ends = [b for b in frd.blocks("DISP") if b.time in (1.0, 2.0)]
+    assert [(b.step, b.time) for b in ends] == [(1, 1.0), (2, 2.0)]
     assert frd.blocks("DISP")[0].components == ["D1", "D2", "D3"]
     assert frd.blocks("STRESS")[0].components == ["SXX", "SYY", "SZZ", "SXY", "SYZ", "SZX"]
     assert frd.blocks("TOSTRAIN")[0].components == ["EXX", "EYY", "EZZ", "EXY", "EYZ", "EZX"]
-    summary = json.loads((out / "summary.json").read_text())
     per_stage = [sum(1 for s in summary["steps"] if s.get("stage") == name) for name in ("stage1", "step2")]
-    assert [s.increment for s in frd.blocks("DISP")] == per_stage  # (the step's last increment)
+    assert [b.increment for b in ends] == per_stage  # (the step's last increment)
+    first = [b.time for b in frd.blocks("DISP")].index(1.0)  # (the sets at the end of the first step)
     for s in frd.sets:
         assert sorted(s.values) == sorted(frd.nodes)
 
@@ -205,14 +209,14 @@ def test_frd_results_against_dat_vtu_and_equilibrium(deck_run):
         u = dat[("displacements", s.time)]
         assert all(_same_to_printed_digits(s.values[n], u[n]) for n in frd.nodes)
     rf = dat[("forces", 1.0)]
-    forc = frd.blocks("FORC")[0]
+    forc = frd.blocks("FORC")[first]
     assert all(_same_to_printed_digits(forc.values[n], rf[n]) for n in frd.nodes)
 
     labels = json.loads((out / "deck" / "blocks.nodes.json").read_text())["bodies"]
     order = np.concatenate([labels[b] for b in ("BRICKS", "QUAD", "TET")])
     at_one = [ln for ln in (out / "result.pvd").read_text().splitlines() if 'timestep="1"' in ln]
     vtu = meshio.read(out / at_one[0].split('file="')[1].split('"')[0])  # the end of the first step
-    stress, strain, pe = frd.blocks("STRESS")[0], frd.blocks("TOSTRAIN")[0], frd.blocks("PE")[0]
+    stress, strain, pe = frd.blocks("STRESS")[first], frd.blocks("TOSTRAIN")[first], frd.blocks("PE")[first]
     for k, n in enumerate(order):
         assert np.allclose(stress.values[n], vtu.point_data["cauchy_nodal"][k], rtol=1e-5, atol=1e-10)
     # element values averaged at the nodes, from the VTU's cells (an elastic body's plastic strain: NaN there, 0 here)
@@ -228,7 +232,7 @@ def test_frd_results_against_dat_vtu_and_equilibrium(deck_run):
     assert all(pe.values[n][0] > 1e-4 for n in labels["BRICKS"])  # (yielded: 5 / 1000 < 0.01)
     assert all(pe.values[n][0] == 0.0 for n in labels["QUAD"] + labels["TET"])
 
-    disp = frd.blocks("DISP")[0]
+    disp = frd.blocks("DISP")[first]
     x = np.array([frd.nodes[n] + disp.values[n] for n in HEX20_NODES])
     f = np.array([forc.values[n] for n in HEX20_NODES])
     moment = x.T @ f  # sum over the nodes of x (x) f: the integral of the Cauchy stress over the current volume
@@ -302,7 +306,8 @@ def test_ccx_input_errors_exit_201(tmp_path):
 def test_ccx_increment_that_does_not_converge_exits_201(tmp_path):
     """Tops pushed down by 1.5 (the bricks invert) with increments no smaller than half the step: the first attempt
     (the whole step) is cut back, the half converges, the second half fails twice; exit 201 with *ERROR, the failed
-    attempts marked U in the .sta with their sizes, no result set in the frd (no step ended) but a closed file."""
+    attempts marked U in the .sta with their sizes, the frd with the result set of the converged half (a run that
+    stops keeps what converged) and closed."""
     write_deck(tmp_path / "fail.inp", top=-1.5, static="0.5, 1.0, 0.5, 0.5")
     proc = _cli("ccx", "-i", "fail", cwd=tmp_path)
     assert proc.returncode == 201, proc.stdout + proc.stderr
@@ -318,7 +323,8 @@ def test_ccx_increment_that_does_not_converge_exits_201(tmp_path):
     sizes = [float(r.split()[-1]) for r in rows if r.split()[1] == rows[-1].split()[1]]
     assert all(b == pytest.approx(a / 2) for a, b in zip(sizes, sizes[1:]))
     frd = read_frd(tmp_path / "fail.frd")
-    assert frd.closed and not frd.sets and len(frd.elements) == 4
+    assert frd.closed and len(frd.elements) == 4
+    assert [(b.step, b.time) for b in frd.blocks("DISP")] == [(1, 0.5)] * len(done)
 
 
 def test_resuming_a_completed_deck_run_keeps_the_frd(deck_run, tmp_path):
