@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..observer import Observer
+from .deck_dat import output_due
 
 #: covcontact cell type -> (CalculiX's frd element type, the cell's nodes in the order the frd lists them); the
 #: deck's node order of C3D8, C3D6, C3D4, C3D10 and C3D20 is covcontact's (VTK's); the frd lists a 20-node brick's
@@ -137,7 +138,8 @@ def _nodal(values: np.ndarray, incidence: tuple[np.ndarray, np.ndarray], n_nodes
 
 class FrdFile(Observer):
     """Writes ``path`` (the .frd) of a deck's run from the labels file of :func:`covcontact.io.deck_import.import_deck`:
-    the mesh at the start, a result set at the end of each deck step, `` 9999`` at the end (any status). A resumed
+    the mesh at the start, a result set at each output increment of the deck (the .dat's: every increment, every
+    Nth with FREQUENCY, the time points), `` 9999`` at the end (any status). A resumed
     run goes on with the file it finds (its closing record dropped, its counters read from it)."""
 
     def __init__(self, labels: Path, path: Path):
@@ -149,6 +151,7 @@ class FrdFile(Observer):
         self.kode = 0         # result sets written
         self.increments = 0   # converged increments of the deck step in hand
         self.in_step = -1     # that deck step
+        self.due_count: dict[int, int] = {}  # converged increments per deck step (output_due)
 
     # -- events ---------------------------------------------------------------------------------------
     def started(self, run) -> None:
@@ -177,8 +180,7 @@ class FrdFile(Observer):
         if step != self.in_step:
             self.in_step, self.increments = step, 0
         self.increments += max(1, len(getattr(run.newton, "converged_increments", None) or []))  # (as JOB.sta counts)
-        last = stage + 1 == len(self.deck_step) or self.deck_step[stage + 1] != step
-        if not (inc.ends_stage and last):
+        if not output_due(self.info, self.due_count, stage, bool(inc.ends_stage)):  # (the .dat's increments)
             return
         periods = self.info["periods"]
         t = sum(periods[:stage]) + periods[stage] * inc.lam
