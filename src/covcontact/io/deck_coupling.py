@@ -420,9 +420,10 @@ def safe_name(text: str) -> str:
 
 def coupling_names(m, names: list[str]) -> list[str]:
     """The rigid bodies' names with those of *KINEMATIC couplings after their CONSTRAINT NAME (unique)."""
-    out = list(names)
+    out, done = list(names), set()
     for cp in _couplings(m):
-        if cp.kind == "kinematic" and cp.rigid >= 0 and out[cp.rigid].startswith("RIGID"):
+        if cp.kind == "kinematic" and cp.rigid >= 0 and cp.rigid not in done:  # (the first of those on one REF NODE)
+            done.add(cp.rigid)
             name = safe_name(cp.name)
             taken = set(out) | {safe_name(s) for s, _, _ in m.sections}
             out[cp.rigid] = name if name not in taken else f"{name}_{cp.rigid + 1}"
