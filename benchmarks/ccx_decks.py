@@ -6,15 +6,20 @@ Install the decks and their references first (they are not downloaded here):
 
 Each deck named (default: every deck in that folder whose keywords covcontact reads) is run with
 ``covcontact run DECK.inp`` in a folder of its own; the ``.dat`` table it writes is compared with the deck's
-``.dat.ref``: for every block of displacements (U) and forces (RF) that both print at the same time, the largest
-difference over the largest value of the reference block (a deck that prints no displacements there: those of its
+``.dat.ref``: for every block both print at the same time (U, RF, S, PEEQ, E, ENER, ELSE, EVOL, the contact blocks
+CSTR, CDIS, CELS, CNUM, the *SECTION PRINT table: ``dat_blocks``), the largest difference over the largest value of
+the reference block (a deck that prints no displacements there: those of its
 ``.frd.ref`` at the end of each step, against covcontact's VTU of that step). covcontact is always geometrically nonlinear; a deck
 whose steps are linear (no NLGEOM) is also run by CalculiX itself (``ccx``, ``apt-get install calculix-ccx``) with
 NLGEOM added to its steps, and the displacements compared with that run as well. Decks that covcontact refuses (unsupported keywords, one
 line each) or that fail are listed with the reason. Results: a JSON file and a markdown table
 (docs/verification.md, "CalculiX test decks").
 
-    python benchmarks/ccx_decks.py [--decks contact1,contact4] [--folder DIR] [--out results/ccx_decks]
+    python benchmarks/ccx_decks.py [--decks contact1,contact4] [--folder DIR] [--out results/ccx_decks] [--add-prints]
+
+``--add-prints`` asks every step of each deck for E, ENER, ELSE, EVOL over all elements (and CDIS, CSTR, CELS, CNUM
+where the deck has contact pairs) and has CalculiX run the same deck (NLGEOM added), so that the blocks its
+references lack are compared too.
 """
 
 from __future__ import annotations
@@ -57,18 +62,19 @@ _CONTACT = (("contact stress", ("contact", "tangential")), ("relative contact di
 def dat_blocks(text: str) -> dict[tuple[str, str, float], dict]:
     """The blocks of a .dat file that the survey compares: (kind, set, time) -> row key -> values. Nodal blocks (U, RF)
     and element blocks (ELSE, EVOL) by label, Gauss-point blocks (S, E, PEEQ, ENER) by (element, integration point),
-    totals as one row. *CONTACT PRINT: CSTR's pressure ("contact") and |tangential traction| ("tangential"), CDIS's
-    clearance ("clearance") and |tangential displacement| ("slip"), CELS ("contact energy"), per slave node, or per
-    slave face (element, face) of surface-to-surface contact, whose integration points are each code's own (the mean
-    over the face's points; energies: their sum); their totals ("total contact energy", "contact elements": CNUM).
-    *SECTION PRINT: the surface's force ("section force"), moment about its centre ("section moment"), centre and
-    area."""
+    totals as one row. *CONTACT PRINT: CSTR's pressure ("contact") and shear stresses ("tangential"), CDIS's clearance
+    ("clearance") and tangential displacements ("slip"; both codes take CalculiX's tangential axes), CELS ("contact
+    energy"), per slave node, or per slave face (element, face) of surface-to-surface contact, whose integration points
+    are each code's own (the mean over the face's points; energies: their sum); their totals ("total contact energy",
+    "contact elements": CNUM). *SECTION PRINT: the surface's force ("section force"), moment about its centre
+    ("section moment"), centre and area."""
     out: dict = {}
     key, mode, section, faces, table = None, None, 0, {}, []
 
     def flush():  # surface-to-surface rows: the mean (energies: the sum) of each face's points
         for k, rows in faces.items():
-            out[k] = {f: (np.sum(v, axis=0) if k[0] == "contact energy" else np.mean(v, axis=0)) for f, v in rows.items()}
+            total = k[0] == "contact energy"
+            out[k] = {f: (np.sum(v, axis=0) if total else np.mean(v, axis=0)) for f, v in rows.items()}
         faces.clear()
 
     for line in text.splitlines():
@@ -133,7 +139,7 @@ def dat_blocks(text: str) -> dict[tuple[str, str, float], dict]:
                 label = int(f[0]) if mode[0] == "slave" else (int(f[0]), int(f[1]))
                 v = [float(x) for x in f[1 if mode[0] == "slave" else 2:]]
                 first, tang = mode[1]
-                rows = [(first, np.array(v[:1]))] + ([(tang, np.array([np.hypot(v[1], v[2])]))] if tang else [])
+                rows = [(first, np.array(v[:1]))] + ([(tang, np.array(v[1:3]))] if tang else [])
                 for kind, val in rows:
                     if mode[0] == "slave":
                         out[(kind, "ALL", key[2])][label] = val
@@ -248,12 +254,50 @@ def candidates(folder: Path) -> list[str]:
     return sorted(set(out))
 
 
-def run_deck(name: str, folder: Path, out: Path) -> dict:
+#: the blocks beside U, RF, S, PEEQ and CSTR (docs/input.md, the .dat's variables), for the second table
+NEW_KINDS = ("strains", "energy density", "internal energy", "total internal energy", "volume", "total volume",
+             "clearance", "slip", "contact energy", "total contact energy", "contact elements", "section force",
+             "section moment", "section area", "section centre")
+#: what ``--add-prints`` asks of every step: the element blocks over all elements, with contact pairs the contact ones
+EXTRA_EL = "*EL PRINT, ELSET=SURVEYALL, TOTALS=YES\nE, ENER, ELSE, EVOL\n"
+EXTRA_CONTACT = "*CONTACT PRINT, TOTALS=YES\nCDIS, CSTR, CELS, CNUM\n"
+
+
+def with_prints(text: str, deck: Path) -> str:
+    """The deck with EXTRA_EL (over a set SURVEYALL of every element, defined before the first *STEP) and, if it has
+    contact pairs, EXTRA_CONTACT at the end of every step (a step's first *EL PRINT or *CONTACT PRINT replaces the
+    requests carried over from the step before: both codes read the same deck)."""
+    from covcontact.io.deck_model import read_model
+
+    labels = np.unique(np.concatenate([b[2] for b in read_model(deck).blocks]))
+    rows = [", ".join(map(str, labels[k: k + 12])) for k in range(0, len(labels), 12)]
+    extra = EXTRA_EL + (EXTRA_CONTACT if "*CONTACTPAIR" in text.upper().replace(" ", "") else "")
+    out, first = [], True
+    for ln in text.splitlines():
+        key = ln.upper().replace(" ", "")
+        if key.startswith("*STEP") and first:
+            out += ["*ELSET, ELSET=SURVEYALL", *rows]
+            first = False
+        if key.startswith("*ENDSTEP"):
+            out += extra.splitlines()
+        out.append(ln)
+    return "\n".join(out) + "\n"
+
+
+def _summary(row: dict, blocks: list[dict], suffix: str = "") -> None:
+    """max_rel_<kind><suffix> of every kind the comparison has."""
+    for kind in sorted({b["kind"] for b in blocks}):
+        row[f"max_rel_{kind}{suffix}"] = max(b["rel_diff"] for b in blocks if b["kind"] == kind)
+
+
+def run_deck(name: str, folder: Path, out: Path, add_prints: bool = False) -> dict:
     work = out / name
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     deck = work / f"{name}.inp"
     deck.write_text(_text(folder / f"{name}.inp"))
+    if add_prints:
+        deck.write_text(with_prints(deck.read_text(), deck))
     ref = _text(folder / f"{name}.dat.ref")
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(work / "run"),
@@ -272,16 +316,13 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
     if frd and not any(b["kind"] == "displacements" for b in blocks):  # only the .frd holds displacements
         blocks += compare_blocks(ours_at_step_ends(work / "run"), frd_displacements(frd))
     row["blocks"] = blocks
-    for kind in ("displacements", "forces", "stresses", "contact", "tangential", "equivalent"):
-        vals = [b["rel_diff"] for b in blocks if b["kind"] == kind]
-        if vals:
-            row[f"max_rel_{kind}"] = max(vals)
+    _summary(row, blocks)
     text = deck.read_text()
     linear = [ln for ln in text.splitlines() if ln.upper().replace(" ", "").startswith("*STEP")
               and "NLGEOM" not in ln.upper()]
     row["nlgeom"] = not linear
     ccx = shutil.which("ccx")
-    if linear and ccx:  # covcontact is geometrically nonlinear: CalculiX itself with NLGEOM on every step
+    if (linear or add_prints) and ccx:  # CalculiX itself with NLGEOM on every step (covcontact is nonlinear)
         nl = work / "ccx_nlgeom"
         nl.mkdir()
         lines = [ln + (", NLGEOM" if ln.upper().replace(" ", "").startswith("*STEP") and "NLGEOM" not in ln.upper()
@@ -293,10 +334,8 @@ def run_deck(name: str, folder: Path, out: Path) -> dict:
             if not any(b["kind"] == "displacements" for b in nb) and (nl / f"{name}.frd").is_file():
                 nb += compare_blocks(ours_at_step_ends(work / "run"),
                                      frd_displacements((nl / f"{name}.frd").read_text(errors="replace")))
-            for kind in ("displacements", "forces", "stresses", "contact", "tangential", "equivalent"):
-                vals = [b["rel_diff"] for b in nb if b["kind"] == kind]
-                if vals:
-                    row[f"max_rel_{kind}_vs_ccx_nlgeom"] = max(vals)
+            row["blocks_vs_ccx_nlgeom"] = nb
+            _summary(row, nb, "_vs_ccx_nlgeom")
     return row
 
 
@@ -305,6 +344,9 @@ def main() -> int:
     ap.add_argument("--decks", default=None, help="comma-separated deck names (default: the candidates)")
     ap.add_argument("--folder", default=str(FOLDER))
     ap.add_argument("--out", default="results/ccx_decks")
+    ap.add_argument("--add-prints", action="store_true",
+                    help="ask every step for E, ENER, ELSE, EVOL (and CDIS, CSTR, CELS, CNUM with contact pairs) and "
+                         "compare them with CalculiX run on the same deck")
     args = ap.parse_args()
     folder, out = Path(args.folder), Path(args.out)
     if not folder.is_dir():
@@ -313,7 +355,7 @@ def main() -> int:
     names = args.decks.split(",") if args.decks else candidates(folder)
     rows = []
     for name in names:
-        row = run_deck(name, folder, out)
+        row = run_deck(name, folder, out, args.add_prints)
         rows.append(row)
         u = row.get("max_rel_displacements")
         sv = row.get("max_rel_stresses")
@@ -336,6 +378,13 @@ def main() -> int:
                      f"{fmt(r.get('max_rel_displacements_vs_ccx_nlgeom'))} | "
                      f"{fmt(r.get('max_rel_forces_vs_ccx_nlgeom'))} | {fmt(r.get('max_rel_stresses_vs_ccx_nlgeom'))} | "
                      f"{r.get('why', '')} |")
+    # the other blocks: per deck and kind, against the reference and against CalculiX with NLGEOM
+    lines += ["", "| deck | block | vs .dat.ref | vs ccx NLGEOM |", "|---|---|---|---|"]
+    for r in rows:
+        for kind in NEW_KINDS:
+            a, b = r.get(f"max_rel_{kind}"), r.get(f"max_rel_{kind}_vs_ccx_nlgeom")
+            if a is not None or b is not None:
+                lines.append(f"| {r['deck']} | {kind} | {fmt(a)} | {fmt(b)} |")
     (out / "ccx_decks.md").write_text("\n".join(lines) + "\n")
     print(f"wrote {out / 'ccx_decks.md'}", file=sys.stderr)
     return 0

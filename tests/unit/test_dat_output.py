@@ -69,11 +69,18 @@ SOF, SOM
 DELTA, K, SIGMA_INF = 1e-3, 1e4, 0.01   # the punch's press, the law's slope and tension
 
 
-def _punch_deck(path: Path, pair: str) -> Path:
+MU, STICK, SLIDE = 0.2, 1e5, 1e-5   # friction: Coulomb's coefficient, the stick slope, the punch's slide along x
+
+
+def _punch_deck(path: Path, pair: str, slide: bool = False) -> Path:
     """two_block_deck's punch (elements 101-104, its bottom the slave surface of element faces S1) pressed rigidly by
     DELTA into a base 1e7 times stiffer (every punch node prescribed), the LINEAR law (K, sigma_inf, c0) in one
-    increment; prints CDIS, CSTR, CELS (TOTALS=YES), CNUM."""
+    increment; prints CDIS, CSTR, CELS (TOTALS=YES), CNUM. ``slide``: with friction (MU, STICK), the punch moved by
+    SLIDE along x too (it sticks: STICK SLIDE < MU K DELTA)."""
     text = two_block_deck(path, pair=pair).read_text()
+    if slide:
+        text = text.replace("LINEAR\n1.0e6\n", f"LINEAR\n1.0e6\n*FRICTION\n{MU}, {STICK}\n").replace(
+            "TOP, 1, 2\n", f"TOP, 1, 1, {SLIDE}\nTOP, 2, 2\n")
     for old, new in (("*Element, type=c3d8,\nELSET=PUNCH", "*ELEMENT, TYPE=C3D8, ELSET=PUNCH"),
                      ("*SURFACE, NAME=SSLAV, TYPE=NODE\nNSLAVE",
                       "*ELSET, ELSET=PUNCHBOT\n101, 102, 103, 104\n*SURFACE, NAME=SSLAV\nPUNCHBOT, S1\n"
@@ -83,10 +90,13 @@ def _punch_deck(path: Path, pair: str) -> Path:
                      ("LINEAR\n1.0e6", f"LINEAR\n{K}, {SIGMA_INF}, 1e-3"),
                      ("*STATIC\n0.5, 1.0", "*STATIC, DIRECT\n1.0, 1.0"),
                      ("TOP, 1, 2\nTOP, 3, 3, -0.02", f"PUNCHN, 1, 2\nPUNCHN, 3, 3, -{DELTA}"),
+                     (f"TOP, 1, 1, {SLIDE}\nTOP, 2, 2\nTOP, 3, 3, -0.02",
+                      f"PUNCHN, 1, 1, {SLIDE}\nPUNCHN, 2, 2\nPUNCHN, 3, 3, -{DELTA}"),
                      ("*NODE PRINT, NSET=BOTTOM\nU, RF",
                       "*NODE PRINT, NSET=BOTTOM, TOTALS=ONLY\nRF\n*CONTACT PRINT, TOTALS=YES\nCDIS, CSTR, CELS, CNUM")):
-        assert old in text, old
-        text = text.replace(old, new)
+        if old in text or not (slide ^ old.startswith("TOP, 1, 1")):
+            assert old in text, old
+            text = text.replace(old, new)
     path.write_text(text)
     return path
 
@@ -107,6 +117,13 @@ def bar(tmp_path_factory):
 def punch(tmp_path_factory):
     d = tmp_path_factory.mktemp("punch")
     deck = _punch_deck(d / "punch.inp", "NODE TO SURFACE")
+    return deck, _run(deck, d / "out")
+
+
+@pytest.fixture(scope="module")
+def punch_slide(tmp_path_factory):
+    d = tmp_path_factory.mktemp("punch_slide")
+    deck = _punch_deck(d / "slide.inp", "NODE TO SURFACE", slide=True)
     return deck, _run(deck, d / "out")
 
 
@@ -208,6 +225,26 @@ def test_contact_print_of_a_rigidly_pressed_punch(punch):
     assert reaction[2] == pytest.approx(p, rel=1e-5)   # (the pressures sum to the support's reaction)
 
 
+def test_contact_print_with_sticking_friction(punch_slide):
+    """The punch pressed and slid by SLIDE along x with friction, sticking (STICK SLIDE < MU p): CDIS's tangential
+    displacement the slide along tang1 (CalculiX's first tangential axis of the normal z: x), CSTR's shear stress
+    STICK SLIDE along the slide (CalculiX's sign), CELS the normal part plus the stick spring's (STICK SLIDE)^2 area /
+    (2 STICK)."""
+    lines = punch_slide[1].splitlines()
+    cdis = _block(lines, " relative contact displacement (slave node,normal,tang1,tang2) for all contact elements and "
+                         "time 0.1000000E+01")
+    # (to the stiff base's give, 1e-5 of the slide)
+    np.testing.assert_allclose(cdis[:, 1:], np.tile([-DELTA, SLIDE, 0.0], (9, 1)), rtol=5e-5, atol=1e-4 * SLIDE)
+    e = np.pi * SIGMA_INF / K
+    p = K * DELTA * (0.5 + np.arctan(DELTA / e) / np.pi)
+    cstr = _block(lines, " contact stress (slave node,press,tang1,tang2) for all contact elements and time "
+                         "0.1000000E+01")
+    np.testing.assert_allclose(cstr[:, 1:], np.tile([p, STICK * SLIDE, 0.0], (9, 1)), rtol=5e-5, atol=1e-6 * p)
+    cels = _block(lines, " contact print energy (slave node,energy) forall contact elements and time 0.1000000E+01")
+    areas = np.array([1, 2, 1, 2, 4, 2, 1, 2, 1]) / 16.0
+    np.testing.assert_allclose(cels[:, 1], areas * (p * DELTA + STICK * SLIDE ** 2) / 2.0, rtol=1e-5)
+
+
 def test_contact_print_surface_to_surface(punch_sts):
     """Surface-to-surface: the slave faces' Gauss points are the slaves, labelled by their element and face (2 x 2 on
     each of the four faces S1: CNUM 16), the linear face-to-face law's pressure K DELTA, energy (weight) K DELTA^2 / 2
@@ -247,19 +284,24 @@ def _mask(text: str, faces: bool = False) -> str:
 
 
 @pytest.mark.skipif(shutil.which("ccx") is None, reason="CalculiX (ccx) is not installed")
-def test_against_calculix(bar, punch, punch_sts, tmp_path):
+def test_against_calculix(bar, punch, punch_slide, punch_sts, tmp_path):
     """CalculiX runs the same decks: its .dat has the same lines (headers, blank lines, columns; numbers masked; the
     surface-to-surface rows of a face taken once, as the codes' integration points differ) and the same values: the
     bar's S, E, ENER, ELSE, EVOL to 1e-6, its section force and moment to 1e-3 (CalculiX integrates its stresses
-    extrapolated to the nodes over the face), the node-to-surface punch's CDIS, CSTR, CELS, CNUM to 1e-4; the
+    extrapolated to the nodes over the face), the node-to-surface punch's CDIS, CSTR, CELS, CNUM to 1e-4, the sliding
+    one's tangential displacements and shear stresses (signs and axes) to 1e-6 and its CELS but for the stick spring's
+    energy, which CalculiX 2.20 prints twice over (its source halves it: covcontact prints the spring's energy); the
     surface-to-surface punch's clearance, pressure and energy per slave face to 1e-6 (CalculiX's 112 integration points
     against covcontact's 16: CNUM differs)."""
     survey = _survey()
+    contact = {"contact": 1e-4, "clearance": 1e-4, "contact energy": 1e-4, "total contact energy": 1e-4,
+               "contact elements": 0.0}
     for (deck, ours), tol in ((bar, {"stresses": 1e-6, "strains": 1e-6, "energy density": 1e-6, "internal energy": 1e-6,
                                      "total internal energy": 1e-6, "total volume": 1e-12, "section force": 1e-3,
                                      "section moment": 1e-3, "section area": 1e-9, "section centre": 1e-9}),
-                              (punch, {"contact": 1e-4, "clearance": 1e-4, "contact energy": 1e-4,
-                                       "total contact energy": 1e-4, "contact elements": 0.0}),
+                              (punch, contact),
+                              (punch_slide, {"contact": 1e-6, "clearance": 1e-6, "tangential": 1e-6, "slip": 1e-6,
+                                             "contact elements": 0.0}),
                               (punch_sts, {"contact": 1e-6, "clearance": 1e-6, "contact energy": 1e-6,
                                            "total contact energy": 1e-6})):
         work = tmp_path / deck.stem
@@ -269,8 +311,13 @@ def test_against_calculix(bar, punch, punch_sts, tmp_path):
         assert proc.returncode == 0, proc.stdout[-2000:]
         theirs = (work / f"{deck.stem}.dat").read_text()
         assert _mask(ours, deck is punch_sts[0]) == _mask(theirs, deck is punch_sts[0])
-
         rows = {r["kind"]: r for r in survey.compare(ours, theirs) if r["time"] == 1.0}
         for kind, limit in tol.items():
             assert kind in rows, (kind, sorted(rows))
             assert rows[kind]["rel_diff"] <= limit, rows[kind]
+        if deck is punch_slide[0]:
+            a, b = survey.dat_blocks(ours), survey.dat_blocks(theirs)
+            key = ("contact energy", "ALL", 1.0)
+            areas = np.array([1, 2, 1, 2, 4, 2, 1, 2, 1]) / 16.0
+            twice = np.array([b[key][n][0] - a[key][n][0] for n in range(1001, 1018, 2)])
+            np.testing.assert_allclose(twice, areas * STICK * SLIDE ** 2 / 2.0, rtol=1e-3)

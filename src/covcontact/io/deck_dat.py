@@ -38,7 +38,8 @@ _CONTACT_HEAD = {
     "CSTR": (" contact stress (slave node,press,tang1,tang2) for all contact elements and time",
              " contact stress (slave element+face,press,tang1,tang2) for all contact elements and time"),
     "CDIS": (" relative contact displacement (slave node,normal,tang1,tang2) for all contact elements and time",
-             " relative contact displacement (slave element+face,normal,tang1,tang2) for all contact elements and time"),
+             " relative contact displacement (slave element+face,normal,tang1,tang2) for all contact elements and "
+             "time"),
     "CELS": (" contact print energy (slave node,energy) forall contact elements and time",
              " contact print energy (slave element+face,energy)for all contact elements and time")}
 
@@ -167,7 +168,8 @@ def point_energies(solid, H: np.ndarray, state: dict) -> np.ndarray:
     Elog = np.einsum("...ia,...a,...ja->...ij", v, 0.5 * np.log(w), v)
     hist = state["hist"]
     ep = hist[..., H_EP: H_EP + 6]   # 11, 22, 33, 12, 23, 13
-    Ep = np.stack([np.stack([ep[..., 0], ep[..., 3], ep[..., 5]], -1), np.stack([ep[..., 3], ep[..., 1], ep[..., 4]], -1),
+    Ep = np.stack([np.stack([ep[..., 0], ep[..., 3], ep[..., 5]], -1),
+                   np.stack([ep[..., 3], ep[..., 1], ep[..., 4]], -1),
                    np.stack([ep[..., 5], ep[..., 4], ep[..., 2]], -1)], -2)
     Ee = Elog - Ep
     tr = np.einsum("...ii->...", Ee)
@@ -438,7 +440,7 @@ class _Now:
                         out.update(zip(labels, w[:, :, None]))
                     else:   # ELSE: the density times the Gauss points' reference volumes
                         out.update(zip(labels, np.nansum(w * blk.solid.gauss_volumes(), axis=1)[:, None]))
-            except ValueError:
+            except (ValueError, AttributeError):   # (a formulation without these Gauss-point values)
                 continue
         self._fields[var] = out
         return out
@@ -471,8 +473,9 @@ class _Now:
     # -- contact --------------------------------------------------------------------------------------------------
     def contact_rows(self) -> list[tuple]:
         """Per printed pass, per active slave in the pass's order: (kind "node" | "face", label, gap, pressure,
-        traction (t1, t2), relative tangential displacement (t1, t2), energy), the tangential axes CalculiX's of the
-        contact normal (:func:`ccx_tangents`)."""
+        shear stress (t1, t2), relative tangential displacement (t1, t2), energy), the tangential axes CalculiX's of the
+        contact normal (:func:`ccx_tangents`); the pressure is the normal force on the slave over its area, the shear
+        stress the tangential force the slave exerts (CalculiX's sign: along the slave's slip)."""
         if self._contact is not None:
             return self._contact
         from ..contact.surface import facet_frame
@@ -516,7 +519,8 @@ class _Now:
                     facet_frame(np.ascontiguousarray(ue[faces]), float(s.xi[j, 0]), float(s.xi[j, 1]), *frame)
                     rel = ue[p.slaves[j]] - frame[0]
                 energy = contact_energy(p, j, s.force[j], n, gap, float(s.multiplier[j]))
-                rows.append((key[0], key[1], gap, float(f @ n), (float(f @ e1), float(f @ e2)),
+                # (the shear stress as CalculiX prints it: the spring's force, opposite to the one on the slave)
+                rows.append((key[0], key[1], gap, float(f @ n), (-float(f @ e1), -float(f @ e2)),
                              (float(rel @ e1), float(rel @ e2)), energy))
         return rows
 

@@ -64,7 +64,8 @@ class Step:
     loads_new: set[str] = field(default_factory=set)   # "cload"/"dload" with OP=NEW in this step
     #: (nset, variables, where, totals: "NO" | "YES" | "ONLY")
     node_print: list[tuple[str, tuple[str, ...], str, str]] = field(default_factory=list)
-    el_print: list[tuple[str, tuple[str, ...], str, str]] = field(default_factory=list)  # (elset, variables, where, totals)
+    #: (elset, variables, where, totals)
+    el_print: list[tuple[str, tuple[str, ...], str, str]] = field(default_factory=list)
     contact_print: tuple[str, ...] = ()    # *CONTACT PRINT variables
     contact_card: tuple[str, str] = ("", "NO")   # where the step's *CONTACT PRINT is, its TOTALS
     #: *SECTION PRINT: (surface, NAME, variables, where)
