@@ -59,6 +59,9 @@ class Problem:
     dynamics: Dynamics | None = None  # the first stage dynamic (None: quasi-static)
     gravity: tuple[float, float, float] | None = None  # a body force rho g on every body, in full from the start
     initial_velocity: list[InitialVelocity] = field(default_factory=list)
+    #: springs and dashpots between nodes or to ground (``covcontact.elements.springs`` Spring, Dashpot)
+    springs: list = field(default_factory=list)
+    dashpots: list = field(default_factory=list)
 
     def stage_dynamics(self, index: int) -> Dynamics | None:
         """The time stepping of stage ``index`` (0: the first), None for a quasi-static stage."""

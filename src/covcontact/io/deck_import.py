@@ -23,6 +23,7 @@ from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 from .deck_coupling import DeckCouplings
 from .deck_rigid import DeckRigid
+from .deck_springs import DeckSprings
 
 _COMP = "xyz"
 
@@ -673,6 +674,7 @@ class _Writer:
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
         rigid = "".join(_table("[[rigid]]", e) for e in self.rigid.entries(self.extra_nsets, self._ref))
+        springs = "".join(_table(kind, e) for kind, e in DeckSprings(self).entries())  # (SPRINGA, ..., DASHPOTA)
         conds += "".join(_table("[[force]]", e) for e in self.couplings.entries(self.extra_nsets, self._ref))
         self.unsupported += self.rigid.unsupported
         first = self.m.steps[0]
@@ -680,7 +682,7 @@ class _Writer:
             first, self.stage_steps[0][1], self.stage_jump[0]) if first.dynamic else {})}) + self._solver()
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.out.write_text(f"# imported from {self.deck.name} by covcontact import\n" + head + bodies + rigid
-                            + contacts + conds + stages)
+                            + contacts + springs + conds + stages)
         self._write_mesh()
         labels = self.out.with_suffix(".nodes.json")
         per_body = {}

@@ -16,6 +16,7 @@ import numpy as np
 from .deck import Card, DeckError, numbers, read_deck
 from .deck_coupling import COUPLING_CARDS, read_coupling_card
 from .deck_loads import Boundary, Load, LoadCards
+from .deck_springs import BEAMS, SPRING_CARDS, SPRING_ELEMENTS, read_spring_card, read_spring_elements
 
 #: Abaqus / CalculiX element type -> (covcontact cell type, options); C3D8R is the full-integration hex8 (there is
 #: no hourglass-controlled hex8), C3D20R the reduced hex20
@@ -166,6 +167,9 @@ class _Reader(LoadCards):
             k += 1
             if c.name in _ABAQUS_ONLY:
                 m.dialect = "abaqus"
+            if c.name in SPRING_CARDS:  # (*SPRING, *DASHPOT, *MPC: deck_springs checks its own parameters)
+                read_spring_card(self, c)
+                continue
             if c.name not in SUPPORTED:
                 m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
                 continue
@@ -504,9 +508,12 @@ class _Reader(LoadCards):
 
     def _elements(self, c: Card) -> None:
         etype = c.param("TYPE", required=True).upper()
+        if etype in SPRING_ELEMENTS:  # (springs and dashpots, no solids: deck_springs)
+            read_spring_elements(self, c, etype)
+            return
         if etype not in ELEMENTS:
-            self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported (covcontact reads "
-                                      f"{', '.join(ELEMENTS)})")
+            self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported "
+                                      + BEAMS.get(etype, f"(covcontact reads {', '.join(ELEMENTS)})"))
             cont = False
             for line in c.data:  # (their labels and nodes: a surface or set on them is named as such later)
                 fields = [f.strip() for f in line.split(",") if f.strip()]

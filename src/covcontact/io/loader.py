@@ -20,6 +20,7 @@ from .dynamics_input import check_densities, read_dynamics, read_initial_velocit
 from .fields import read_steps
 from .options_input import read_output, read_solver
 from .rigid_input import check_attached, read_rigid
+from .springs_input import read_springs
 from .stage_input import named_conditions, stage
 from .validate import InputError, Section, suggest
 
@@ -39,7 +40,7 @@ def load_problem(path: str | Path) -> Problem:
 
 
 _TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "body_force", "contact",
-              "equation", "steps", "stages", "initial_velocity", "solver", "output")
+              "equation", "spring", "dashpot", "steps", "stages", "initial_velocity", "solver", "output")
 
 
 def problem_from_dict(raw: dict, path: Path) -> Problem:
@@ -66,6 +67,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     body_forces = read_body_forces(top, bodies)
     contacts = read_contacts(top, sets, rigid)
     equations = read_equations(top, sets, dirichlet)
+    springs, dashpots = read_springs(top, sets)
 
     for i, r in enumerate(rigid):
         if r.free and not r.attach and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
@@ -104,6 +106,9 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                          "[Ixx, Iyy, Izz] about its reference point in a dynamic stage", f"rigid[{i}].inertia")
     elif velocities:
         top.fail("initial velocities need a dynamic stage (procedure = \"dynamic\")", "initial_velocity")
+    if dashpots and not dynamic:
+        top.fail("dashpots act in dynamic stages only (their force is c times a velocity), and this problem has none "
+                 "(procedure = \"dynamic\")", "dashpot")
     check_attached(top, rigid, bodies, dirichlet, equations)
     solver = read_solver(top)
     output = read_output(top)
@@ -112,4 +117,4 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
                    units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity, equations=equations,
-                   body_forces=body_forces, ramp=ramp)
+                   body_forces=body_forces, ramp=ramp, springs=springs, dashpots=dashpots)

@@ -38,7 +38,8 @@ def auto_amg(problem) -> bool:
            or b.mesh.cell_type not in FACES for b in problem.bodies):
         return False
     if any(c.friction for c in problem.contacts) or any(rb.free or rb.attach for rb in problem.rigid) or _dynamic(problem) \
-            or getattr(problem, "gravity", None) is not None or getattr(problem, "equations", None):
+            or getattr(problem, "gravity", None) is not None or getattr(problem, "equations", None) \
+            or getattr(problem, "springs", None) or getattr(problem, "dashpots", None):
         return False
     on_boundary = sum(np.unique(boundary_faces(b.mesh)[0]).size for b in problem.bodies)
     return on_boundary <= AUTO_AMG_BOUNDARY * n_nodes
@@ -157,6 +158,9 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if distributes(linear) and getattr(problem, "equations", None):
         raise InputError(f"{where}: multi-point constraints ([[equation]]) are not available with the distributed "
                          f"solver {linear!r} yet; use a serial solver (--solver pardiso or superlu)")
+    if distributes(linear) and (getattr(problem, "springs", None) or getattr(problem, "dashpots", None)):
+        raise InputError(f"{where}: springs and dashpots ([[spring]], [[dashpot]]) are not available with the "
+                         f"distributed solver {linear!r} yet; use a serial solver (--solver pardiso or superlu)")
 
 
 

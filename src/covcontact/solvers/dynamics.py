@@ -124,6 +124,9 @@ class DynamicModel:
         R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=timing, raw=cons is not None)
         g, d = self.integ, committed.dynamics
         a, v, dt = self.kinematics(u, lam, committed)
+        fd = self.damping(u, v, g.gamma / (g.beta * dt), K)  # (the dashpots' forces, their tangent into K)
+        if fd is not None:
+            R = R + fd
         Rd = self.M @ ((1.0 - g.alpha_m) * a + g.alpha_m * d["a"]) + (1.0 - g.alpha_f) * R + g.alpha_f * d["r"]
         if K is not None:
             K.data *= 1.0 - g.alpha_f
@@ -143,7 +146,26 @@ class DynamicModel:
         dyn = dict(d)
         dyn.update(u=u.copy(), v=v, a=a, r=R, rd=Rd, f=f, work=np.array(work), time=np.array(float(d["time"]) + dt),
                    rc=rc, wc=np.array(wc - 0.5 * float((rc0 + rc) @ du)))
+        if fd is not None:  # (the work of the dashpots' forces on the bodies, trapezoidal: what they dissipate)
+            fd0 = d["fd"] if "fd" in d else np.zeros_like(fd)
+            dyn.update(fd=fd, wd=np.array(float(d["wd"] if "wd" in d else 0.0) + 0.5 * float((fd0 + fd) @ du)))
         return Rd, K, trial.but(dynamics=dyn)
+
+    def damping(self, u: np.ndarray, v: np.ndarray, s: float = 0.0, K=None) -> np.ndarray | None:
+        """The dashpots' forces at displacement ``u`` and velocity ``v`` (every dof), None without dashpots; with
+        ``K`` (the model's raw tangent) their tangent, with dv/du = ``s``, added into it."""
+        springs = getattr(self.model, "springs", None)
+        if springs is None or not springs.dashpots:
+            return None
+        from ..elements.springs import add_blocks
+
+        f = np.zeros(self.model.n_dofs)
+        pattern = self.model.coupling.pattern if K is not None else None
+        if K is not None and K.nnz != pattern.nnz:
+            raise ValueError("the tangent is not on the model's pattern")
+        blocks = springs.dashpot_blocks(self.model.positions(u), v.reshape(-1, 3), s, K is not None)
+        add_blocks(blocks, f, K, pattern)
+        return f
 
 
 def applied_forces(model, Rd: np.ndarray, lam: float) -> np.ndarray:
@@ -212,9 +234,13 @@ class Dynamic(QuasiStatic):
             # the last step left (with the constraint forces in it) is not that of the new equations of motion: the
             # equilibrium acceleration at the same displacement and velocity, as a dynamic step that starts
             R, _, _ = self.model.evaluate(u, state.lam, state, want_K=False, raw=True)
+            fd = self.dynamic_model.damping(u, state.dynamics["v"])
+            R = R if fd is None else R + fd
             a, Rd = self._equilibrium(R, self.model.free)
             dyn = dict(state.dynamics)
             dyn.update(a=a, r=R, rd=Rd, f=applied_forces(self.model, Rd, state.lam))
+            if fd is not None:
+                dyn["fd"] = fd
             return state.but(dynamics=dyn)
         model = self.model
         cons = getattr(model, "constraints", None)
@@ -225,11 +251,15 @@ class Dynamic(QuasiStatic):
         v[~free] = 0.0  # (a prescribed dof moves with its prescription)
         if cons is not None:  # (the eliminated dofs' velocities follow the others')
             v = cons.lift(v)
+        fd = self.dynamic_model.damping(u, v)  # (dashpots: their forces at the initial velocities)
+        R = R if fd is None else R + fd
         a, Rd = self._equilibrium(R, free)  # (Rd: the supports' forces at rest or with the initial velocities' inertia)
         rc = getattr(model, "last_contact_residual", None)
         dyn = {"u": u.copy(), "u0": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
                "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam),
                "rc": np.zeros_like(R) if rc is None else rc.copy(), "wc": np.array(0.0)}
+        if fd is not None:
+            dyn.update(fd=fd, wd=np.array(0.0))
         e = self._energies(u, state.but(dynamics=dyn))
         dyn["e0"] = np.array(e["mechanical"])
         dyn["ec0"] = np.array(e["contact"])
@@ -308,6 +338,9 @@ class Dynamic(QuasiStatic):
         d = state.dynamics
         kinetic = 0.5 * float(d["v"] @ (self.M @ d["v"]))
         strain = self.model.system.energy(u, state.elements)
+        springs = getattr(self.model, "springs", None)
+        if springs is not None:  # (the springs' stored energy)
+            strain += springs.energy(self.model.positions(u), u.reshape(-1, 3))
         contact = 0.0
         for k, p in enumerate(state.contact.passes):
             act = self.model.contact.active_mask(k, state.contact)
@@ -330,12 +363,15 @@ class Dynamic(QuasiStatic):
         # what the contact took out of the bodies and does not hold as penalty energy: the frictional dissipation
         # (and the contact law's numerical losses; a moving rigid tool's work counts against it)
         contact_loss = -float(d.get("wc", 0.0)) - (e["contact"] - float(d.get("ec0", 0.0)))
-        balance = e["mechanical"] + dissipation + contact_loss - float(d["e0"]) - float(d["work"])
+        damping = float(d["wd"]) if "wd" in d else None  # (what the dashpots dissipated)
+        balance = e["mechanical"] + dissipation + contact_loss + (damping or 0.0) - float(d["e0"]) - float(d["work"])
         scale = max(e["mechanical"], float(d["e0"]), abs(float(d["work"])), 1e-300)
         entry["time"] = float(d["time"])
         entry["energy"] = {"kinetic": e["kinetic"], "strain": e["strain"], "contact": e["contact"],
                            "external_work": float(d["work"]), "dissipation": dissipation,
                            "contact_dissipation": contact_loss, "balance_error": balance / scale}
+        if damping is not None:
+            entry["energy"]["damping"] = damping
         return entry
 
     def _reactions(self, u: np.ndarray, lam: float, state: State) -> dict:

@@ -13,6 +13,7 @@ import numpy as np
 from ..assembly.system import System
 from ..contact.assembly import CouplingPattern
 from ..contact.manager import ContactManager
+from ..elements.springs import add_blocks, spring_set
 from .stages import Loading, StagePlan
 from .state import State
 
@@ -50,6 +51,15 @@ class Model:
         self.contact = ContactManager(problem, self.system, tangent)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
         blocks = [b.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies) for b in body.mesh.blocks]
+        #: springs and dashpots (``covcontact.elements.springs``), None without: element blocks beside the bodies'
+        self.springs = spring_set(problem, self.system)
+        if self.springs is not None:  # (their node pairs join the bodies' pattern)
+            from ..assembly.pattern import Pattern
+
+            pairs = [np.array([[ref.A, ref.B] for ref in self.system.reference])] if self.system.reference else []
+            blocks = blocks + pairs + self.springs.couplings()
+            self.system.pattern = Pattern(self.system.n_nodes, blocks)
+            self.symmetric = self.symmetric and self.springs.symmetric
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
         self.stages = StagePlan(problem, self.system)
         self.constraints = self._constraints(problem)
@@ -226,6 +236,8 @@ class Model:
         self.last_contact_residual = rc
         if want_K:
             CouplingPattern.scatter(K.data, pattern, triples)
+        if self.springs is not None:
+            add_blocks(self.springs.spring_blocks(x, u.reshape(-1, 3), want_K), r, K, pattern)
         t3 = time.perf_counter()
         if timing is not None:
             timing["assembly"] += t2 - t1
