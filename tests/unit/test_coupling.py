@@ -213,12 +213,13 @@ def test_distributing_coupling_loads_the_bar_as_calculix_does(tmp_path):
     """*DISTRIBUTING 4-6 with forces along x and y and a moment about z at node 1000: the imported [[force]] entries
     (one per node of the end face) sum to the force and their moment about node 1000 is the moment (1e-9); U and RF
     within 1e-3 of CalculiX's (measured 2e-16: the same nodal loads); the clamp's reaction balances the load (force,
-    and moment at the deformed positions)."""
+    and moment at the deformed positions). Step 2's *CLOAD on the REF NODE restates the force alone: the distributed
+    loads of step 1 are replaced (CalculiX's OP=NEW in effect), the clamp holds -F alone."""
     import tomllib
 
     F, Fy, M = 10.0, 1.0, 2.0
     text = bar("*COUPLING, REF NODE=1000, SURFACE=SEND, CONSTRAINT NAME=LOAD\n*DISTRIBUTING\n4, 6",
-               step(f"*CLOAD\n1000, 1, {F}\n1000, 2, {Fy}\n1000, 6, {M}"))
+               step(f"*CLOAD\n1000, 1, {F}\n1000, 2, {Fy}\n1000, 6, {M}") + step(f"*CLOAD\n1000, 1, {F}"))
     ours, ref = run_deck(tmp_path, "dist", text)
     problem = tomllib.loads((tmp_path / "o_dist" / "deck" / "dist.toml").read_text())
     forces = [f for f in problem["force"] if f["name"].startswith("dc1n")]
@@ -232,6 +233,7 @@ def test_distributing_coupling_loads_the_bar_as_calculix_does(tmp_path):
     u = ours[("displacements", "NALL", 1.0)]
     applied = np.sum([np.cross(X[int(f["name"][4:])] + u[int(f["name"][4:])], f["value"]) for f in forces], axis=0)
     assert clamp_moment(reaction, X)[2] == pytest.approx(-applied[2], rel=1e-5)  # (about the origin)
+    assert np.abs(sum(ours[("forces", "FIX", 2.0)].values()) + [F, 0.0, 0.0]).max() < 1e-6
     assert 1000 not in ours[("displacements", "NALL", 1.0)]  # (its REF NODE has no unknowns; CalculiX prints 0)
     ref = None if ref is None else {k: {n: v for n, v in b.items() if n != 1000} for k, b in ref.items()}
     assert agree(ours, ref) <= 1e-3
