@@ -321,3 +321,40 @@ def test_against_calculix(bar, punch, punch_slide, punch_sts, tmp_path):
             areas = np.array([1, 2, 1, 2, 4, 2, 1, 2, 1]) / 16.0
             twice = np.array([b[key][n][0] - a[key][n][0] for n in range(1001, 1018, 2)])
             np.testing.assert_allclose(twice, areas * STICK * SLIDE ** 2 / 2.0, rtol=1e-3)
+
+
+def test_print_cards_read_as_calculix_reads_them(tmp_path):
+    """*SECTION PRINT and *CONTACT PRINT requests carry over to a step without their own card (as the others do), a
+    step's first card replaces them; contact variables are read by their first four letters (CDISP, CSTRESS), section
+    variables SOF, SOM, SOAREA; what is not tabulated is a note; *SECTION PRINT needs NAME=; TOTALS must be NO, YES or
+    ONLY. The labels file carries each request's place among the cards and the surfaces' faces."""
+    import json
+
+    from covcontact.io.deck import DeckError
+    from covcontact.io.deck_import import import_deck
+    from covcontact.io.deck_model import read_model
+
+    text = _bar_deck(tmp_path / "bar.inp").read_text()
+    step2 = ("*STEP, NLGEOM\n*STATIC\n0.5, 1.0\n*CONTACT PRINT\nCSTRESS, CFN\n*END STEP\n"
+             "*STEP, NLGEOM\n*STATIC\n0.5, 1.0\n*SECTION PRINT, SURFACE=MID, NAME=SP2\nSOAREA, DRAG\n*END STEP\n")
+    deck = tmp_path / "two.inp"
+    deck.write_text(text.replace("SOF, SOM\n*END STEP\n", "SOF, SOM\n*CONTACT PRINT, TOTALS=YES\nCDISP, CELS\n"
+                                 "*END STEP\n" + step2))
+    m = read_model(deck)
+    assert [[s[:3] for s in st.section_print] for st in m.steps] == [
+        [("MID", "SP1", ("SOF", "SOM"))], [("MID", "SP1", ("SOF", "SOM"))], [("MID", "SP2", ("SOAREA", "DRAG"))]]
+    assert [st.contact_print for st in m.steps] == [("CDISP", "CELS"), ("CSTRESS", "CFN"), ("CSTRESS", "CFN")]
+    assert [st.contact_card[1] for st in m.steps] == ["YES", "NO", "NO"]
+    notes = [n.split(": ", 1)[1] for n in m.notes if "not printed in the .dat" in n]
+    assert notes == ["*CONTACT PRINT CFN: not printed in the .dat (covcontact tabulates CSTR, CDIS, CELS, CNUM there)",
+                     "*SECTION PRINT DRAG: not printed in the .dat (covcontact tabulates SOF, SOM, SOAREA there)"]
+    imp = import_deck(deck, tmp_path / "d" / "two.toml")
+    info = json.loads(imp.labels.read_text())
+    assert info["surfaces"] == {"MID": [[1, 4]]}
+    orders = [[p[3] for p in info["el_print"][0]], [p[3] for p in info["node_print"][0]],
+              [p[3] for p in info["section_print"][0]], info["contact_card"][0][1]]
+    assert orders == [[1, 2, 3], [4], [5], 6]   # (the deck's order of the step's cards)
+    for bad, match in (("NAME=SP1", "missing parameter NAME="), ("TOTALS=ONLY\nRF", "TOTALS must be NO, YES or ONLY")):
+        deck.write_text(text.replace(bad, "TOTALS=ALL\nRF" if "TOTALS" in bad else "X=1"))
+        with pytest.raises(DeckError, match=match):
+            read_model(deck)
