@@ -355,6 +355,40 @@ def test_dashpots_damp_at_c_over_2m(tmp_path):
     assert energy["damping"] > 0.5 * 0.5e-6 * 0.9 and abs(energy["balance_error"]) < 1e-9
 
 
+def test_damped_run_resumes_exactly(tmp_path, monkeypatch):
+    """The state rule: a damped run stopped by a signal at its 9th time step and resumed ends where the uninterrupted
+    one ends (displacements, the dashpots' dissipation, the iterations), the springs and dashpots holding no history
+    beyond the dynamic state's velocities and dissipation."""
+    import json
+
+    from covcontact.solvers import run as run_module
+    from covcontact.solvers.signals import Interrupted
+
+    raw = _oscillator(0.02, 0.4, 0.05 * math.pi)
+    raw["output"] = {"vtu": False}  # (a checkpoint after every step)
+    problem = problem_from_dict(raw, tmp_path / "osc.toml")
+    ref = problem.run(out=tmp_path / "ref")
+    advance = run_module.Newton.advance
+    calls = {"n": 0}
+
+    def stopping(self, *args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 9:
+            raise Interrupted(15)
+        return advance(self, *args, **kwargs)
+
+    monkeypatch.setattr(run_module.Newton, "advance", stopping)
+    assert problem.run(out=tmp_path / "cut").exit_code == 143
+    monkeypatch.setattr(run_module.Newton, "advance", advance)
+    resumed = problem.run(out=tmp_path / "cut", resume=True)
+    assert resumed.exit_code == 0
+    np.testing.assert_allclose(resumed.u, ref.u, rtol=1e-10, atol=1e-14)
+    a = json.loads((tmp_path / "ref" / "summary.json").read_text())["steps"]
+    b = json.loads((tmp_path / "cut" / "summary.json").read_text())["steps"]
+    assert [s["iterations"] for s in a] == [s["iterations"] for s in b]
+    assert b[-1]["energy"]["damping"] == pytest.approx(a[-1]["energy"]["damping"], rel=1e-10)
+
+
 # ------------------------------------------------------------------------------------------------ decks
 
 def _static_deck(path: Path) -> None:
