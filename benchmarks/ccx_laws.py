@@ -2,8 +2,8 @@
 
 A punch (one C3D8, 1 x 1 x 0.5) starts at a clearance above a base (one C3D8, 2 x 2 x 1, its bottom held) and its top
 is moved down step by step, from a clearance through touching to an overclosure; the punch's face is the slave
-surface (element faces: each corner node carries a quarter of its area, as CalculiX's springs do), the base's top
-the master. Each step prints the punch top's reaction (*NODE PRINT, TOTALS=ONLY) in both codes; the table gives
+surface (element faces: each corner node carries a quarter of its area, as CalculiX's springs do; or its nodes as a
+node surface, which CalculiX weights by the area of the master face under each node), the base's top the master. Each step prints the punch top's reaction (*NODE PRINT, TOTALS=ONLY) in both codes; the table gives
 both per step and their difference relative to the largest force of the run. The steps sweep the clearance on
 both sides of zero and across c0 (the laws' reach).
 
@@ -31,6 +31,10 @@ GAP0 = 0.004  # the punch's clearance at the start
 LAWS = {
     "LINEAR n2f (K, sigma_inf, c0)": ("NODE TO SURFACE", "PRESSURE-OVERCLOSURE=LINEAR\n1.0e4, 5.0, 2.0e-3",
                                       [0.0036, 0.0039, 0.0040, 0.0041, 0.0045, 0.0050]),
+    "LINEAR n2f, node surface": ("NODE TO SURFACE*", "PRESSURE-OVERCLOSURE=LINEAR\n1.0e4, 5.0, 2.0e-3",
+                                 [0.0039, 0.0040, 0.0041, 0.0045, 0.0050]),
+    "EXPONENTIAL, node surface": ("NODE TO SURFACE*", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n1.0e-3, 20.0",
+                                  [0.0032, 0.0036, 0.0040, 0.0042]),
     "LINEAR f2f (K)": ("SURFACE TO SURFACE", "PRESSURE-OVERCLOSURE=LINEAR\n1.0e4",
                        [0.0039, 0.0041, 0.0045, 0.0050]),
     "EXPONENTIAL (c0, p0)": ("NODE TO SURFACE", "PRESSURE-OVERCLOSURE=EXPONENTIAL\n1.0e-3, 20.0",
@@ -43,7 +47,11 @@ LAWS = {
 
 
 def deck(pair: str, behavior: str, travel: list[float], gap0: float) -> str:
-    """The deck: nodes 1-8 the base, 11-18 the punch; one step per travel."""
+    """The deck: nodes 1-8 the base, 11-18 the punch; one step per travel. A pair type ending in * takes the punch's
+    bottom nodes as a node surface (no area of their own: CalculiX weights them by the master face)."""
+    slave = "2, S1"
+    if pair.endswith("*"):
+        pair, slave = pair[:-1], "NSLAV"
     base = [(0, 0, 0), (2, 0, 0), (2, 2, 0), (0, 2, 0), (0, 0, 1), (2, 0, 1), (2, 2, 1), (0, 2, 1)]
     z0 = 1.0 + gap0
     punch = [(0.5, 0.5, z0), (1.5, 0.5, z0), (1.5, 1.5, z0), (0.5, 1.5, z0),
@@ -61,8 +69,10 @@ def deck(pair: str, behavior: str, travel: list[float], gap0: float) -> str:
 15, 16, 17, 18
 *SURFACE, NAME=SMAST
 1, S2
-*SURFACE, NAME=SSLAV
-2, S1
+*NSET, NSET=NSLAV
+11, 12, 13, 14
+*SURFACE, NAME=SSLAV{", TYPE=NODE" if slave == "NSLAV" else ""}
+{slave}
 *MATERIAL, NAME=M
 *ELASTIC
 1000.0, 0.3

@@ -118,6 +118,7 @@ master = "base.zmax"
 law = "arctan"
 penalty = 1.0e6
 tension = 0.014285714285714285
+weighting = "master"
 [[dirichlet]]
 set = "base.zmin"
 components = "xyz"
@@ -182,7 +183,7 @@ def test_mapping_of_the_keywords(tmp_path):
     assert [b.mesh.n_cells for b in p.bodies] == [4, 4] and p.bodies[0].material.E == 1000.0
     c = p.contacts[0]
     assert c.slave == ("PUNCH", "SSLAV") and c.master == ("BASE", "SMAST") and c.penalty == 1.0e6
-    assert c.weighting == "nodal"  # a node surface: the law per node
+    assert c.weighting == "master"  # a node surface: the law per area of the master facet under each node
     assert {(d.body, d.set, d.components) for d in p.dirichlet} >= {("BASE", "BOTTOM", (0,)), ("PUNCH", "TOP", (2,))}
     assert [d.values for d in p.dirichlet if d.set == "TOP" and d.components == (2,)] == [(-0.02,)]
     assert p.steps.initial == 0.5

@@ -145,3 +145,23 @@ def test_rigidly_pressed_punch_carries_the_law(tmp_path, kind):
         assert force == pytest.approx(1.0 * p[0], rel=1e-6), (kind, step["contact_force"])
         if kind == "pull":
             assert p[0] < 0.0 and step["active_contacts"] == 9
+
+
+def test_master_weighting_takes_the_area_of_the_facet_under_each_node(tmp_path):
+    """weighting = "master" (a deck's node surface, as CalculiX weights it): each slave node's penalty per area times
+    the area of the master facet under it. The rigidly pressed punch's 9 nodes on base facets of (2/3)^2 carry
+    9 K d (2/3)^2; the exact tangent against differences of the residual (1e-6)."""
+    base = PUNCH.replace('weighting = "area"', 'weighting = "master"').replace("LAW", "penalty = 1.0e4")
+    text = base.replace('set = "punch.zmax"', 'set = "punch.all"').replace(
+        "E = 1000.0, nu = 0.3 }\nmesh = { generator = \"block\", lx = 2.0",
+        "E = 1.0e16, nu = 0.3 }\nmesh = { generator = \"block\", lx = 2.0")
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    for step, frac in zip(s["steps"], (0.5, 1.0)):
+        assert step["contact_force"][2] == pytest.approx(9 * 1.0e4 * 0.004 * frac * (2.0 / 3.0) ** 2, rel=1e-6)
+    path.write_text(base)
+    rep = check_tangent(load_problem(path), step=2, columns=None)
+    assert rep["converged"] and rep["relative_error"] <= 1e-6, rep["relative_error"]

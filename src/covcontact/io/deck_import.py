@@ -511,10 +511,12 @@ class _Writer:
             entry: dict = {"name": f"pair{k + 1}", "slave": self._ref(sb, sname), "master": self._ref(mb, _name(master))}
             if sts:
                 entry["type"] = "sts"
-            else:  # a node surface: the law's value per node (unit area, as CalculiX takes it); faces: per area
-                entry["weighting"] = "nodal" if sk == "NODE" else "area"
+            else:  # faces: per tributary area; a node surface: per the area of the master face under each node
+                entry["weighting"] = "master" if sk == "NODE" else "area"  # (CalculiX's spring area of such nodes)
             if kind == "TIE":  # *TIE: CalculiX writes equations; a stiff penalty tie here
                 entry.update({"law": "tied", "penalty": "auto" if sk != "NODE" else self._hard_penalty(mb)})
+                if sk == "NODE":
+                    entry["weighting"] = "nodal"
                 if ties.get(where):
                     entry["tie_tolerance"] = ties[where]
             elif it.behavior == "tied":
@@ -531,7 +533,7 @@ class _Writer:
                 if len(pts) == 2:  # (one point: constant pressure; a second point with the same makes a table)
                     entry["table"].append([pts[0] + 1.0, pts[1]])
             elif sk == "NODE":  # hard contact, node slaves: augmented Lagrange with 10 E h per node
-                entry.update({"penalty": self._hard_penalty(mb), "method": "augmented"})
+                entry.update({"penalty": self._hard_penalty(mb), "method": "augmented", "weighting": "nodal"})
             else:
                 entry.update({"penalty": "auto", "method": "augmented"})
             adjust = self.m.pair_adjust.get(where)
