@@ -118,7 +118,7 @@ master = "base.zmax"
 law = "arctan"
 penalty = 1.0e6
 tension = 0.014285714285714285
-weighting = "master"
+weighting = "boundary"
 [[dirichlet]]
 set = "base.zmin"
 components = "xyz"
@@ -183,7 +183,7 @@ def test_mapping_of_the_keywords(tmp_path):
     assert [b.mesh.n_cells for b in p.bodies] == [4, 4] and p.bodies[0].material.E == 1000.0
     c = p.contacts[0]
     assert c.slave == ("PUNCH", "SSLAV") and c.master == ("BASE", "SMAST") and c.penalty == 1.0e6
-    assert c.weighting == "master"  # a node surface: the law per area of the master facet under each node
+    assert c.weighting == "boundary"  # a node surface: the law per node area over the body's boundary faces
     assert {(d.body, d.set, d.components) for d in p.dirichlet} >= {("BASE", "BOTTOM", (0,)), ("PUNCH", "TOP", (2,))}
     assert [d.values for d in p.dirichlet if d.set == "TOP" and d.components == (2,)] == [(-0.02,)]
     assert p.steps.initial == 0.5
@@ -561,9 +561,11 @@ def test_imported_meshes_equal_their_files(tmp_path):
 
 def test_contact_print_tabulates_contact_stresses(tmp_path):
     """*CONTACT PRINT CSTRESS: a block per step end with every active slave node (the deck's labels of the punch's
-    bottom nodes), the pressure positive and summing (a node slave surface: per node, the force) to the support's
-    reaction (to the tilt of the deformed surface), the tangential tractions zero without friction (1e-9 of the pressure: the normal is the gap vector's
-    direction, also at edge and vertex points)."""
+    bottom nodes), the pressure positive, and times each node's area (a node slave surface: its area over the punch's
+    boundary faces, as CalculiX takes it: 3/16, 4/16 and 4/16 (quarters of 0.5 x 0.5 faces) at a corner, an edge and the centre
+    of the bottom) summing to the support's reaction (to the tilt of the deformed surface), the tangential tractions
+    zero without friction (1e-9 of the pressure: the normal is the gap vector's direction, also at edge and vertex
+    points)."""
     deck = two_block_deck(tmp_path / "tb.inp")
     deck.write_text(deck.read_text().replace("*NODE PRINT", "*CONTACT PRINT\nCSTRESS\n*NODE PRINT"))
     proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "out"),
@@ -584,7 +586,11 @@ def test_contact_print_tabulates_contact_stresses(tmp_path):
     support = sum(v[2] for k, v in fz.items() if k.startswith("BASE.BOTTOM"))
     # (the pressures act along the deformed surface's normals, tilted by about 1e-2: their sum is the vertical
     # reaction to 1e-4)
-    assert np.all(rows[:, 1] > 0.0) and rows[:, 1].sum() == pytest.approx(support, rel=1e-4)
+    lp, Xp, _ = _block_nodes(2, 2, 1, 1.0, 1.0, 0.5, [0.5, 0.5, 1.0], 1001)
+    xy = dict(zip(lp.tolist(), Xp[:, :2].tolist()))
+    rim = [sum(np.isclose(v, 0.5) or np.isclose(v, 1.5) for v in xy[int(lab)]) for lab in rows[:, 0]]
+    area = np.array([{2: 3.0, 1: 4.0, 0: 4.0}[r] / 16.0 for r in rim])  # (a quarter of each 0.25 face)
+    assert np.all(rows[:, 1] > 0.0) and (rows[:, 1] * area).sum() == pytest.approx(support, rel=1e-4)
     assert np.abs(rows[:, 2:]).max() < 1e-9 * rows[:, 1].max()
 
 

@@ -210,25 +210,22 @@ class PressureLaw:
         a = np.asarray(area, dtype=float)
         return np.where(a > 0.0, self.reach * np.sqrt(np.maximum(a, 0.0)), 1e-10)  # (CalculiX: 1e-10 without area)
 
-    def traction(self, g: np.ndarray, area: np.ndarray, reach_area=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def traction(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(active, sigma, dsigma/dg) per slave: sigma = -w p(-g) the signed normal force (negative in compression),
         w the area or 1; active where g is below the law's limit and the force is not zero (or, touching or
         overclosed, is zero: the slope there starts Newton from a touching state). A positive sigma pulls
-        (the arctan law's tension at a clearance). ``reach_area``: the area the reach is taken over, when it is not
-        the weight's (a node surface's slaves weighted by their master facet have none: CalculiX's 1e-10 reach)."""
+        (the arctan law's tension at a clearance)."""
         g = np.asarray(g, dtype=float)
         w = area if self.per_area else np.ones_like(g)
         gg = np.where(np.isfinite(g), g, 0.0)
         p, dp = self.pressure(gg)
-        active = np.isfinite(g) & (g < self.limit(area if reach_area is None else reach_area)) & (
-            (p != 0.0) | (gg <= 0.0))
+        active = np.isfinite(g) & (g < self.limit(area)) & ((p != 0.0) | (gg <= 0.0))
         return active, np.where(active, -w * p, 0.0), np.where(active, w * dp, 0.0)
 
-    def equivalents(self, g: np.ndarray, area: np.ndarray, reach_area=None
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def equivalents(self, g: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(active, eps', lam') of the linear law lam' + eps' g with this law's traction and slope at each gap (the
         slope at least SLOPE_FLOOR times the reference stiffness times the weight)."""
-        active, sig, dsig = self.traction(g, area, reach_area)
+        active, sig, dsig = self.traction(g, area)
         w = area if self.per_area else np.ones_like(sig)
         eps = np.maximum(dsig, SLOPE_FLOOR * self.stiffness * np.maximum(w, 1e-300))
         gg = np.where(np.isfinite(g), g, 0.0)

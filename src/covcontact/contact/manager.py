@@ -211,20 +211,14 @@ class ContactManager:
         t.hist_facet = t.facet.copy()
         nen = p.surface.nen
         nd = 3 * (nen + 1)
-        # weighting "master": each slave's penalty per area times the area of the master facet under it (CalculiX's
-        # node surfaces); else the pass's own
         eps, eps_t = p.eps, p.eps_t
-        if p.facet_weight is not None:
-            w = np.where(ok, p.facet_weight[np.where(ok, res.facet, 0)], 0.0)
-            eps, eps_t = p.eps * w, p.eps_t * w
         # the smoothed law (or a pressure-overclosure curve) as the linear one with its traction and slope at each
         # gap (the same g the kernels compute from the projection)
         if p.law is not None:
-            on, eps_s, lam_s = p.law.equivalents(np.where(ok, res.g, np.inf), p.area if p.facet_weight is None else
-                                                 w, reach_area=p.area if p.facet_weight is None else 0.0 * w)
+            on, eps_s, lam_s = p.law.equivalents(np.where(ok, res.g, np.inf), p.area)
             active = ok & on
         else:
-            active = ok & is_active(res.g, t.multiplier, np.where(eps > 0.0, eps, 1.0), p.band)
+            active = ok & is_active(res.g, t.multiplier, eps, p.band)
             eps_s, lam_s = linear_equivalents(res.g, t.multiplier, eps, p.band) if p.band != 0.0 else \
                 (eps, t.multiplier)
         facet_points = active & (res.kind == FACET)

@@ -12,14 +12,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..mesh.faces import all_boundary_faces
 from .analytic import Cylinder, Plane, Sphere
 from .element import CASES
 from .facets import patch_count, quad_patches
 from .points import VirtualPoints, gauss_points
 from .selfcontact import excluded_facets
 from .surface import MeshSurface, facet_sizes, slave_area
-from .tied import tie
 from .laws import PressureLaw
+from .tied import tie
 from .tool_profile import Profile
 
 
@@ -58,7 +59,6 @@ class Pass:
     slave_facet: np.ndarray | None = None  # sts: (ns,) each point's facet in slave_faces
     own_patch: np.ndarray | None = None    # sts self-contact: (ns,) each point's patch quadrilateral in surface
     law: object = None                     # a laws.PressureLaw evaluated in the Python layer (None: band's law)
-    facet_weight: np.ndarray | None = None  # weighting "master": the area each master facet gives a slave on it
 
     @property
     def ns(self) -> int:
@@ -166,24 +166,21 @@ def _slaves(num: Numbering, pair, faces: np.ndarray | None, nodes: np.ndarray | 
     return nodes, area, None
 
 
-def master_face_weight(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Per master face, the area CalculiX gives a slave node of a node surface (which has no area of its own) when it
-    lies on that face, from the face's area Jacobian dm at its centre: 4 dm for quadrilaterals (their area, for a
-    parallelogram), dm / 2 for tri3 (their area) and 4 dm for tri6 (8 times their area: CalculiX takes the
-    quadrilateral's formula there); straight-sided faces, in the reference configuration."""
-    c = np.asarray(X)[faces]
-    if faces.shape[1] in (3, 6):
-        dm = np.linalg.norm(np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]), axis=1)
-        return dm / 2.0 if faces.shape[1] == 3 else 4.0 * dm
-    a = -c[:, 0] + c[:, 1] + c[:, 2] - c[:, 3]   # 4 dx/dxi and 4 dx/deta at the centre (corners; VTK order)
-    b = -c[:, 0] - c[:, 1] + c[:, 2] + c[:, 3]
-    return np.linalg.norm(np.cross(a, b), axis=1) / 4.0
+def boundary_area(num: Numbering, body: str, nodes: np.ndarray) -> np.ndarray:
+    """Per node of ``nodes`` (extended ids of ``body``), its area over all the boundary faces of its body around it
+    (``slave_area`` of each face type): what CalculiX gives the nodes of a node surface (weighting "boundary")."""
+    mesh, off = num.mesh_of(body)
+    X = num.reference()
+    area = np.zeros(len(X))
+    for faces, _, _ in all_boundary_faces(mesh):
+        area += slave_area(X, faces + off)
+    return area[nodes]
 
 
 def _pressure_law(pair) -> PressureLaw | None:
     """The pair's pressure-overclosure curve evaluated in the Python layer (CalculiX's laws), or None (the kernels'
     own: penalty, smoothed penalty, Abaqus' exponential)."""
-    per_area = pair.weighting in ("area", "master") or pair.type == "sts" or pair.penalty == "auto"
+    per_area = pair.weighting in ("area", "boundary") or pair.type == "sts" or pair.penalty == "auto"
     if pair.law == "arctan":
         return PressureLaw("arctan", per_area, slope=float(pair.penalty), tension=pair.tension, reach=pair.reach)
     if pair.law == "table":
@@ -205,8 +202,14 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         slave_faces = smesh.face_sets[slave[1]] + soff if slave[1] in smesh.face_sets else None
         nodes = smesh.node_sets[slave[1]] + soff if pair.type == "nts" else None
     slaves, area, own = _slaves(num, pair, slave_faces, nodes, X)
+    if pair.weighting == "boundary":
+        area = boundary_area(num, slave[0], slaves)
     penalty = _auto_penalty(num, pair, slave, master) if pair.penalty == "auto" else pair.penalty
-    if pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
+    if pair.weighting == "boundary":
+        keep = area > 0.0
+        slaves, area = slaves[keep], area[keep]
+        eps = penalty * area
+    elif pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
         if slave_faces is None:
             raise ValueError(f"contact {pair.name}: area weighting needs a face set named {slave[1]!r}")
         if pair.type == "nts" and np.any(area <= 0.0):  # tri6 corner nodes (slave_area): no contact, as in CalculiX
@@ -254,10 +257,8 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         else:
             faces = mmesh.face_sets[master[1]] + moff
             h = float(np.mean(facet_sizes(X, faces))) / np.sqrt(2.0)
-            quads, parent = quad_patches(faces, num.points)  # tri3, tri6, quad8 facets as quadrilaterals
+            quads, _ = quad_patches(faces, num.points)  # tri3, tri6, quad8 facets as quadrilaterals
             p = Pass(name, slaves, eps, area, surface=MeshSurface(quads, n_nodes=num.n_ext + num.points.count), **kw)
-            if pair.weighting == "master":
-                p.facet_weight = master_face_weight(X, faces)[parent]
     if pair.law == "tied":
         Xe = np.vstack([X, num.points.positions(X)])
         xs = Xe[slaves] if pair.type == "sts" else X[slaves]

@@ -171,14 +171,10 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         if method == "penalty" and (gap_tol is not None or gap_rel is not None):
             c.fail("gap tolerances need method = \"augmented\"")
         given = c.has("weighting")
-        weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area", "master"))
-        if weighting == "master":
-            if ctype == "sts" or surfaces is not None or master[1] == "":
-                c.fail("weighting = \"master\" gives node-to-surface slaves the area of the meshed master facet under "
-                       "them (CalculiX's node surfaces): not for sts, self-contact or analytic masters", "weighting")
-            if method == "augmented" or penalty == "auto":
-                c.fail("weighting = \"master\" takes a penalty per area as a number, with method = \"penalty\"",
-                       "weighting")
+        weighting = c.get("weighting", "str", "nodal", choices=("nodal", "area", "boundary"))
+        if weighting == "boundary" and (ctype == "sts" or surfaces is not None):
+            c.fail("weighting = \"boundary\" gives node-to-surface slaves their area over all the boundary faces of "
+                   "their body around them (CalculiX's node surfaces): not for sts or self-contact", "weighting")
         if ctype == "sts":
             if given and weighting != "area":
                 c.fail("type = \"sts\" integrates the gap over the slave surface: its penalty is per unit area "

@@ -511,8 +511,8 @@ class _Writer:
             entry: dict = {"name": f"pair{k + 1}", "slave": self._ref(sb, sname), "master": self._ref(mb, _name(master))}
             if sts:
                 entry["type"] = "sts"
-            else:  # faces: per tributary area; a node surface: per the area of the master face under each node
-                entry["weighting"] = "master" if sk == "NODE" else "area"  # (CalculiX's spring area of such nodes)
+            else:  # faces: per tributary area; a node surface: per the node's area over its body's boundary faces
+                entry["weighting"] = "boundary" if sk == "NODE" else "area"  # (CalculiX's spring area of such nodes)
             if kind == "TIE":  # *TIE: CalculiX writes equations; a stiff penalty tie here
                 entry.update({"law": "tied", "penalty": "auto" if sk != "NODE" else self._hard_penalty(mb)})
                 if sk == "NODE":
