@@ -93,6 +93,9 @@ class StepOutcome:
     augmentation: int = 0
 
 
+#: the extrapolating predictor continues a drive (prescribed displacements, loads, rigid motions) whose increment
+#: turns from the last step's by less than 60 degrees (cosine above TURN); a drive at rest in either step is no turn
+TURN = 0.5
 #: halvings of a Newton correction whose full length inverts an element, before the increment is cut back
 MAX_BACKTRACKS = 5
 #: springs of the stabilisation of bodies held by contact alone, relative to their tangent's mean diagonal
@@ -313,8 +316,9 @@ class Newton:
 
     def _extrapolates_from(self, lam_a: float, lam_b: float) -> bool:
         """Whether the step from lam_a to lam_b starts from the extrapolating predictor (``_predict``): it
-        continues the last converged step, and the loading does not turn (no kind of drive, prescribed
-        displacements, loads or rigid motions, whose increment points against the last step's)."""
+        continues the last converged step (a cut-back attempt of a failed step too: it starts where that step
+        did), and the loading does not turn (no kind of drive, prescribed displacements, loads or rigid motions,
+        whose increment turns by more than 60 degrees from the last step's, ``TURN``)."""
         last = self._last
         if not (self.extrapolate and last is not None and lam_b > lam_a
                 and abs(last[1] - lam_a) <= 1e-14 * max(1.0, abs(lam_a)) and last[1] > last[0]):
@@ -324,7 +328,8 @@ class Newton:
             return True
         before = [b - a for a, b in zip(drive(last[0]), drive(last[1]))]
         now = [b - a for a, b in zip(drive(lam_a), drive(lam_b))]
-        return all(float(p @ q) >= 0.0 for p, q in zip(before, now))
+        return all(float(p @ q) >= TURN * float(np.linalg.norm(p)) * float(np.linalg.norm(q))
+                   for p, q in zip(before, now))
 
     def _predict(self, u: np.ndarray, lam_a: float, lam_b: float, du_d: np.ndarray) -> np.ndarray:
         """The extrapolating predictor (``predictor = "extrapolate"``, continuing a converged step): the previous
@@ -522,6 +527,7 @@ class Newton:
             extrapolated = self._extrapolates_from(lam, target)
             res, trial = self._try(u, lam, target, committed, None)
             outcomes.append(res)
+            last = self._last
             if not res.converged and extrapolated:
                 # the extrapolated start led astray: the same increment again from the tangent predictor before
                 # a cutback
@@ -529,8 +535,9 @@ class Newton:
                 self._last = None
                 res, trial = self._try(u, lam, target, committed, None)
                 outcomes.append(res)
-            # the extrapolating predictor continues from a converged step; a failed one retries without it
-            self._last = (lam, target, u - saved) if res.converged else None
+            # the extrapolating predictor continues from the last converged increment, also into the cut back
+            # attempts of a failed one (still ending where the cutback starts)
+            self._last = (lam, target, u - saved) if res.converged else last
             augment = 0
             # augmented Lagrangian: Uzawa updates at the converged state, each followed by Newton
             while res.converged and (new := self.model.augment(trial)) is not None:
