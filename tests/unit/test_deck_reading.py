@@ -9,6 +9,7 @@ from pathlib import Path
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from covcontact.io.deck import DeckError, read_deck
@@ -176,3 +177,22 @@ def test_surface_to_surface_decks_search_along_newton_corrections(tmp_path):
     assert proc.returncode == 0, proc.stderr
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert s["status"] == "completed" and sum(st["cutbacks"] for st in s["steps"]) == 0
+
+
+def test_blanks_calculix_ignores_and_c3d8i_lines_with_more_nodes(tmp_path):
+    """CalculiX drops the blanks of keyword lines: *NODEPRINT is *NODE PRINT and TIMEPOINTS= is TIME POINTS=; a C3D8I
+    line with more than its eight nodes (as CalculiX writes the nodes of its incompatible modes) takes the first
+    eight."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    deck = tmp_path / "b.inp"
+    deck.write_text(text.replace("*STEP, NLGEOM", "*TIMEPOINTS, NAME=TP\n0.4\n*STEP, NLGEOM")
+                    .replace("*NODE PRINT, NSET=BOTTOM", "*NODEPRINT, NSET=BOTTOM, TIMEPOINTS=TP"))
+    m = read_model(deck)
+    assert m.steps[0].time_points == "TP" and m.steps[0].node_print[0][0] == "BOTTOM" and m.unsupported == []
+    lines = text.split("*ELEMENT, TYPE=C3D8, ELSET=BASE\n")[1].split("*")[0].strip().splitlines()
+    extra = "\n".join(ln + ", 1, 2, 3, " for ln in lines)
+    deck.write_text(text.replace("*ELEMENT, TYPE=C3D8, ELSET=BASE\n" + "\n".join(lines),
+                                 "*ELEMENT, TYPE=C3D8I, ELSET=BASE\n" + extra))
+    m = read_model(deck)
+    ref = read_model(two_block_deck(tmp_path / "tb.inp"))
+    assert m.blocks[0][0] == "C3D8I" and np.array_equal(m.blocks[0][3], ref.blocks[0][3])

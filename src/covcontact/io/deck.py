@@ -98,18 +98,36 @@ class Card:
             raise self.fail(f"{what} must be a number, got {fields[j]!r} (field {j + 1})", k) from None
 
 
+#: keyword and parameter names of several words, by their letters alone: CalculiX drops every blank of a keyword
+#: line, so *NODEPRINT is *NODE PRINT and TIMEPOINTS= is TIME POINTS= there; they are read so here too
+_SPACED = {n.replace(" ", ""): n for n in (
+    "NODE PRINT", "EL PRINT", "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT",
+    "ELEMENT OUTPUT", "CONTACT OUTPUT", "SECTION PRINT", "SOLID SECTION", "SURFACE INTERACTION", "SURFACE BEHAVIOR",
+    "CONTACT PAIR", "END STEP", "CHANGE FRICTION", "RIGID BODY", "TIME POINTS", "REF NODE", "ROT NODE",
+    "POSITION TOLERANCE", "SMALL SLIDING", "REMOVE ALL", "TIME DELAY", "CONSTRAINT NAME", "CONTACT ELEMENTS",
+    "LAST ITERATIONS", "SECTION FORCES", "TIME INCREMENTATION", "STEP TIME", "TOTAL TIME", "NODE TO SURFACE",
+    "SURFACE TO SURFACE", "SHELL SECTION", "BEAM SECTION", "INITIAL CONDITIONS", "END PART", "END ASSEMBLY",
+    "END INSTANCE")}
+
+
+def _canonical(word: str) -> str:
+    """A keyword or parameter name upper-case with single blanks, the blanks CalculiX ignores restored."""
+    w = " ".join(word.upper().split())
+    return _SPACED.get(w.replace(" ", ""), w)
+
+
 def _params(text: str, file: Path, line: int) -> tuple[str, dict[str, str]]:
     parts = [p.strip() for p in text[1:].split(",")]
-    name = " ".join(parts[0].upper().split())
+    name = _canonical(parts[0])
     params: dict[str, str] = {}
     for p in parts[1:]:
         if not p:
             continue
         if "=" in p:
             k, v = p.split("=", 1)
-            params[" ".join(k.upper().split())] = v.strip()
+            params[_canonical(k)] = v.strip()
         else:
-            params[" ".join(p.upper().split())] = ""
+            params[_canonical(p)] = ""
     if not name:
         raise DeckError(f"{file}:{line}: a keyword line without a keyword (a lone '*')")
     return name, params

@@ -525,7 +525,18 @@ class _Reader(LoadCards):
                 cont = line.rstrip().endswith(",")
             return
         cell = ELEMENTS[etype][0]
-        a = numbers(c, 1 + NNODE[cell], f"a {etype} element (label and {NNODE[cell]} nodes)", integer=True)
+        try:
+            a = numbers(c, 1 + NNODE[cell], f"a {etype} element (label and {NNODE[cell]} nodes)", integer=True)
+        except DeckError:
+            if etype != "C3D8I":
+                raise
+            # (a C3D8I line with more than its eight nodes, as CalculiX writes them with the nodes of its incompatible
+            # modes: CalculiX reads the first eight of each line, and so does this)
+            rows = [[f for f in r if f] for r in c.rows()]
+            if not rows or any(len(r) < 9 for r in rows):
+                raise
+            a = np.array([[int(c.number(k, j, r, "a node label")) for j in range(9)] for k, r in enumerate(rows)],
+                         dtype=np.int64)
         if a.dtype != np.int64:
             if np.any(a != np.round(a)):
                 raise c.fail("element and node labels are whole numbers")
