@@ -133,6 +133,27 @@ class DistMatrix:
             np.take(data, keep, out=out)
         return out
 
+    def add_mass(self, M: sp.csr_matrix, c: float, cache: dict, scale: float = 1.0) -> DistMatrix:
+        """``scale`` K + ``c`` M in place (the tangent of a dynamic step): this rank scales its share and adds
+        the mass of its own elements (``M.local`` of a :class:`ReplicatedMass`; all of M on one rank) into its
+        body entries, so that the sum over the ranks holds the mass once. ``cache``: as for
+        ``covcontact.solvers.dynamics.add_into``."""
+        from ..solvers.dynamics import add_into
+
+        if self.eliminated:
+            raise ValueError("the mass joins a distributed tangent before its elimination")
+        local = getattr(M, "local", None)
+        if local is None:
+            if self.comm.size > 1:
+                raise ValueError("a distributed tangent needs the mass of this rank's elements "
+                                 "(DistributedSystem.mass)")
+            local = M
+        self.body.data *= scale
+        if self.contact is not None:
+            self.contact.data *= scale
+        add_into(self.body, local, c, cache)
+        return self
+
     def contact_triplets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """PETSc rows, columns and values of the contact share (may repeat entries)."""
         K = self.contact
@@ -142,6 +163,15 @@ class DistMatrix:
         rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
         t = self.layout.to_petsc
         return t[rows], t[K.indices.astype(np.int64)], K.data
+
+
+class ReplicatedMass(sp.csr_matrix):
+    """The dof mass matrix of a distributed run: the whole matrix on every rank (the vectors are replicated:
+    the dynamic residual, the energies and the start's equilibrium use it as a serial run does) and, as
+    ``local``, the mass of this rank's elements alone (couplings within its local pattern): its share of the
+    dynamic tangent."""
+
+    local: sp.csr_matrix | None = None
 
 
 class PartBody:
@@ -275,6 +305,29 @@ class DistributedSystem(System):
                 for blk, st in zip(self.blocks, state))
         return float(sum_all(self.comm, np.array([e]))[0])
 
+    def mass(self, lumped: bool = False, massless: np.ndarray | None = None, **options) -> ReplicatedMass:
+        """The whole dof mass matrix (as ``System.mass``) on every rank, with the mass of this rank's elements
+        as its ``local``. ``massless`` (a redistributed mass) is the same on every rank: the contact nodes of
+        all ranks' slaves (``covcontact.solvers.dynamics.contact_nodes`` joins them through
+        ``DistributedModel.any_over_ranks``). ``options``: those of ``System.mass`` and
+        ``covcontact.elements.mass.assemble_mass`` (element by element)."""
+        from ..elements.mass import assemble_mass, dof_matrix, element_masses
+
+        M = ReplicatedMass(super().mass(lumped, massless, **options))
+        if self.comm.size == 1:
+            M.local = M
+            return M
+        parts = []
+        for blk, body in zip(self.blocks, self.bodies.values()):
+            elements = blk.solid.elements
+            for _, idx, material, cell_type in body.material_parts(elements):
+                cells = body.mesh.cells_of(elements[idx])[1]
+                parts.append((cells + blk.offset, element_masses(cell_type, body.mesh.points, cells,
+                                                                 material.density)))
+        lump = lumped or massless is not None
+        M.local = dof_matrix(assemble_mass(self.n_nodes, parts, lump, massless, **options))
+        return M
+
     def eliminate(self, K):
         """Dirichlet elimination of a DistMatrix (in place); a scipy matrix as in the serial System."""
         if isinstance(K, DistMatrix):
@@ -308,6 +361,10 @@ class DistributedModel(Model):
         self.contact = DistributedContact(problem, self.system, tangent, comm)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
         self.stages = StagePlan(problem, self.system)
+        #: whether a stage is dynamic: ``evaluate`` then keeps the contact forces' share of the residual
+        #: (``last_contact_residual``, summed over the ranks) for the energy account
+        self.dynamic = hasattr(problem, "stage_dynamics") and any(
+            problem.stage_dynamics(k) is not None for k in range(len(problem.stages) + 1))
         self.set_stage(State([], None))
 
     @property
@@ -328,10 +385,14 @@ class DistributedModel(Model):
         r, data, etrial = self.system.local_internal(u, committed.elements, guess.elements, want_K=want_K)
         t1 = time.perf_counter()
         ev, ctrial = self.contact.evaluate(self.positions(u), lam, committed.contact, guess.contact, want_K)
-        r += ev.blocks.residual()
+        rc = ev.blocks.residual()
+        r += rc
         Kc = ev.blocks.csr() if want_K else None
         t2 = time.perf_counter()
-        r = sum_all(self.comm, r)
+        if self.dynamic:  # (the dynamic energy account reads the contact forces' share, summed alike)
+            r, self.last_contact_residual = sum_all(self.comm, np.stack([r, rc]))
+        else:
+            r = sum_all(self.comm, r)
         t3 = time.perf_counter()
         if timing is not None:
             timing["assembly"] += t1 - t0
@@ -345,6 +406,15 @@ class DistributedModel(Model):
 
     def eliminate(self, K):
         return self.system.eliminate(K)
+
+    def sum_over_ranks(self, value: float) -> float:
+        """A sum over this rank's elements or contact slaves summed over the ranks (collective)."""
+        return float(sum_all(self.comm, np.array([float(value)]))[0])
+
+    def any_over_ranks(self, mask: np.ndarray) -> np.ndarray:
+        """A boolean mask over the nodes or dofs set where any rank sets it (collective): a mask of this
+        rank's contact slaves made that of all slaves (the redistributed mass's contact nodes)."""
+        return sum_all(self.comm, np.asarray(mask, dtype=np.float64)) > 0.0
 
     def plastic_change(self, a, b) -> tuple[int, int]:
         """Summed over the ranks (collective)."""
@@ -365,4 +435,4 @@ class DistributedModel(Model):
                 "slaves": [r[2] for r in rows], "numba_threads": self.threads}
 
 
-__all__ = ["DistMatrix", "DistributedModel", "DistributedSystem", "PartBody", "Structure"]
+__all__ = ["DistMatrix", "DistributedModel", "DistributedSystem", "PartBody", "ReplicatedMass", "Structure"]

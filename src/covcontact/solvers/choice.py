@@ -136,7 +136,7 @@ def auto_line(linear: str, ranks: int, one_core_hint: bool = False, started: boo
 
 
 def _dynamic(problem) -> bool:
-    """Whether ``problem`` has a dynamic stage (serial only for now)."""
+    """Whether ``problem`` has a dynamic stage."""
     return any(problem.stage_dynamics(k) is not None for k in range(len(problem.stages) + 1))
 
 
@@ -149,12 +149,6 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if distributes(linear) and any(rb.free or rb.attach for rb in problem.rigid):
         raise InputError(f"{where}: rigid bodies with free components or attached nodes (reference nodes) are not available with "
                          f"the distributed solver {linear!r} yet; use a serial solver")
-    if distributes(linear) and getattr(problem, "gravity", None) is not None:
-        raise InputError(f"{where}: gravity is not available with the distributed solver {linear!r} yet; use a "
-                         f"serial solver (--solver pardiso or superlu)")
-    if distributes(linear) and _dynamic(problem):
-        raise InputError(f"{where}: dynamic stages are not available with the distributed solver {linear!r} yet; "
-                         f"use a serial solver (--solver pardiso or superlu)")
     if distributes(linear) and getattr(problem, "equations", None):
         raise InputError(f"{where}: multi-point constraints ([[equation]]) are not available with the distributed "
                          f"solver {linear!r} yet; use a serial solver (--solver pardiso or superlu)")

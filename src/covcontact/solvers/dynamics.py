@@ -75,9 +75,13 @@ class Integrator:
         return (1.0 - self.alpha_m) / (self.beta * dt * dt)
 
 
-def add_into(K: sp.csr_matrix, M: sp.csr_matrix, c: float, cache: dict) -> sp.csr_matrix:
-    """K + c M in K's own sparsity pattern (M's entries lie in it: the mass couples the nodes of an element, which
-    the tangent couples already); K is changed in place. ``cache`` keeps the positions for K's pattern."""
+def add_into(K: sp.csr_matrix, M: sp.csr_matrix, c: float, cache: dict, scale: float = 1.0) -> sp.csr_matrix:
+    """``scale`` K + c M in K's own sparsity pattern (M's entries lie in it: the mass couples the nodes of an element,
+    which the tangent couples already); K is changed in place. ``cache`` keeps the positions for K's pattern. A
+    distributed tangent (not a scipy matrix) adds its rank's share itself (``K.add_mass``)."""
+    if not sp.issparse(K):
+        return K.add_mass(M, c, cache, scale)
+    K.data *= scale
     key = (K.shape, K.nnz, id(K.indices), id(K.indptr))
     pos = cache.get("pos") if cache.get("key") == key else None
     if pos is None:
@@ -129,8 +133,7 @@ class DynamicModel:
             R = R + fd
         Rd = self.M @ ((1.0 - g.alpha_m) * a + g.alpha_m * d["a"]) + (1.0 - g.alpha_f) * R + g.alpha_f * d["r"]
         if K is not None:
-            K.data *= 1.0 - g.alpha_f
-            K = add_into(K, self.M, g.mass_factor(dt), self._cache)
+            K = add_into(K, self.M, g.mass_factor(dt), self._cache, scale=1.0 - g.alpha_f)
         if cons is not None:
             Rd, K = cons.transform(Rd, K)
             if K is not None and self.model.system.reference:
@@ -191,7 +194,8 @@ def contact_nodes(model) -> np.ndarray:
             nodes.append(contact.points.nodes(p.surface.faces.ravel()))
         ids = np.concatenate(nodes)
         mask[ids[ids < model.system.n_nodes]] = True
-    return mask
+    joined = getattr(model, "any_over_ranks", None)  # (a distributed model's passes hold its rank's slaves)
+    return mask if joined is None else joined(mask)
 
 
 def initial_velocity(model, problem) -> np.ndarray:
@@ -346,6 +350,8 @@ class Dynamic(QuasiStatic):
             act = self.model.contact.active_mask(k, state.contact)
             g = np.where(act, p.gap, 0.0)
             contact += 0.5 * float(np.sum(np.linalg.norm(p.force[act], axis=1) * np.abs(g[act])))
+        if hasattr(self.model, "sum_over_ranks"):  # (a distributed model's passes hold its rank's slaves)
+            contact = self.model.sum_over_ranks(contact)
         return {"kinetic": kinetic, "strain": strain, "contact": contact, "mechanical": kinetic + strain + contact}
 
     def _report(self, inc: Increment, u: np.ndarray, stats0: dict, time0: dict) -> dict:
