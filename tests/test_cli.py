@@ -316,3 +316,51 @@ def test_warmup_problems_are_quiet_and_converge(capsys):
     assert [label for label, _ in done] == [label for label, _ in PROBLEMS]
     err = capsys.readouterr().err
     assert "warning" not in err and err.count("covcontact: compiled") == len(PROBLEMS)
+
+
+RATTLE = """
+[problem]
+name = "rattle"
+procedure = "dynamic"
+dt = 0.02
+t_end = 0.3
+method = "newmark"
+mass = "consistent"
+[[bodies]]
+name = "bar"
+material = { model = "svk", E = 1.0, nu = 0.0, density = 1.0 }
+mesh = { generator = "block", lx = 1.0, ly = 0.1, lz = 0.1, nx = 50, ny = 1, nz = 1 }
+[[rigid]]
+name = "wall"
+shape = "plane"
+point = [1.0, 0.0, 0.0]
+normal = [-1.0, 0.0, 0.0]
+[[contact]]
+slave = "bar.xmax"
+master = "wall"
+penalty = 1.0e4
+weighting = "area"
+[[initial_velocity]]
+body = "bar"
+value = [0.01, 0.0, 0.0]
+[output]
+vtu = false
+"""
+
+
+def test_energy_growth_warns_and_strict_fails(tmp_path, capsys):
+    """A bar on a wall with the consistent mass chosen (tests/verification/test_bar_impact.py): the run says at its
+    start that the mass can rattle, warns once when the energy grows and completes; with --strict it ends there as
+    failed (exit 1) with the step and the growth, the converged steps kept."""
+    path = write(tmp_path, RATTLE)
+    code, _, err = run_cli(["run", path, "--out", tmp_path / "a"], capsys)
+    assert code == 0, err
+    assert "note: mass = \"consistent\" with contact" in err
+    assert err.count("warning: step") == 1 and "the bodies' energy grows" in err
+    s = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert s["status"] == "completed" and s["energy_growth"]["step"] >= 1
+    code, _, err = run_cli(["run", path, "--out", tmp_path / "b", "--strict", "--quiet"], capsys)
+    assert code == 1
+    s = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert s["status"] == "failed" and s["reason"].startswith(f"--strict: step {s['energy_growth']['step']}:")
+    assert len(s["steps"]) == s["energy_growth"]["step"]

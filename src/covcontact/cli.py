@@ -50,6 +50,9 @@ def _parser() -> argparse.ArgumentParser:
                         "petsc-gamg where auto picks it, else petsc (MUMPS), or the --solver given; 1: one "
                         "process (default auto: one rank per core where the solver auto picks petsc-gamg, else "
                         "one process)")
+    r.add_argument("--strict", action="store_true",
+                   help="a step whose energy grows beyond what was brought in (a dynamic stage's energy account) "
+                        "ends the run as failed, exit code 1, instead of a warning")
     r.add_argument("--ignore-unsupported", action="store_true",
                    help="a deck: go on without what covcontact does not support (each ignored line is listed)")
     r.add_argument("--dialect", choices=("auto", "calculix", "abaqus"), default="auto",
@@ -203,7 +206,7 @@ def _run_deck(args) -> int:
                      deck={"file": deck.name, "ignored": imported.unsupported, "notes": imported.notes})
     frd = FrdFile(imported.labels, out / f"{deck.stem}.frd")
     result = solve_problem(problem, out=out, tangent=args.tangent, quiet=args.quiet, linear=args.solver,
-                           resume=args.resume, observers=[table, frd])
+                           resume=args.resume, observers=[table, frd], strict=getattr(args, "strict", False))
     if not args.quiet:
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code
@@ -291,7 +294,7 @@ def cmd_run(args) -> int:
     if args.ranks != 1:
         return _run_ranks(args, problem, started)
     result = problem.run(out=args.out, tangent=args.tangent, quiet=args.quiet, solver=args.solver,
-                         resume=args.resume)
+                         resume=args.resume, strict=args.strict)
     if not args.quiet and result.model.is_root:  # one line from a distributed run
         print(f"results in {result.out}", file=sys.stderr)
     return result.exit_code
@@ -347,7 +350,8 @@ def _run_ranks(args, problem, started: bool = False) -> int:
     cmd += [sys.executable, "-m", "covcontact.cli", "run", str(args.problem), "--solver", solver]
     cmd += ["--out", args.out] if args.out else []
     cmd += ["--tangent", args.tangent] if args.tangent else []
-    cmd += [flag for flag, on in (("--quiet", args.quiet), ("--resume", args.resume)) if on]
+    cmd += [flag for flag, on in (("--quiet", args.quiet), ("--resume", args.resume), ("--strict", args.strict))
+            if on]
     env = environment_for_mpiexec()  # each rank takes its share of the cores (parallel.comm.share_cores)
     if started:  # the run's thread budget is shared out: NUMBA_NUM_THREADS and the like become per rank
         env.update(threads_per_rank(env, n))

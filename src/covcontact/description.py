@@ -159,6 +159,8 @@ class Steps:
 
 #: time integration methods of a dynamic stage
 DYNAMIC_METHODS = ("generalized-alpha", "hht", "newmark")
+#: mass matrices of a dynamic stage ("auto" resolves to one of the others, solvers/dynamics.py ``resolved_mass``)
+MASSES = ("auto", "consistent", "lumped", "redistributed", "consistent-redistributed")
 
 
 @dataclass
@@ -166,14 +168,15 @@ class Dynamics:
     """A dynamic stage (``procedure = "dynamic"``): time steps ``dt`` up to ``t_end`` (the stage's load factor is
     t / t_end), the integrator ``method`` with the spectral radius ``rho_inf`` at infinite frequency (1: no
     numerical damping; generalized-alpha in [0, 1], HHT in [0.5, 1]; Newmark is the trapezoidal rule), and the
-    ``mass`` matrix, "consistent", "lumped" or "redistributed" (docs/theory.md, section 20); ``dt_min`` and ``dt_max``
+    ``mass`` matrix, "auto" (redistributed with contact, else consistent), "consistent", "lumped" or "redistributed"
+    (docs/theory.md, section 20); ``dt_min`` and ``dt_max``
     make the time steps automatic (from ``dt``, on the local error estimate against ``tolerance``)."""
 
     dt: float
     t_end: float
     method: str = "generalized-alpha"
     rho_inf: float = 1.0
-    mass: str = "consistent"
+    mass: str = "auto"
     dt_min: float | None = None  # with dt_max: automatic time steps from dt (docs/theory.md, section 20)
     dt_max: float | None = None
     tolerance: float = 1e-3      # automatic time steps: the local error estimate's target, relative

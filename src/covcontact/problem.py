@@ -83,12 +83,15 @@ class Problem:
         raise KeyError(f"no deformable body named {name!r}")
 
     def run(self, out: str | Path | None = None, tangent: str | None = None, quiet: bool = True,
-            solver: str | None = None, resume: bool = False):
+            solver: str | None = None, resume: bool = False, strict: bool = False):
         """Solve the problem and write the results to ``out`` (default ``results/<name>``).
 
         ``tangent`` overrides every contact pair's tangent case; ``resume`` continues from the last
-        checkpoint in ``out`` (``covcontact.io.checkpoint.CheckpointError`` if there is none that fits).
+        checkpoint in ``out`` (``covcontact.io.checkpoint.CheckpointError`` if there is none that fits);
+        ``strict`` ends the run as failed (exit code 1) at the first step whose energy grows beyond what was brought
+        in (a dynamic stage's energy account, docs/input.md "Dynamics").
         """
         from .solvers.run import solve_problem
 
-        return solve_problem(self, out=out, tangent=tangent, quiet=quiet, linear=solver, resume=resume)
+        return solve_problem(self, out=out, tangent=tangent, quiet=quiet, linear=solver, resume=resume,
+                            strict=strict)

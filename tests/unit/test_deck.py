@@ -285,15 +285,16 @@ def test_mapping_of_laws_materials_and_loads(tmp_path):
 
 
 def test_dynamic_steps(tmp_path):
-    """*DYNAMIC (ALPHA, increment, period) becomes a dynamic stage with HHT, rho_inf = (1 + alpha) / (1 - alpha); a
-    deck without *DENSITY is then refused naming the density."""
+    """*DYNAMIC (ALPHA, increment, period) becomes a dynamic stage with HHT, rho_inf = (1 + alpha) / (1 - alpha) and
+    CalculiX's consistent mass of implicit dynamics (its manual: lumped only with EXPLICIT); a deck without *DENSITY
+    is then refused naming the density."""
     text = two_block_deck(tmp_path / "tb.inp").read_text().replace("*STATIC\n0.5, 1.0\n",
                                                                     "*DYNAMIC, ALPHA=-0.1\n0.05, 0.5, 0.01, 0.1\n")
     deck = tmp_path / "dyn.inp"
     deck.write_text(text.replace("1000.0, 0.3\n", "1000.0, 0.3\n*DENSITY\n1.0\n"))
     p = load_problem(import_deck(deck, tmp_path / "d" / "p.toml").problem)
     d = p.dynamics
-    assert (d.method, d.dt, d.t_end, d.dt_min, d.dt_max) == ("hht", 0.05, 0.5, 0.01, 0.1)
+    assert (d.method, d.dt, d.t_end, d.dt_min, d.dt_max, d.mass) == ("hht", 0.05, 0.5, 0.01, 0.1, "consistent")
     assert d.rho_inf == pytest.approx(0.9 / 1.1)
     deck.write_text(text)
     with pytest.raises(InputError, match="density"):

@@ -63,5 +63,6 @@ def test_a_good_file_loads(tmp_path):
     path.write_text(BASE)
     prob = load_problem(path)
     assert prob.dynamics.dt == 0.1 and prob.dynamics.method == "generalized-alpha"
+    assert prob.dynamics.mass == "auto"  # (consistent-redistributed with contact, consistent without)
     assert len(prob.steps.factors) == 10 and prob.steps.factors[-1] == 1.0
     assert prob.initial_velocity[0].value == (0.0, 0.0, 0.1)

@@ -52,3 +52,23 @@ def test_redistribution_keeps_each_element_mass():
     np.testing.assert_allclose(r.sum(axis=1), d.sum(axis=1), rtol=1e-14)
     assert np.all(r[massless[m.cells]] == 0.0)
     np.testing.assert_array_equal(r[0], d[0])  # the element without contact nodes is untouched
+
+
+def test_consistent_redistributed_mass():
+    """``consistent_interior``: the elements with a massless node lumped and redistributed, the others consistent;
+    the body's mass kept (rho V = 3), the massless nodes' rows empty."""
+    from covcontact.elements.mass import assemble_mass
+
+    m = block(3.0, 1.0, 1.0, 3, 1, 1, "hex8")
+    Me = element_masses("hex8", m.points, m.cells, 1.0)
+    massless = np.zeros(m.n_nodes, dtype=bool)
+    massless[m.node_sets["xmax"]] = True
+    M = assemble_mass(m.n_nodes, [(m.cells, Me)], True, massless, consistent_interior=True).toarray()
+    assert M.sum() == pytest.approx(3.0, rel=1e-14)
+    assert np.all(M[massless] == 0.0) and np.all(M[:, massless] == 0.0)
+    touch = massless[m.cells].any(axis=1)
+    inner = np.flatnonzero(~touch)
+    only = assemble_mass(m.n_nodes, [(m.cells[inner], Me[inner])], False).toarray()
+    edge = assemble_mass(m.n_nodes, [(m.cells[touch], Me[touch])], True, massless).toarray()
+    np.testing.assert_allclose(M, only + edge, rtol=1e-14)
+    assert np.count_nonzero(only - np.diag(np.diag(only))) > 0  # (the interior is not lumped)

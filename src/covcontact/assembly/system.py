@@ -156,9 +156,10 @@ class System:
         self._build_loads()
         self._build_dirichlet()
 
-    def mass(self, lumped: bool = False, massless: np.ndarray | None = None):
+    def mass(self, lumped: bool = False, massless: np.ndarray | None = None, consistent_interior: bool = False):
         """The dof mass matrix (n_dofs, n_dofs) of the deformable bodies, consistent or HRZ-lumped
-        (``covcontact.elements.mass``), lumped with the ``massless`` nodes' mass redistributed when given; zero rows at
+        (``covcontact.elements.mass``), lumped with the ``massless`` nodes' mass redistributed when given (with
+        ``consistent_interior`` only in the elements that have a massless node, consistent elsewhere); zero rows at
         reference nodes. A material without density is a ValueError."""
         from ..elements.mass import assemble_mass, dof_matrix, element_masses
 
@@ -170,7 +171,8 @@ class System:
                     raise ValueError(f"body {body.name!r}: its material has no density (needed for the mass)")
                 cells = body.mesh.cells_of(idx)[1]
                 parts.append((cells + blk.offset, element_masses(cell_type, body.mesh.points, cells, rho)))
-        M = dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless))
+        M = dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless,
+                                     consistent_interior))
         if self.reference:  # rigid bodies with free components: mass on A, rotary inertia on B (small rotations)
             diag = np.zeros(self.n_dofs)
             for ref in self.reference:

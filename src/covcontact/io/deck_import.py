@@ -390,8 +390,9 @@ class _Writer:
 
     def _timing(self, step, duration: float, jump: bool = False) -> dict:
         """The steps (``steps``) of a stage that makes ``duration`` of the deck's step or, for *DYNAMIC, its dynamic
-        keys: HHT with rho_inf = (1 + alpha) / (1 - alpha), the deck's increment as dt (automatic within its min and
-        max unless DIRECT)."""
+        keys: HHT with rho_inf = (1 + alpha) / (1 - alpha), CalculiX's consistent mass of implicit dynamics (with contact
+        the run says that it can rattle, see docs/input.md "Dynamics"), the deck's increment as dt (automatic within
+        its min and max unless DIRECT)."""
         a, _, lo, hi = step.increments
         if not step.dynamic:
             if step.direct:
@@ -403,7 +404,7 @@ class _Writer:
                 out["max"] = min(1.0, hi / duration)
             return {"steps": out}
         out = {"procedure": "dynamic", "dt": min(a, duration), "t_end": duration, "method": "hht",
-               "rho_inf": (1.0 + step.alpha) / (1.0 - step.alpha)}
+               "rho_inf": (1.0 + step.alpha) / (1.0 - step.alpha), "mass": "consistent"}
         if jump:
             out["ramp"] = False
         if not step.direct and lo and hi:

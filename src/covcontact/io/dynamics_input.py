@@ -4,7 +4,7 @@
 
 from __future__ import annotations
 
-from ..description import DYNAMIC_METHODS, Dynamics, InitialVelocity
+from ..description import DYNAMIC_METHODS, MASSES, Dynamics, InitialVelocity
 from .validate import Section
 
 #: the keys of a dynamic stage besides ``procedure``
@@ -33,7 +33,7 @@ def read_dynamics(sec: Section) -> Dynamics | None:
     lo = 0.5 if method == "hht" else 0.0
     if not lo <= rho <= 1.0:
         sec.fail(f"must lie in [{lo:g}, 1] for method = \"{method}\", got {rho:g}", "rho_inf")
-    mass = sec.get("mass", "str", "consistent", choices=("consistent", "lumped", "redistributed"))
+    mass = sec.get("mass", "str", "auto", choices=MASSES)
     auto = [k for k in ("dt_min", "dt_max") if sec.has(k)]
     if len(auto) == 1:
         sec.fail(f"automatic time steps need both dt_min and dt_max (and dt, the first step); add "

@@ -42,6 +42,9 @@ class Summary(Observer):
             self.data["warnings"] = list(run.warnings)
 
     def stage_entered(self, run, procedure, entering: bool) -> None:
+        mass = getattr(procedure, "mass", None)
+        if mass is not None:  # (a dynamic stage: the mass matrix it resolved, "auto" made explicit)
+            self.data.setdefault("mass", {})[procedure.spec.name] = mass
         if not procedure.staged:
             return
         spec = procedure.spec
@@ -65,6 +68,10 @@ class Summary(Observer):
 
     def increment_converged(self, run, inc) -> None:
         self._add(inc)
+        growth = inc.entry.get("energy_warning")
+        if growth is not None and "energy_growth" not in self.data:  # (the first one of the run)
+            self.data["energy_growth"] = {"step": inc.step, "time": inc.entry.get("time"), "message": growth}
+            self.data.setdefault("warnings", []).append(f"step {inc.step}: {growth}")
         self.data["wall_time_s"] = self.t_before + time.perf_counter() - run.t_start
         self._write()
 
@@ -268,12 +275,21 @@ class Progress(Observer):
                  always=True)
 
     def stage_entered(self, run, procedure, entering: bool) -> None:
+        for note in getattr(procedure, "notes", ()):
+            self.say(f"note: {note}")
         if entering:
             spec = procedure.spec
             self.say(f"stage {spec.index + 1}/{run.n_stages} {spec.name!r}"
                      + (f": releasing {', '.join(spec.release_names)}" if spec.release_names else ""))
 
     def increment_converged(self, run, inc) -> None:
+        growth = inc.entry.get("energy_warning")
+        if growth is not None and not getattr(run, "energy_said", False):  # (said once per run, even with --quiet)
+            run.energy_said = True
+            self.say(f"warning: step {inc.step}: {growth}", always=True)
+        self._step_line(run, inc)
+
+    def _step_line(self, run, inc) -> None:
         if self.quiet:
             return
         # computed on every rank of a distributed run alike (the count is collective), printed by the first
@@ -288,7 +304,7 @@ class Progress(Observer):
 
     def increment_failed(self, run, inc) -> None:
         if not self.quiet:
-            self.increment_converged(run, inc)
+            self._step_line(run, inc)
         else:  # --quiet silences the progress, never why a run failed
             self.say(f"step {inc.step} (load factor {inc.lam:.4g}) failed after {inc.cutbacks} cutbacks: {inc.why}",
                      always=True)

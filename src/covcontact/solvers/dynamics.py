@@ -185,10 +185,15 @@ def applied_forces(model, Rd: np.ndarray, lam: float) -> np.ndarray:
 
 def contact_nodes(model) -> np.ndarray:
     """Mask over the system's nodes of the deformable nodes on a contact surface: every slave node (the facet nodes of
-    segment-to-surface points) and every node of a mesh master surface (patch points resolved to their nodes)."""
+    segment-to-surface points) and every node of a mesh master surface (patch points resolved to their nodes); tied
+    pairs left out (their surfaces never part, so they cannot rattle)."""
     mask = np.zeros(model.system.n_nodes, dtype=bool)
-    contact = model.contact
+    contact = getattr(model, "contact", None)
+    if contact is None:
+        return mask
     for p in contact.passes:
+        if getattr(p, "tied", False):
+            continue
         nodes = [contact.points.nodes(p.slaves)]
         if p.surface is not None:
             nodes.append(contact.points.nodes(p.surface.faces.ravel()))
@@ -196,6 +201,31 @@ def contact_nodes(model) -> np.ndarray:
         mask[ids[ids < model.system.n_nodes]] = True
     joined = getattr(model, "any_over_ranks", None)  # (a distributed model's passes hold its rank's slaves)
     return mask if joined is None else joined(mask)
+
+
+def resolved_mass(mass: str, massless: np.ndarray) -> str:
+    """The mass matrix of a stage that asks for ``mass``: ``"auto"`` is the consistent redistributed mass where
+    deformable nodes lie on a contact surface (``massless``, :func:`contact_nodes`), the consistent mass elsewhere
+    (docs/theory.md, section 20: the contact boundary without inertia cannot rattle, so the contact cannot add
+    energy; the consistent mass of the interior rings less after an impact than the lumped one)."""
+    if mass != "auto":
+        return mass
+    return "consistent-redistributed" if np.any(massless) else "consistent"
+
+
+def _tools_still(model, spec) -> bool:
+    """Whether no rigid body's motion changes over the stage ``spec`` (its start and end load factors)."""
+    drive = getattr(model, "drive", None)
+    if drive is None:
+        return True
+    a, b = drive(0.0)[2], drive(spec.lam_end)[2]
+    return a.size == 0 or bool(np.allclose(a, b, rtol=0.0, atol=1e-14 * max(1.0, float(np.abs(a).max()))))
+
+
+#: the mass matrices without inertia on the contact surfaces
+REDISTRIBUTED = ("redistributed", "consistent-redistributed")
+#: an energy growth of the bodies beyond this share of the energy in the system is said (``Dynamic._growth``)
+GROWTH = 0.01
 
 
 def initial_velocity(model, problem) -> np.ndarray:
@@ -220,8 +250,19 @@ class Dynamic(QuasiStatic):
         super().__init__(model, newton, spec, t_stage, staged, control)
         self.dyn, self.problem, self.t_start = dyn, problem, float(t_start)
         self.integrator = Integrator.of(dyn.method, dyn.rho_inf)
-        self.M = model.system.mass(lumped=dyn.mass == "lumped",
-                                   massless=contact_nodes(model) if dyn.mass == "redistributed" else None)
+        massless = contact_nodes(model)
+        self.mass = resolved_mass(dyn.mass, massless)
+        massless_here = massless if self.mass in REDISTRIBUTED else None
+        self.M = model.system.mass(lumped=self.mass == "lumped", massless=massless_here,
+                                   consistent_interior=self.mass == "consistent-redistributed")
+        #: the tools (rigid masters) stand still over the stage: the contact's account then holds no tool work
+        self.tools_still = _tools_still(model, spec)
+        self.energy_warning: str | None = None  # the stage's energy growth, said once (``_growth``)
+        #: what the stage's choices do to the energy, said at its start
+        self.notes = [] if self.mass in REDISTRIBUTED or not np.any(massless) else [
+            f'mass = "{self.mass}" with contact: the contact nodes keep their inertia, so a flat impact can rattle '
+            f'(open and close between steps) and gain energy; the run warns if it does; mass = '
+            f'"consistent-redistributed" (the default with contact) keeps the energy']
         self.dynamic_model = DynamicModel(model, self.M, self.integrator, dyn.t_end)
 
     def start(self, state: State, u: np.ndarray | None = None) -> State:
@@ -378,7 +419,32 @@ class Dynamic(QuasiStatic):
                            "contact_dissipation": contact_loss, "balance_error": balance / scale}
         if damping is not None:
             entry["energy"]["damping"] = damping
+        growth = self._growth(entry["energy"], e["mechanical"], d)
+        if growth is not None and self.energy_warning is None:
+            self.energy_warning = growth
+            entry["energy_warning"] = growth
         return entry
+
+    def _growth(self, energy: dict, mechanical: float, d: dict) -> str | None:
+        """Why the bodies' energy grows beyond what was brought in, None where it does not: the contact gave back
+        more than it took (``contact_dissipation`` below -GROWTH of the energy in the system; judged only while the
+        stage's rigid tools stand still, as a moving tool's work is part of that account) or the balance gains more
+        than GROWTH. The likely cause and its fix with it."""
+        system = max(mechanical, float(d["e0"]), abs(float(d["work"])), 1e-300)
+        gained = -energy["contact_dissipation"] / system if self.tools_still else 0.0
+        if gained > GROWTH:
+            cause = (f"the contact gave the bodies {gained:.1%} of their energy (contact_dissipation "
+                     f"{energy['contact_dissipation']:.4g})")
+        elif energy["balance_error"] > GROWTH:
+            cause = f"the energy balance gained {energy['balance_error']:.1%}"
+        else:
+            return None
+        if self.mass not in REDISTRIBUTED and np.any(contact_nodes(self.model)):
+            fix = (f'the contact surfaces rattle with mass = "{self.mass}" (the contact opens and closes between '
+                   f'steps): mass = "consistent-redistributed" (the default with contact) keeps the energy')
+        else:
+            fix = "shorter time steps (dt) or numerical damping (rho_inf below 1) may help"
+        return f"the bodies' energy grows: {cause}; {fix}"
 
     def _reactions(self, u: np.ndarray, lam: float, state: State) -> dict:
         """The supports' resultant forces with the inertia: the step's dynamic residual on their dofs."""

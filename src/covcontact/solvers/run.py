@@ -83,7 +83,7 @@ def _tangent_name(problem, tangent: str | None) -> str:
 
 
 def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resume=False,
-                  observers=()) -> Result:
+                  observers=(), strict: bool = False) -> Result:
     """Solve ``problem`` and write its results; see ``Problem.run``.
 
     With a distributing backend (``petsc``, ``petsc-gamg``) every MPI rank runs this function; only
@@ -102,6 +102,7 @@ def solve_problem(problem, out=None, tangent=None, quiet=True, linear=None, resu
         if linear != requested and not quiet and model.is_root:
             print(auto_line(linear, model.size, numba.get_num_threads() > 1), file=sys.stderr, flush=True)
         run = Run(problem, model, out, tangent, quiet, linear, t_start, strategy, list(observers))
+        run.strict = strict
         return strategy.execute(model, lambda: run.execute(resume))
 
 
@@ -128,6 +129,7 @@ class Run:
         self.summary_timing: dict = {}
         self.total_time = 0.0
         self.stop_status: str | None = None  # set by an observer to end the run after the current step
+        self.strict = False  # the first step whose energy grows ends the run as failed (``--strict``)
         self.control_state: dict = {}  # the increment control's state of a resumed stage (from the checkpoint)
         #: why a failed run failed (summary.json: ``reason``, ``failed_step`` or ``error``; ``last_converged``)
         self.failure: dict | None = None
@@ -267,6 +269,10 @@ class Run:
                         return "failed"
                     self.state = inc.state
                     self.emit("increment_converged", inc)
+                    growth = inc.entry.get("energy_warning")
+                    if self.strict and growth is not None:  # (the step is kept: it converged)
+                        self.failure = {"reason": f"--strict: step {inc.step}: {growth}"}
+                        return "failed"
                 stops.poll()
                 if self.stop_status is not None:
                     return self.stop_status
