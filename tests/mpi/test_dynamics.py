@@ -85,7 +85,7 @@ components = "y"
 vtu = false
 """
 
-#: the agreement asked for: solver tolerance (measured: 1e-10 to 2e-10 relative, see the tests)
+#: the agreement asked for: solver tolerance (measured: at most 2e-10 relative, see the tests)
 TOL = 1e-8
 
 
@@ -162,8 +162,8 @@ def _compare(tmp_path: Path, text: str, name: str) -> tuple[dict, dict]:
 
 def test_bar_on_a_rigid_wall_two_ranks(tmp_path):
     """The wall impact with the redistributed mass: one rank holds no contact slave, yet both take the mass off the
-    contact nodes. Measured against serial: energies within 5e-11 of the largest, displacements 4e-11, velocities
-    1.1e-10, accelerations 2.5e-12 (relative to their largest)."""
+    contact nodes. Measured against serial: energies within 5e-11 of the largest, displacements 1.6e-10, velocities
+    1.1e-10, accelerations 2.3e-12 (relative to their largest)."""
     ref, summary = _compare(tmp_path, WALL, "wall")
     assert 0 in summary["parallel"]["slaves"]  # (the partition cuts across the bar: the wall end on one rank)
     active = np.array([s["active_contacts"] > 0 for s in summary["steps"]])
@@ -178,8 +178,9 @@ def test_bar_on_a_rigid_wall_two_ranks(tmp_path):
 def test_block_falls_under_gravity_two_ranks(tmp_path, method, steps):
     """The weight assembled once over the ranks: before the landing the block falls freely (kinetic energy m (g t)^2
     / 2 = the work of its weight); then it bounces off the plane as in the serial run, with automatic time steps
-    the same steps. Measured against serial: energies within 1e-10 of the largest, displacements 5e-11, velocities
-    1e-10 to 2e-10; with automatic steps the step times to 2e-15."""
+    the same steps. Measured against serial (relative to the largest): generalized-alpha energies 1e-10,
+    displacements 5e-11, velocities 1.8e-10; HHT with automatic steps (13 of them) energies 3e-13, displacements
+    7e-13, velocities 4e-12, the step times to 1e-15."""
     t_end = "0.2" if steps else "0.3"
     ref, summary = _compare(tmp_path, FALL.replace("METHOD", method + "\n" + steps).replace("T_END", t_end), "fall")
     first = summary["steps"][0]
