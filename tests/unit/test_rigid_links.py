@@ -165,6 +165,40 @@ def test_attached_input_errors(tmp_path):
         assert words in str(err.value) and "\n" not in str(err.value), (words, str(err.value))
 
 
+def test_total_stage_motion_turns_to_the_total_rotation_vector(tmp_path):
+    """A stage motion with ``total = true``: its rotation is the body's total rotation vector, reached linearly from
+    the one the stage starts with (CalculiX's rotational node), where the default composes the stage's rotation onto
+    the pose reached. A free bar hanging from the cap turned to 1.0 e_z, then (total) to 0.8 (1, 1, 1): every node at
+    c + R(theta)(X - c) (closed form, Rodrigues) to 1e-8, the cap's rotation vector 0.8 (1, 1, 1) to 1e-12; halfway
+    through the stage the motion's vector is the mean of the two. ``total`` with ``path`` is a one-line error."""
+    from covcontact.motion import RigidMotion, StagedMotion
+
+    c = [0.5, 0.5, 2.0]
+    theta1, theta2 = np.array([0.0, 0.0, 1.0]), np.array([0.8, 0.8, 0.8])
+    text = BAR.replace("MATERIAL", SVK).replace("RIGID", f"motion = {{ rotation = {theta1.tolist()}, center = {c} }}")
+    text = text.replace('[[dirichlet]]\nset = "bar.zmin"\ncomponents = "xyz"\n', "")
+    text += (f'[[stages]]\nname = "turn"\nsteps = {{ count = 4 }}\n'
+             f'motions = {{ cap = {{ rotation = {theta2.tolist()}, center = {c}, total = true }} }}\n')
+    path = tmp_path / "total.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0
+    X = load_problem(path).bodies[0].mesh.points
+    x = X + res.u.reshape(-1, 3)[: len(X)]
+    np.testing.assert_allclose(x, c + (X - c) @ rotation_matrix(theta2).T, rtol=0.0, atol=1e-8)
+    np.testing.assert_allclose(res.summary["steps"][-1]["rigid_bodies"]["cap"]["rotation"], theta2, atol=1e-12)
+    first = RigidMotion(rotation=theta1, center=c)
+    staged = StagedMotion(RigidMotion(rotation=theta2, center=c, total=True), *first.state(1.0))
+    np.testing.assert_allclose(staged.rotation_vector(0.5), 0.5 * (theta1 + theta2), rtol=0.0, atol=1e-15)
+    np.testing.assert_allclose(staged.matrix(0.5), rotation_matrix(0.5 * (theta1 + theta2)), atol=1e-15)
+    composed = StagedMotion(RigidMotion(rotation=theta2 - theta1, center=c), *first.state(1.0))
+    assert np.abs(composed.matrix(1.0) - rotation_matrix(theta2)).max() > 0.1   # (the default: not the same)
+    path.write_text(text.replace("total = true", "total = true, path = [[0.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 1.0]]"))
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert "not as a path" in str(err.value) and "\n" not in str(err.value)
+
+
 # ------------------------------------------------------------------------------------------------ decks
 
 def _bar_deck(path, steps: str, rigid: str = "*RIGID BODY, NSET=TOP, REF NODE=1000, ROT NODE=1001") -> None:

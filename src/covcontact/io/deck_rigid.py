@@ -5,7 +5,9 @@ its REF NODE; the REF NODE's dofs 1-3 are the body's translation and the ROT NOD
 (CalculiX's convention), as are the REF NODE's dofs 4-6 (Abaqus'; ``covcontact.io.deck_coupling``, which also adds
 the *KINEMATIC couplings as such bodies). A *BOUNDARY on either node prescribes that component (the body's
 ``motion``, a stage's ``motions``), a *CLOAD on it applies the body's force or moment; the components never
-prescribed are ``free``.
+prescribed are ``free``. A prescribed value is the node's total displacement, the rotation vector the body's total
+rotation R(theta) about the REF NODE, each going linearly over a step from the value the step starts with (as
+CalculiX's rotational node means it): a later stage's motion is a ``total`` one.
 """
 
 from __future__ import annotations
@@ -57,8 +59,9 @@ class DeckRigid:
         return labels[~hit], [self.by_label[int(lab)] for lab in labels[hit]]
 
     def stage(self, values: dict, loads: dict) -> tuple[dict, dict]:
-        """Record a stage's prescribed values and loads; for a stage after the first its ``motions`` (the change of
-        the prescribed components over it) and rigid ``targets`` (new force and moment)."""
+        """Record a stage's prescribed values and loads; for a stage after the first its ``motions`` (``total``
+        ones: the prescribed displacement and rotation vector at its end) and rigid ``targets`` (new force and
+        moment)."""
         self.stage_values.append(values)
         self.stage_loads.append(loads)
         if len(self.stage_values) == 1:
@@ -68,9 +71,12 @@ class DeckRigid:
         for r, name in enumerate(self.names):
             comps = {c for (q, c) in values if q == r}
             if comps:
-                d = [values.get((r, c), 0.0) - prev_v.get((r, c), 0.0) for c in range(6)]
-                if any(d):
-                    motions[name] = {"translation": d[:3], "rotation": d[3:], "center": self.origins[r].tolist()}
+                v = [values.get((r, c), 0.0) for c in range(6)]
+                if v != [prev_v.get((r, c), 0.0) for c in range(6)]:
+                    # (the total rotation vector, not its change composed onto the rotation reached: the two differ
+                    # once the axis turns)
+                    motions[name] = {"translation": v[:3], "rotation": v[3:], "center": self.origins[r].tolist(),
+                                     "total": True}
             new = [0.0 if c in self.idle.get(r, ()) else loads.get((r, c), 0.0) for c in range(6)]
             if new != [prev_l.get((r, c), 0.0) for c in range(6)]:
                 targets[name] = {"force": new[:3], "moment": new[3:]}

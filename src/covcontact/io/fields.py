@@ -13,7 +13,7 @@ from .validate import Section
 
 
 def read_motion(sec: Section | None) -> RigidMotion:
-    """A ``motion = { translation, rotation, center, path }`` table (none: standing still)."""
+    """A ``motion = { translation, rotation, center, path, total }`` table (none: standing still)."""
     if sec is None:
         return RigidMotion()
     translation = sec.get("translation", "vector", (0.0, 0.0, 0.0))
@@ -29,9 +29,10 @@ def read_motion(sec: Section | None) -> RigidMotion:
         if not ok:
             sec.fail("must be an array of rows [lam, tx, ty, tz]", "path")
         path = raw
+    total = sec.get("total", "bool", False)
     sec.done()
     try:
-        return RigidMotion(translation=translation, rotation=rotation, center=center, path=path)
+        return RigidMotion(translation=translation, rotation=rotation, center=center, path=path, total=total)
     except ValueError as exc:
         sec.fail(str(exc), "path" if path is not None else None)
 

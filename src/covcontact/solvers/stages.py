@@ -52,11 +52,9 @@ class _Condition:
 
     def values(self, X: np.ndarray, lam: float) -> np.ndarray:
         """Prescribed displacement of ``dofs`` at lam (X: reference positions of all nodes)."""
-        if self.rigid is not None:  # a reference node pair: translation and rotation vector of the motion
-            from ..contact.reference import rotation_vector
-
+        if self.rigid is not None:  # a reference node pair: translation and (total) rotation vector of the motion
             t = self.motion.apply(self.rigid.origin, lam) - self.rigid.origin
-            q = np.concatenate([t, rotation_vector(self.motion.matrix(lam))])
+            q = np.concatenate([t, self.motion.rotation_vector(lam)])
             return q[list(self.components)]
         if self.motion is None:
             v = self.start + lam * (self.target - self.start)
@@ -66,12 +64,13 @@ class _Condition:
 
     def end(self, lam_end: float) -> tuple:
         """(start value, pose) this condition leaves for the next stage (a condition from the state: its target,
-        reached at the end of the stage, or None while it holds the state's values)."""
+        reached at the end of the stage, or None while it holds the state's values); the pose as (Q, b, total
+        rotation vector)."""
         if self.from_state:
             return (None if self.held else self.target), None
         if self.motion is None:
             return self.start + lam_end * (self.target - self.start), None
-        return None, self.motion.pose(lam_end)
+        return None, self.motion.state(lam_end)
 
 
 @dataclass
@@ -94,7 +93,7 @@ class StageSpec:
     #: found them (nothing else would restrain them)
     parked: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64), repr=False)
     parked_names: tuple[str, ...] = ()
-    #: parked dofs moved by a motion this stage gives their body: (dofs, RigidMotion, components 0..2)
+    #: parked dofs moved by a motion this stage gives their body: (dofs, StagedMotion, components 0..2)
     parked_moves: list = field(default_factory=list, repr=False)
     #: contact pairs released at the start of this stage: switched off, their forces ramped to zero
     released_pairs: tuple[str, ...] = ()
@@ -175,7 +174,7 @@ class StagePlan:
                                                    values[key].shape).astype(float)
             new_motions = {}
             for name, m in prev.motions.items():
-                pose = m.pose(lam_end)
+                pose = m.state(lam_end)
                 nm = st.motions.get(name)
                 new_motions[name] = StagedMotion(nm, *pose) if nm is not None else StagedMotion.hold(*pose)
             new_contacts = dict(prev.contacts)
@@ -219,7 +218,7 @@ class StagePlan:
                 parked_names.append(ref.name)
                 trans = tuple(c for c in ref.free if c < 3)
                 if driven and trans:
-                    parked_moves.append((3 * ref.A + np.array(trans), moved[ref.name], trans))
+                    parked_moves.append((3 * ref.A + np.array(trans), motions[ref.name], trans))
         constrained = np.zeros(sysm.n_dofs, dtype=bool)
         for c in conds:
             constrained[c.dofs] = True
@@ -321,7 +320,7 @@ class Loading:
         if self.spec.parked.size:
             u[self.spec.parked] = self.parked[self.spec.parked]
             for dofs, motion, comps in self.spec.parked_moves:
-                u[dofs] += motion.offset(lam)[list(comps)]
+                u[dofs] += motion.moved_by(lam)[list(comps)]
         return u
 
     def external(self, lam: float) -> np.ndarray:
