@@ -154,6 +154,14 @@ class DistMatrix:
         add_into(self.body, local, c, cache)
         return self
 
+    def block(self, mask: np.ndarray) -> sp.csr_matrix:
+        """The global matrix's block on the dofs of ``mask`` (before the elimination), the same scipy matrix on
+        every rank: the ranks' shares summed."""
+        local = self.body[mask][:, mask]
+        if self.contact is not None:
+            local = local + self.contact[mask][:, mask]
+        return sum(p.tocsr() for p in gather_all(self.comm, local.tocoo())).tocsr()
+
     def contact_triplets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """PETSc rows, columns and values of the contact share (may repeat entries)."""
         K = self.contact

@@ -107,6 +107,13 @@ class DynamicModel:
     def __init__(self, model, M: sp.csr_matrix, integrator: Integrator, T: float):
         self.model, self.M, self.integ, self.T = model, M, integrator, float(T)
         self._cache: dict = {}
+        #: the dofs without mass (the contact nodes of a redistributed mass)
+        self.massless = np.asarray(abs(M).sum(axis=1)).ravel() == 0.0
+        # they hold their equilibrium at the end of every step, (1 - af) r(u_(n+1)) = 0 (the factor keeps the
+        # tangent symmetric): held at the generalized mid-point, (1 - af) r_(n+1) + af r_n = 0, a massless dof out of
+        # balance at a step's start (a load that jumps) would swing about its equilibrium from step to step,
+        # undamped for af = 1/2 (rho_inf = 1); Dynamic.start balances them at the stage's start
+        self.keep_r = (~self.massless).astype(float) if integrator.alpha_f and self.massless.any() else 1.0
 
     def __getattr__(self, name):
         return getattr(self.model, name)
@@ -125,13 +132,17 @@ class DynamicModel:
         # with multi-point constraints the inertia joins the nodal forces at every dof, then the constraints hand
         # them over (R and the stored r are at every dof, Rd the independent dofs')
         cons = getattr(self.model, "constraints", None)
-        R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=timing, raw=cons is not None)
+        # (a rigid body's free dofs carry its mass: the quasi-static check that contact restrains them is not asked)
+        kw = {"check": False} if getattr(self.model.system, "reference", None) else {}
+        R, K, trial = self.model.evaluate(u, lam, committed, guess, want_K=want_K, timing=timing, raw=cons is not None,
+                                          **kw)
         g, d = self.integ, committed.dynamics
         a, v, dt = self.kinematics(u, lam, committed)
         fd = self.damping(u, v, g.gamma / (g.beta * dt), K)  # (the dashpots' forces, their tangent into K)
         if fd is not None:
             R = R + fd
-        Rd = self.M @ ((1.0 - g.alpha_m) * a + g.alpha_m * d["a"]) + (1.0 - g.alpha_f) * R + g.alpha_f * d["r"]
+        Rd = (self.M @ ((1.0 - g.alpha_m) * a + g.alpha_m * d["a"]) + (1.0 - g.alpha_f) * R
+              + g.alpha_f * self.keep_r * d["r"])
         if K is not None:
             K = add_into(K, self.M, g.mass_factor(dt), self._cache, scale=1.0 - g.alpha_f)
         if cons is not None:
@@ -222,6 +233,19 @@ def _tools_still(model, spec) -> bool:
     return a.size == 0 or bool(np.allclose(a, b, rtol=0.0, atol=1e-14 * max(1.0, float(np.abs(a).max()))))
 
 
+#: Newton iterations and relative tolerance of the balance of the massless dofs at a dynamic stage's start
+BALANCE_ITERATIONS = 20
+BALANCE_TOLERANCE = 1e-12
+
+
+def dof_block(K, mask: np.ndarray) -> sp.csr_matrix:
+    """The tangent's block on the dofs of ``mask`` as a scipy matrix (a distributed tangent: its ranks' shares
+    summed, on every rank)."""
+    if sp.issparse(K):
+        return K.tocsr()[mask][:, mask]
+    return K.block(mask)
+
+
 #: the mass matrices without inertia on the contact surfaces
 REDISTRIBUTED = ("redistributed", "consistent-redistributed")
 #: an energy growth of the bodies beyond this share of the energy in the system is said (``Dynamic._growth``)
@@ -289,7 +313,9 @@ class Dynamic(QuasiStatic):
             return state.but(dynamics=dyn)
         model = self.model
         cons = getattr(model, "constraints", None)
-        R, _, _ = model.evaluate(u, state.lam, state, want_K=False, raw=cons is not None)
+        R = self._balance_massless(u, state) if cons is None else None
+        if R is None:
+            R, _, _ = model.evaluate(u, state.lam, state, want_K=False, raw=cons is not None)
         free = model.free
         first = not any(self.problem.stage_dynamics(i) is not None for i in range(state.stage))
         v = initial_velocity(model, self.problem) if first else np.zeros(model.n_dofs)
@@ -309,6 +335,28 @@ class Dynamic(QuasiStatic):
         dyn["e0"] = np.array(e["mechanical"])
         dyn["ec0"] = np.array(e["contact"])
         return state.but(dynamics=dyn)
+
+    def _balance_massless(self, u: np.ndarray, state: State) -> np.ndarray | None:
+        """The free dofs without mass (the contact nodes of a redistributed mass) brought into equilibrium at the
+        stage's start, the others held: Newton on them alone, ``u`` changed in place (their static deflection
+        under what loads them: their share of the weight, loads applied at once). Without it the first step would
+        take them there at once and lose half the work of that imbalance. Returns the residual at the balanced
+        ``u``; None where there is nothing to balance."""
+        m = self.dynamic_model.massless & self.model.free
+        if not m.any():
+            return None
+        model = self.model
+        # (the rigid bodies' free dofs are held here: whether the tangent restrains them is not asked)
+        kw = {"check": False} if getattr(model.system, "reference", None) else {}
+        R, K, _ = model.evaluate(u, state.lam, state, **kw)
+        ref = max(float(np.linalg.norm(model.external(state.lam))), float(np.linalg.norm(R[~m & model.free])),
+                  1e-300)
+        for _ in range(BALANCE_ITERATIONS):
+            if float(np.linalg.norm(R[m])) <= BALANCE_TOLERANCE * ref:
+                break
+            u[m] -= sla.spsolve(dof_block(K, m).tocsc(), R[m])
+            R, K, _ = model.evaluate(u, state.lam, state, **kw)
+        return R
 
     def _frees_equations(self, stage: int) -> bool:
         """Whether ``stage`` removes equations (its ``remove`` names one)."""

@@ -210,13 +210,14 @@ class Model:
 
     # evaluation -------------------------------------------------------------------------------
     def evaluate(self, u: np.ndarray, lam: float, committed: State, guess: State | None = None,
-                 want_K: bool = True, timing: dict | None = None, raw: bool = False):
+                 want_K: bool = True, timing: dict | None = None, raw: bool = False, check: bool = True):
         """Residual R = f_int + f_contact - f_ext(lam), its tangent (CSR or None) and the trial state.
 
         ``committed`` gives the history, ``guess`` (default ``committed``) the starting point of the local
         iterations (EAS parameters, contact points, Uzawa multipliers). Neither is changed. With multi-point
         constraints the residual and tangent are those of the independent dofs (``constraints.transform``), unless
-        ``raw``: then R at every dof (the nodal forces before the constraints hand them over).
+        ``raw``: then R at every dof (the nodal forces before the constraints hand them over). ``check``: the
+        tangent must restrain every free dof of a rigid body (SingularMatrixError naming the body otherwise).
         """
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
@@ -245,7 +246,7 @@ class Model:
         r = r - self.external(lam)
         if self.constraints is not None and not raw:
             r, K = self.constraints.transform(r, K)
-        if want_K and self.system.reference and (self.constraints is None or not raw):
+        if check and want_K and self.system.reference and (self.constraints is None or not raw):
             self._check_restrained(K)
         return r, K, committed.but(elements=etrial, contact=ctrial, lam=lam)
 
