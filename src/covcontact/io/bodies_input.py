@@ -60,6 +60,35 @@ def _read_once(path: Path, element: str | None = None):
     return _MESH_FILES[key]
 
 
+def build_shell(shell: Section, sec: Section, base: Path):
+    """The solid-shell mesh of a body with ``shell = { thickness, offset }`` and ``mesh = { file = "SURFACE" }``, a
+    mid-surface mesh (mesh/shell.py ``extrude_surface``)."""
+    from ..mesh.shell import OFFSETS, ShellMeshError, extrude_surface, read_surface
+
+    thickness = shell.get("thickness", "float", positive=True)
+    offset = shell.get("offset", "any", "middle")
+    if isinstance(offset, str):
+        if offset not in OFFSETS:
+            shell.fail(f"must be \"middle\", \"top\", \"bottom\" or a number in [-0.5, 0.5], got {offset!r}"
+                       f"{suggest(offset, list(OFFSETS))}", "offset")
+    elif isinstance(offset, bool) or not isinstance(offset, (int, float)) or not -0.5 <= offset <= 0.5:
+        shell.fail(f"must be \"middle\", \"top\", \"bottom\" or a number in [-0.5, 0.5], got {offset!r}", "offset")
+    shell.done()
+    if not sec.has("file"):
+        sec.fail("a shell body's mesh is a surface mesh file: give mesh = { file = \"SURFACE.msh\" }")
+    fname = sec.get("file", "str")
+    sec.done()
+    path = (base / fname) if not Path(fname).is_absolute() else Path(fname)
+    if not path.exists():
+        sec.fail(f"mesh file {fname!r} does not exist (looked for {path}; a relative path is taken from the "
+                 f"problem file's folder)", "file")
+    try:
+        points, cell_type, cells, node_sets, element_sets = read_surface(path)
+        return extrude_surface(points, cell_type, cells, thickness, offset, node_sets, element_sets)
+    except ShellMeshError as exc:
+        sec.fail(str(exc), "file")
+
+
 def build_mesh(sec: Section, base: Path, element: str | None):
     """Mesh from ``generator = ...`` plus its arguments, or ``file = ...`` (read through meshio)."""
     from ..mesh.io import MeshError
@@ -400,12 +429,20 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
         if any(x.name == bname for x in bodies):
             b.fail(f"duplicate body name {bname!r}", "name")
         element = b.get("element", "str", None, choices=CELLS)
+        formulation_given = b.has("formulation")
         formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell", "fbar"))
         options = b.get("options", "table", None)
         options = options.rest() if options is not None else {}
         material = read_material(b.get("material", "table")) if b.has("material") or not b.has("materials") else None
         by_set = b.get("materials", "table", None)
-        mesh = build_mesh(b.get("mesh", "table"), base, element)
+        if b.has("shell"):  # a mid-surface mesh made into solid-shells (mesh/shell.py)
+            if formulation_given and formulation != "solid-shell":
+                b.fail(f"a shell body is made of solid-shells: leave out formulation (got {formulation!r})",
+                       "formulation")
+            formulation = "solid-shell"
+            mesh = build_shell(b.get("shell", "table"), b.get("mesh", "table"), base)
+        else:
+            mesh = build_mesh(b.get("mesh", "table"), base, element)
         _check_cells(b, mesh, formulation)
         user_cells(b.get("cells", "table", None), mesh)
         user_sets(b.get("sets", "table", None), mesh)

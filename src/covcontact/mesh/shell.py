@@ -1,0 +1,261 @@
+"""Solid-shell meshes from mid-surface meshes (docs/theory.md, section 25).
+
+A shell as users have it is a surface mesh (Gmsh quadrilaterals or triangles, an Abaqus/CalculiX deck's S4 or S8R
+elements) and a thickness. covcontact's shells are solid-shells, one element through the thickness with both faces
+real surfaces; :func:`extrude_surface` makes them:
+
+- the surface's cells are oriented consistently (each cell's normal by the right-hand rule of its corner order;
+  across every edge that two cells share, they run through it in opposite directions; the first cell of each
+  connected part keeps its orientation, so the surface's normal is that of its first cell); a surface that no
+  orientation makes consistent (a Moebius strip) is an error naming two cells that disagree;
+- every node gets a director, the unit mean of the normals x_xi x x_eta of the cells around it evaluated at the
+  node (each weighted by its size there); on a smooth surface meshed finely it is the surface's normal;
+- the reference surface is moved along the directors by the offset (Abaqus's OFFSET: the mid-surface lies at
+  -offset t from the given surface along the normal; "middle" 0, "top" +1/2: the given surface is the shell's top,
+  SPOS, "bottom" -1/2), and the bottom and top nodes are mid -+ t/2 d;
+- quad4 cells become hex8 (the four bottom nodes, then the four top nodes), quad9 cells hex18 (a quad9 at the
+  bottom, then one at the top); a quad8 gets its centre node (the serendipity surface's point at the cell centre,
+  -1/4 of the corners plus 1/2 of the mid-side nodes) and becomes a quad9; a tri3 is split into three quad4 (its
+  corners, the mid-points of its edges, shared with the neighbours, and its centroid).
+
+Sets: the surface's element sets (a split triangle's three quads in its sets); each node set of the surface holds
+its nodes of both layers; node and face sets "top" and "bottom" (outward: the top's along the directors, the
+bottom's against them) and "edges" (the lateral faces along the surface's free edges); a node set of the surface
+whose nodes include whole free edges also becomes the face set of those lateral faces (a clamped edge, an edge load).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+
+from .mesh import Mesh
+
+#: the solid-shell cell of each surface cell type (after quad8 -> quad9 and tri3 -> quad4)
+SOLID_OF = {"quad4": "hex8", "quad9": "hex18"}
+#: the surface cell types :func:`extrude_surface` takes
+SURFACE_CELLS = ("quad4", "quad8", "quad9", "tri3")
+#: offsets by name (the given surface's place in the shell, Abaqus's OFFSET)
+OFFSETS = {"middle": 0.0, "top": 0.5, "bottom": -0.5}
+
+_CORNERS = {"quad4": 4, "quad9": 4}
+#: a quad9 cell's nodes in reversed orientation (corners 0 3 2 1, edge mid-nodes 3-0 2-3 1-2 0-1, centre)
+_REVERSE = {"quad4": np.array([0, 3, 2, 1]), "quad9": np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])}
+#: natural coordinates of a quad9's nodes (the quad4's are its first four)
+_Q9_NAT = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0, 1], [-1, 0], [0, 0]], dtype=float)
+
+
+class ShellMeshError(ValueError):
+    """A surface mesh that cannot be made into solid-shells (the message names the cells)."""
+
+
+def _quad8_to_quad9(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
+    """Each quad8 with its centre node (the serendipity surface's centre: -1/4 of the corners + 1/2 of the
+    mid-side nodes); the points, the thicknesses (the centre's interpolated alike) and the quad9 cells."""
+    def centre(v):
+        return -0.25 * v[cells[:, :4]].sum(axis=1) + 0.5 * v[cells[:, 4:8]].sum(axis=1)
+
+    ids = points.shape[0] + np.arange(cells.shape[0])
+    return np.vstack([points, centre(points)]), np.concatenate([t, centre(t)]), np.hstack([cells, ids[:, None]])
+
+
+def _split_triangles(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
+    """Each tri3 into three quad4 (corner, mid-point of the next edge, centroid, mid-point of the previous edge);
+    the points, the thicknesses (interpolated linearly), the quads and the triangle of each quad."""
+    edges = np.sort(np.stack([cells[:, [0, 1]], cells[:, [1, 2]], cells[:, [2, 0]]], axis=1).reshape(-1, 2), axis=1)
+    unique, inverse = np.unique(edges, axis=0, return_inverse=True)
+    mid = points.shape[0] + inverse.reshape(-1, 3)  # (ntri, 3): mid-points of edges 0-1, 1-2, 2-0
+    centre = points.shape[0] + unique.shape[0] + np.arange(cells.shape[0])
+
+    def new(v):
+        return np.concatenate([v, 0.5 * (v[unique[:, 0]] + v[unique[:, 1]]), v[cells].mean(axis=1)])
+
+    quads = np.stack([np.stack([cells[:, 0], mid[:, 0], centre, mid[:, 2]], axis=1),
+                      np.stack([cells[:, 1], mid[:, 1], centre, mid[:, 0]], axis=1),
+                      np.stack([cells[:, 2], mid[:, 2], centre, mid[:, 1]], axis=1)], axis=1).reshape(-1, 4)
+    return new(points), new(t), quads, np.repeat(np.arange(cells.shape[0]), 3)
+
+
+def _orient(cells: np.ndarray, cell_type: str) -> np.ndarray:
+    """The cells oriented consistently over every edge two of them share (breadth first from the first cell of each
+    connected part); ShellMeshError where the surface cannot be."""
+    n = cells.shape[0]
+    corners = cells[:, :4]
+    directed = np.stack([corners, np.roll(corners, -1, axis=1)], axis=2).reshape(-1, 2)  # (4 n, 2) a -> b
+    key = np.sort(directed, axis=1)
+    _, edge, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    edge = edge.ravel()
+    owner = np.repeat(np.arange(n), 4)
+    forward = directed[:, 0] < directed[:, 1]
+    by_edge: dict[int, list[int]] = {}
+    for k in np.flatnonzero(counts[edge] == 2):
+        by_edge.setdefault(int(edge[k]), []).append(int(k))
+    neighbours: list[list[tuple[int, bool]]] = [[] for _ in range(n)]
+    for a, b in by_edge.values():  # (same: the two cells run through the edge in the same direction)
+        same = bool(forward[a] == forward[b])
+        neighbours[owner[a]].append((int(owner[b]), same))
+        neighbours[owner[b]].append((int(owner[a]), same))
+    flip = np.full(n, -1, dtype=np.int64)
+    for start in range(n):
+        if flip[start] >= 0:
+            continue
+        flip[start] = 0
+        queue = deque([start])
+        while queue:
+            c = queue.popleft()
+            for d, same in neighbours[c]:
+                want = flip[c] ^ int(same)
+                if flip[d] < 0:
+                    flip[d] = want
+                    queue.append(d)
+                elif flip[d] != want:
+                    raise ShellMeshError(f"the surface cannot be oriented: cells {c} and {d} (0-based) disagree "
+                                         f"whichever way they are turned (a Moebius strip?)")
+    out = cells.copy()
+    turned = flip == 1
+    out[turned] = cells[turned][:, _REVERSE[cell_type]]
+    return out
+
+
+def _directors(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndarray:
+    """The unit mean at every node of the normals x_xi x x_eta of its cells there."""
+    from ..fem.shapes import shape_functions
+
+    _, dN, _ = shape_functions(cell_type, _Q9_NAT[: cells.shape[1]])  # (nnodes, nen, 2): at the cell's nodes
+    x = points[cells]  # (ne, nen, 3)
+    a1 = np.einsum("ebi,ab->eai", x, dN[:, :, 0])
+    a2 = np.einsum("ebi,ab->eai", x, dN[:, :, 1])
+    normal = np.cross(a1, a2)  # (ne, nen, 3): at each of the cell's nodes
+    acc = np.zeros_like(points)
+    np.add.at(acc, cells.ravel(), normal.reshape(-1, 3))
+    size = np.linalg.norm(acc, axis=1)
+    used = np.unique(cells)
+    if np.any(size[used] <= 1e-300):
+        bad = used[size[used] <= 1e-300][0]
+        raise ShellMeshError(f"node {bad} (0-based) has no direction: the normals of its cells cancel (a fold of "
+                             f"the surface onto itself?)")
+    return acc / np.where(size > 0.0, size, 1.0)[:, None]
+
+
+def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thickness, offset="middle",
+                    node_sets: dict | None = None, element_sets: dict | None = None) -> Mesh:
+    """The solid-shell mesh (hex8 or hex18, one element through the thickness) of the surface mesh (``points``,
+    ``cell_type`` in SURFACE_CELLS, ``cells``) with ``thickness`` (a number, or one per surface node) and ``offset``
+    ("middle", "top", "bottom" or a number in [-1/2, 1/2]); the module docstring says how. ShellMeshError (a
+    ValueError) for a surface that cannot be made into one."""
+    points = np.asarray(points, dtype=np.float64)
+    cells = np.asarray(cells, dtype=np.int64)
+    if cell_type not in SURFACE_CELLS:
+        raise ShellMeshError(f"surface cells {cell_type!r} cannot be made into solid-shells (they can: "
+                             f"{', '.join(SURFACE_CELLS)})")
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ShellMeshError("the surface's points must be (n, 3)")
+    n_surface = points.shape[0]
+    t = np.broadcast_to(np.asarray(thickness, dtype=np.float64), (n_surface,)).copy()
+    if not np.all(np.isfinite(t)) or np.any(t <= 0.0):
+        bad = int(np.flatnonzero(~(t > 0.0))[0])
+        raise ShellMeshError(f"the thickness must be positive, got {t[bad]:g} at node {bad} (0-based)")
+    o = OFFSETS.get(offset) if isinstance(offset, str) else float(offset)
+    if o is None or not -0.5 <= o <= 0.5:
+        raise ShellMeshError(f"offset must be 'middle', 'top', 'bottom' or a number in [-0.5, 0.5], got {offset!r}")
+    cell_of = np.arange(cells.shape[0])  # the surface cell each new cell comes from
+    if cell_type == "quad8":
+        points, t, cells = _quad8_to_quad9(points, t, cells)
+        cell_type = "quad9"
+    elif cell_type == "tri3":
+        points, t, cells, cell_of = _split_triangles(points, t, cells)
+        cell_type = "quad4"
+    cells = _orient(cells, cell_type)
+    d = _directors(points, cells, cell_type)
+    mid = points - (o * t)[:, None] * d
+    bottom = mid - 0.5 * t[:, None] * d
+    top = mid + 0.5 * t[:, None] * d
+    n = points.shape[0]
+    solid = SOLID_OF[cell_type]
+    mesh = Mesh(np.vstack([bottom, top]), solid, np.hstack([cells, cells + n]))
+    # sets
+    top_faces = cells + n
+    bottom_faces = cells[:, _REVERSE[cell_type]]
+    mesh.add_face_set("top", top_faces)
+    mesh.add_face_set("bottom", bottom_faces)
+    mesh.add_node_set("top", np.unique(top_faces))
+    mesh.add_node_set("bottom", np.unique(bottom_faces))
+    mesh.add_node_set("all", np.arange(2 * n))
+    from .faces import boundary_faces
+
+    faces, _, _ = boundary_faces(mesh)
+    in_plane = np.zeros(2 * n, dtype=bool)
+    lateral = faces[~(np.all(faces < n, axis=1) | np.all(faces >= n, axis=1))]
+    if lateral.shape[0]:
+        mesh.add_face_set("edges", lateral)
+        mesh.add_node_set("edges", np.unique(lateral))
+    for name, ids in (node_sets or {}).items():
+        ids = np.asarray(ids, dtype=np.int64)
+        both = np.concatenate([ids, ids + n])
+        mesh.add_node_set(name, both)
+        in_plane[:] = False
+        in_plane[both] = True
+        f = lateral[np.all(in_plane[lateral], axis=1)] if lateral.shape[0] else lateral
+        if f.shape[0]:
+            mesh.add_face_set(name, f)
+    for name, ids in (element_sets or {}).items():
+        mesh.element_sets[name] = np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64)))
+    return mesh
+
+
+#: meshio's surface cell types and ours
+_FROM_MESHIO = {"quad": "quad4", "quad8": "quad8", "quad9": "quad9", "triangle": "tri3"}
+
+
+def read_surface(path) -> tuple[np.ndarray, str, np.ndarray, dict, dict]:
+    """A surface mesh file read through meshio (Gmsh, VTU, ...): (points, cell type, cells, node sets, element
+    sets). The surface cells must be of one type of SURFACE_CELLS; named groups (Gmsh physical groups, cell sets) of
+    surface cells become element sets, those of lines and points node sets (a physical curve: the nodes of its
+    lines). ShellMeshError where the file holds no surface cells, cells of several types, or volume cells."""
+    import contextlib
+    import io
+    from pathlib import Path
+
+    import meshio
+    from meshio._mesh import topological_dimension
+
+    from .io import _groups
+
+    p = Path(path)
+    said = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            m = meshio.read(p)
+    except (Exception, SystemExit) as exc:  # meshio raises many kinds, or exits, on bad input
+        lines = [ln for ln in said.getvalue().splitlines() if ln.strip()]
+        raise ShellMeshError(f"{p}: cannot read mesh ({lines[0] if lines else type(exc).__name__})") from exc
+    volume = sorted({b.type for b in m.cells if topological_dimension.get(b.type) == 3})
+    if volume:
+        raise ShellMeshError(f"{p}: holds volume cells ({', '.join(volume)}); a shell body's mesh is its surface")
+    kinds = sorted({_FROM_MESHIO[b.type] for b in m.cells if b.type in _FROM_MESHIO})
+    other = sorted({b.type for b in m.cells if topological_dimension.get(b.type) == 2 and b.type not in _FROM_MESHIO})
+    if other or len(kinds) != 1:
+        found = ", ".join(sorted({b.type for b in m.cells})) or "none"
+        raise ShellMeshError(f"{p}: a shell body needs surface cells of one type of {', '.join(SURFACE_CELLS)} "
+                             f"(meshio: quad, quad8, quad9, triangle); found: {found}")
+    blocks = [b for b, blk in enumerate(m.cells) if blk.type in _FROM_MESHIO]
+    first = np.cumsum([0] + [len(m.cells[b].data) for b in blocks])
+    cells = np.concatenate([np.asarray(m.cells[b].data, dtype=np.int64) for b in blocks])
+    used = np.unique(cells)
+    renumber = -np.ones(len(m.points), dtype=np.int64)
+    renumber[used] = np.arange(used.size)
+    points = np.zeros((used.size, 3))
+    pts = np.asarray(m.points, dtype=np.float64)
+    points[:, : pts.shape[1]] = pts[used]
+    node_sets: dict[str, np.ndarray] = {}
+    element_sets: dict[str, np.ndarray] = {}
+    for name, parts in _groups(m).items():
+        for b, ids in parts:
+            if b in blocks:
+                k = blocks.index(b)
+                element_sets[name] = np.union1d(element_sets.get(name, np.zeros(0, np.int64)), first[k] + ids)
+            else:
+                nodes = renumber[np.asarray(m.cells[b].data)[ids].ravel()]
+                node_sets[name] = np.union1d(node_sets.get(name, np.zeros(0, np.int64)), nodes[nodes >= 0])
+    return points, kinds[0], renumber[cells], node_sets, element_sets
