@@ -196,3 +196,73 @@ def test_blanks_calculix_ignores_and_c3d8i_lines_with_more_nodes(tmp_path):
     m = read_model(deck)
     ref = read_model(two_block_deck(tmp_path / "tb.inp"))
     assert m.blocks[0][0] == "C3D8I" and np.array_equal(m.blocks[0][3], ref.blocks[0][3])
+
+
+# ------------------------------------------------------------------------------------- elements not read, named
+
+_QUAD = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n9, 2, 0, 0\n"
+
+
+def _run(deck: Path, tmp_path: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+
+
+@pytest.mark.parametrize("etype", ["S4", "CPS4"])
+def test_a_deck_without_solids_names_its_element_types_and_lines(tmp_path, etype):
+    """A deck whose only elements are of a type covcontact does not read, with a GRAV load on their ELSET=: one
+    line naming the *ELEMENT line and the type (not the *DLOAD's set as undefined), exit 2."""
+    deck = tmp_path / "d.inp"
+    deck.write_text(_QUAD + f"*ELEMENT, TYPE={etype}, ELSET=Eall\n1, 1, 2, 3, 4\n*MATERIAL, NAME=steel\n*ELASTIC\n"
+                    "210000, 0.3\n*DENSITY\n7.85e-9\n*STEP\n*STATIC\n*DLOAD\nEall, GRAV, 9810., 0., -1., 0.\n"
+                    "*END STEP\n")
+    proc = _run(deck, tmp_path)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    (line,) = [ln for ln in proc.stderr.splitlines() if "error" in ln]
+    assert line == (f"covcontact: error: {deck}:7: no solid elements: the deck's elements are {etype} ({deck}:7); "
+                    f"covcontact reads C3D8, C3D8R, C3D20, C3D8I, C3D20R, C3D10, C3D4, C3D6")
+
+
+def test_a_coupling_on_elements_not_read_names_their_type_and_line(tmp_path):
+    deck = tmp_path / "d.inp"
+    deck.write_text(_QUAD + "*ELEMENT, TYPE=CPS6, ELSET=Eall\n48, 1, 2, 3, 4\n*SURFACE, NAME=Sload\n48, S2\n"
+                    "*COUPLING, SURFACE=Sload, REF NODE=9, CONSTRAINT NAME=load\n*KINEMATIC\n1, 3\n*MATERIAL, "
+                    "NAME=steel\n*ELASTIC\n210000, 0.3\n*STEP\n*STATIC\n*CLOAD\n9, 1, 1.\n*END STEP\n")
+    proc = _run(deck, tmp_path)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    (line,) = [ln for ln in proc.stderr.splitlines() if "error" in ln]
+    assert line.startswith(f"covcontact: error: {deck}:10: *SURFACE SLOAD: element 48 is a CPS6 (*ELEMENT, TYPE=CPS6 "
+                           f"at {deck}:7), a type covcontact does not read (it reads C3D8, ")
+    assert line.endswith(f"the surface of *COUPLING LOAD at {deck}:11")
+    deck.write_text(deck.read_text().replace("48, S2", "47, S2"))  # (an element no line defines)
+    with pytest.raises(DeckError, match=r"d\.inp:10: \*SURFACE SLOAD: element 47 is not defined, the surface of"):
+        read_model(deck)
+
+
+def test_loads_on_elements_not_read_are_listed_with_their_type(tmp_path):
+    """GRAV on a set with shell elements (made by ELSET= of their *ELEMENT line, or by an *ELSET that names that
+    set): listed as unsupported with the element's type and *ELEMENT line, the solids keep their weight with
+    --ignore-unsupported; a face load on them is listed with its line; an element no line defines is an error."""
+    text = two_block_deck(tmp_path / "tb.inp").read_text()
+    text = text.replace("*NSET, NSET=BOTTOM", "*ELEMENT, TYPE=S4, ELSET=SKIN\n9001, 1, 2, 5, 4\n*NSET, NSET=BOTTOM", 1)
+    text = text.replace("*ELSET, ELSET=BASETOP", "*ELSET, ELSET=ALL\nBASE, SKIN\n*ELSET, ELSET=BASETOP", 1)
+    text = text.replace("1000.0, 0.3\n", "1000.0, 0.3\n*DENSITY\n1.0\n")
+    shell = text.splitlines().index("*ELEMENT, TYPE=S4, ELSET=SKIN") + 1
+    deck = tmp_path / "m.inp"
+    for k, (load, said) in enumerate([
+            ("SKIN, GRAV, 9.81, 0, 0, -1", "*DLOAD GRAV on SKIN: element 9001 is an S4 (*ELEMENT, TYPE=S4 at "
+             f"{deck}:{shell}), a type covcontact does not read; with --ignore-unsupported the load acts on no "
+             "element (left out)"),
+            ("ALL, GRAV, 9.81, 0, 0, -1", "*DLOAD GRAV on ALL: element 9001 is an S4 (*ELEMENT, TYPE=S4 at "
+             f"{deck}:{shell}), a type covcontact does not read; with --ignore-unsupported the load acts on the "
+             "set's other elements alone"),
+            ("SKIN, P1, 1.0", f"P1 on element 9001, a S4 (not read), from *ELEMENT, TYPE=S4 at {deck}:{shell}")]):
+        deck.write_text(text.replace("*NODE PRINT", f"*DLOAD\n{load}\n*NODE PRINT"))
+        at = deck.read_text().splitlines().index(load) + 1
+        imp = import_deck(deck, tmp_path / f"i{k}" / "p.toml")
+        assert imp.unsupported[-1] == f"{deck}:{at}: {said}"
+        if "ALL" in load:  # (the solids' weight is kept)
+            assert 'cells = "ALL"' in imp.problem.read_text()
+    deck.write_text(text.replace("*NODE PRINT", "*DLOAD\n9002, GRAV, 9.81, 0, 0, -1\n*NODE PRINT"))
+    with pytest.raises(DeckError, match=r"m\.inp:\d+: \*DLOAD: element 9002 is not defined"):
+        import_deck(deck, tmp_path / "x" / "p.toml")

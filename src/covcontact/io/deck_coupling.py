@@ -142,7 +142,7 @@ def read_coupling_card(reader, c: Card, following: Card | None) -> None:
         if kind == "NODE":
             cp.nodes = np.unique(refs)
         else:
-            cp.faces = _faces(m, refs)
+            cp.faces = _faces(m, refs, surface, f", the surface of *COUPLING {name.upper()} at {c.where()}")
             cp.nodes = np.unique(np.concatenate([f for _, f in cp.faces]))
         _couplings(m).append(cp)
         return
@@ -196,8 +196,9 @@ def _couplings(m) -> list:
     return m.couplings
 
 
-def _faces(m, refs) -> list:
-    """(deck element type, node labels of the face) of every face of an element surface's lines."""
+def _faces(m, refs, surface: str = "", owner: str = "") -> list:
+    """(deck element type, node labels of the face) of every face of an element surface's lines (``surface``: its
+    name, ``owner``: ', the surface of ...' for the messages)."""
     out = []
     for els, face, where in refs:
         found = np.zeros(els.size, dtype=bool)
@@ -211,9 +212,15 @@ def _faces(m, refs) -> list:
             rows = conn[np.isin(labels, els)]
             out += [(etype, row[list(table[face])]) for row in rows]
             found |= hit
-        if not found.all():
-            raise DeckError(f"{where}: element {int(els[~found][0])} is not defined (or of a type covcontact does not "
-                            f"read)")
+        if not found.all():  # (a type not read: named with its *ELEMENT line, else not defined)
+            bad = int(els[~found][0])
+            what = m.skipped(bad)
+            if what is None:
+                raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: element {bad} is not "
+                                f"defined{owner}")
+            from .deck_model import ELEMENTS  # (deck_model reads *COUPLING through this module)
+            raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: element {bad} is {what}, a type "
+                            f"covcontact does not read (it reads {', '.join(ELEMENTS)}){owner}")
     return out
 
 

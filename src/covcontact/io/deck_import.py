@@ -12,7 +12,7 @@ that the ``.dat`` table (:class:`DatTable`) can print the deck's labels.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,8 +80,10 @@ class _Writer:
         self.m, self.deck, self.out, self.dialect = m, deck, out, dialect
         self.unsupported = list(m.unsupported)
         self.notes: list[str] = list(m.notes)
-        if not m.blocks:
-            raise DeckError(f"{deck}: no solid elements ({', '.join(ELEMENTS)})")
+        if not m.blocks:  # (the types it has, at their *ELEMENT lines: the first of them is the line said)
+            first = m.skipped_blocks[0][1] if m.skipped_blocks else str(deck)
+            found = f"the deck's elements are {m.element_types()}" if m.skipped_blocks else "the deck has no *ELEMENT"
+            raise DeckError(f"{first}: no solid elements: {found}; covcontact reads {', '.join(ELEMENTS)}")
         self.b = Parts(m)
         self.body_names = self._body_names()
         self.rigid = DeckRigid(m, self.b)
@@ -101,9 +103,11 @@ class _Writer:
                 skipped = [e for e in bad if e in m.skipped_elements]
                 if skipped:  # (a surface on elements not read: the surface cannot be built; listed)
                     self.unsupported.append(f"{where}: {letter}{face} on element {skipped[0]}, a "
-                                            f"{m.skipped_elements[skipped[0]]} (not read)")
+                                            f"{m.skipped_elements[skipped[0]]} (not read), from "
+                                            f"{m.skipped_card(skipped[0])}")
                     continue
-                raise DeckError(f"{where}: element {bad[0]} is not defined")
+                raise DeckError(f"{where}: {'*SURFACE' if letter == 'S' else '*DLOAD'}: element {bad[0]} is not "
+                                f"defined")
             for cell in set(cell_of[idx]):
                 if not 1 <= face <= NFACES[cell]:
                     raise DeckError(f"{where}: {letter}{face}: {cell} elements have the faces {letter}1..{letter}"
@@ -437,8 +441,18 @@ class _Writer:
                 yield ("cload", body, set_name, ld.dof - 1)
         else:
             bodies = self.b.elements_body(ld.elements)
-            if np.any(bodies < 0):
-                raise DeckError(f"{ld.where}: element {int(ld.elements[bodies < 0][0])} is not defined")
+            if np.any(bodies < 0):  # (elements of a type not read: listed, the load on the others kept)
+                gone = [int(e) for e in ld.elements[bodies < 0] if int(e) in self.m.skipped_elements]
+                if len(gone) < int(np.sum(bodies < 0)):
+                    bad = next(int(e) for e in ld.elements[bodies < 0] if int(e) not in self.m.skipped_elements)
+                    raise DeckError(f"{ld.where}: *DLOAD: element {bad} is not defined")
+                if ld.kind in ("grav", "centrif"):  # (a face load's such faces are listed with the surfaces)
+                    self.unsupported.append(f"{ld.where}: *DLOAD {ld.kind.upper()} on {ld.target}: element "
+                                            f"{gone[0]} is {self.m.skipped(gone[0])}, a type covcontact does not "
+                                            f"read; with --ignore-unsupported the load acts on "
+                                            + ("the set's other elements alone" if np.any(bodies >= 0) else
+                                               "no element (left out)"))
+                ld, bodies = replace(ld, elements=ld.elements[bodies >= 0]), bodies[bodies >= 0]
             for body in np.unique(bodies):
                 if ld.kind in ("grav", "centrif"):  # an acceleration on the element set (times the density)
                     name = _name(ld.target) if not ld.target.isdigit() else f"_E{ld.target}"
@@ -557,7 +571,8 @@ class _Writer:
             els = np.concatenate([e for e, _, _ in refs]) if refs else np.zeros(0, np.int64)
             gone = [int(e) for e in els if int(e) in self.m.skipped_elements]
             if gone or not els.size:
-                what = f"element {gone[0]}, a {self.m.skipped_elements[gone[0]]} (not read)" if gone else \
+                what = f"element {gone[0]}, a {self.m.skipped_elements[gone[0]]} (not read), from " \
+                    f"{self.m.skipped_card(gone[0])}" if gone else \
                     "no faces covcontact reads"
                 self.unsupported.append(f"{where}: the surface {name} has {what}; with --ignore-unsupported the pair "
                                         f"is left out")

@@ -116,7 +116,7 @@ class LoadCards:
                         raise c.fail("a CENTRIF load is 'element set, CENTRIF, omega^2, x, y, z, ax, ay, az' (a point "
                                      "of the axis and its direction)", k)
                     ref = row[0].upper()
-                    els = self.m.elsets.get(ref) if not ref.isdigit() else np.array([int(ref)])
+                    els = self.m.element_set(ref) if not ref.isdigit() else np.array([int(ref)])
                     if els is None:
                         raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
                     w2 = c.number(k, 2, row, "omega^2")
@@ -134,7 +134,7 @@ class LoadCards:
                     if len(row) < 6:
                         raise c.fail("a GRAV load is 'element set, GRAV, magnitude, nx, ny, nz'", k)
                     ref = row[0].upper()
-                    els = self.m.elsets.get(ref) if not ref.isdigit() else np.array([int(ref)])
+                    els = self.m.element_set(ref) if not ref.isdigit() else np.array([int(ref)])
                     if els is None:
                         raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
                     g = c.number(k, 2, row, "the magnitude")
@@ -149,11 +149,8 @@ class LoadCards:
                                               f"CENTRIF are read)")
                     continue
                 ref = row[0].upper()
-                if ref.isdigit():
-                    els = np.array([int(ref)], dtype=np.int64)
-                elif ref in self.m.elsets:
-                    els = self.m.elsets[ref]
-                else:
+                els = np.array([int(ref)], dtype=np.int64) if ref.isdigit() else self.m.element_set(ref)
+                if els is None:
                     raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
                 st.loads.append(Load("dload", ref, int(lab[1:]), c.number(k, 2, row, "the magnitude"), c.where(k),
                                      elements=els, amplitude=c.param("AMPLITUDE"), delay=self._delay(c)))

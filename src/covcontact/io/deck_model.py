@@ -129,6 +129,9 @@ class DeckModel:
     #: elements of types covcontact does not read (listed as unsupported): label -> type; and their nodes
     skipped_elements: dict[int, str] = field(default_factory=dict)
     skipped_nodes: set[int] = field(default_factory=set)
+    #: their *ELEMENT cards: (type, where, labels); and the sets their ELSET= names: set name -> those cards' indices
+    skipped_blocks: list[tuple[str, str, np.ndarray]] = field(default_factory=list)
+    skipped_elsets: dict[str, list[int]] = field(default_factory=dict)
     #: *CONTROLS, TIME INCREMENTATION: "max_iterations" (I_C), "max_cutbacks" (I_A), the largest given
     controls: dict[str, int] = field(default_factory=dict)
     #: *TIME POINTS: name -> (times, on the total time?)
@@ -138,12 +141,48 @@ class DeckModel:
     #: "abaqus" where the deck has keywords only Abaqus reads (*PART, *ASSEMBLY, *INSTANCE), else "calculix"
     dialect: str = "calculix"
 
+    def skipped_card(self, label: int) -> str:
+        """The *ELEMENT line of element ``label`` of a type covcontact does not read: '*ELEMENT, TYPE=S8R at
+        FILE:LINE'."""
+        etype = self.skipped_elements[int(label)]
+        where = next((w for t, w, labels in self.skipped_blocks if t == etype and np.any(labels == int(label))), "?")
+        return f"*ELEMENT, TYPE={etype} at {where}"
+
+    def skipped(self, label: int) -> str | None:
+        """What element ``label`` is when covcontact does not read its type: 'an S8R (*ELEMENT, TYPE=S8R at
+        FILE:LINE)'; None for an element that is read or not defined."""
+        etype = self.skipped_elements.get(int(label))
+        if etype is None:
+            return None
+        return f"{_article(etype)} {etype} ({self.skipped_card(label)})"
+
+    def element_set(self, name: str) -> np.ndarray | None:
+        """The labels of element set ``name`` with the elements not read that an ELSET= of their *ELEMENT card put
+        in it (a load or surface on them then names their type where it is refused); None: no such set."""
+        name = name.upper()
+        parts = [self.elsets[name]] if name in self.elsets else []
+        parts += [self.skipped_blocks[i][2] for i in self.skipped_elsets.get(name, [])]
+        return np.concatenate(parts) if parts else None
+
+    def element_types(self) -> str:
+        """The deck's element types that covcontact does not read, each with its first *ELEMENT line: 'S8R (FILE:LINE), S4
+        (FILE:LINE)'."""
+        first: dict[str, str] = {}
+        for t, w, _ in self.skipped_blocks:
+            first.setdefault(t, w)
+        return ", ".join(f"{t} ({w})" for t, w in first.items())
+
     def node_index(self) -> np.ndarray:
         """label -> row of X (-1: no such node)."""
         top = int(self.node_labels.max()) + 1 if self.node_labels.size else 1
         idx = np.full(top, -1, dtype=np.int64)
         idx[self.node_labels] = np.arange(self.node_labels.size)
         return idx
+
+
+def _article(word: str) -> str:
+    """'a' or 'an' before an element type as it is said (an S8R, an SPRINGA, a CPS6, a C3D15)."""
+    return "an" if word[:1].upper() in "AEFHILMNORSX" else "a"
 
 
 def read_model(path) -> DeckModel:
@@ -515,14 +554,19 @@ class _Reader(LoadCards):
             self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported "
                                       + BEAMS.get(etype, f"(covcontact reads {', '.join(ELEMENTS)})"))
             cont = False
+            labels = []
             for line in c.data:  # (their labels and nodes: a surface or set on them is named as such later)
                 fields = [f.strip() for f in line.split(",") if f.strip()]
                 if not cont and fields and fields[0].isdigit():
                     self.m.skipped_elements[int(fields[0])] = etype
+                    labels.append(int(fields[0]))
                     self.m.skipped_nodes.update(int(f) for f in fields[1:] if f.isdigit())
                 elif cont:
                     self.m.skipped_nodes.update(int(f) for f in fields if f.isdigit())
                 cont = line.rstrip().endswith(",")
+            self.m.skipped_blocks.append((etype, c.where(), np.asarray(labels, dtype=np.int64)))
+            if "ELSET" in c.params:  # (a load or section on that set then names the type, not an undefined set)
+                self.m.skipped_elsets.setdefault(c.params["ELSET"].upper(), []).append(len(self.m.skipped_blocks) - 1)
             return
         cell = ELEMENTS[etype][0]
         try:
@@ -569,6 +613,8 @@ class _Reader(LoadCards):
                         ids.append(int(f))
                     elif f.upper() in sets:
                         labels.append(sets[f.upper()])
+                    elif key == "ELSET" and f.upper() in self.m.skipped_elsets:  # (of elements not read)
+                        labels.append(self.m.element_set(f))
                     else:
                         raise c.fail(f"{f!r} is neither a label nor a {key} defined above", k)
                 labels.append(np.asarray(ids, dtype=np.int64))
@@ -601,11 +647,8 @@ class _Reader(LoadCards):
             if len(row) < 2 or not row[1].upper().startswith("S") or not row[1][1:].isdigit():
                 raise c.fail("an element surface line is 'element set or label, S1..S6'", k)
             ref = row[0].upper()
-            if ref.isdigit():
-                els = np.array([int(ref)])
-            elif ref in self.m.elsets:
-                els = self.m.elsets[ref]
-            else:
+            els = np.array([int(ref)]) if ref.isdigit() else self.m.element_set(ref)
+            if els is None:
                 raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
             refs.append((els, int(row[1][1:]), c.where(k)))
         self.m.surfaces[name] = ("ELEMENT", refs)
