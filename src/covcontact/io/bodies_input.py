@@ -177,7 +177,17 @@ def _hardening(sec: Section) -> dict:
 def read_material(sec: Section):
     from ..materials import material_from_name
 
-    model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke", "j2"))
+    from ..materials.rubber import MODELS, RubberError, rubber_from_keys
+
+    model = sec.get("model", "str", choices=("svk", "saint-venant-kirchhoff", "neo-hooke", "neohooke", "j2",
+                                             *MODELS[1:]))
+    if model in MODELS[1:] or (model in ("neo-hooke", "neohooke") and not sec.has("E") and not sec.has("nu")):
+        # the rubber models of the manuals (Neo-Hooke with c10 and d1; with E and nu the compressible Neo-Hooke)
+        density = sec.get("density", "float", None, positive=True)
+        try:
+            return rubber_from_keys(model, sec.rest(), density)
+        except RubberError as exc:
+            sec.fail(str(exc), exc.key)
     E = sec.get("E", "float", positive=True)
     nu = sec.get("nu", "float")
     density = sec.get("density", "float", None, positive=True)

@@ -269,6 +269,10 @@ class Progress(Observer):
     def started(self, run) -> None:
         for w in run.warnings:
             self.say(f"warning: {w}", always=True)
+        from ..materials.rubber import moduli_notes
+
+        for note in moduli_notes(run.problem.bodies):  # (the rubber models' initial moduli, to check the constants)
+            self.say(f"note: {note}")
 
     def resumed(self, run) -> None:
         self.say(f"resuming {run.problem.name} after step {run.state.step} (load factor {run.state.lam:.4g})",

@@ -1,4 +1,5 @@
-"""Hyperelastic materials: St. Venant-Kirchhoff and compressible Neo-Hooke.
+"""Hyperelastic materials: St. Venant-Kirchhoff and compressible Neo-Hooke (the rubber models of the manuals, kind
+RUBBER: covcontact.materials.rubber).
 
 A material is a small dataclass on the Python side and, for the kernels, a pair
 ``(kind, params)``: an int code and a float64 array ``[E, nu, lambda, mu]``. The compiled
@@ -19,6 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
+
+from .rubber import RUBBER, Rubber, rubber_energy, rubber_response
 
 #: kind codes understood by the kernels
 SVK = 0
@@ -100,7 +103,7 @@ class NeoHooke(_Isotropic):
     name: str = field(init=False, default="neo-hooke")
 
 
-Material = SaintVenantKirchhoff | NeoHooke
+Material = SaintVenantKirchhoff | NeoHooke | Rubber
 
 _NAMES: dict[str, type[SaintVenantKirchhoff | NeoHooke]] = {
     "svk": SaintVenantKirchhoff,
@@ -178,6 +181,8 @@ def material_response_h(kind, params, F, H, S, D):
 @njit(cache=True, inline="always")
 def _hyperelastic(kind, params, J, cm, lnJ, S, D):
     """S and D of St. Venant-Kirchhoff or Neo-Hooke from J = det F, C - I (``cm``, Voigt) and ln J."""
+    if kind == RUBBER:
+        return rubber_response(params, J, cm, lnJ, S, D)
     lam = params[2]
     mu = params[3]
     status = 0
@@ -246,7 +251,9 @@ def _hyperelastic(kind, params, J, cm, lnJ, S, D):
 
 @njit(cache=True)
 def material_energy(kind, params, F):
-    """Strain energy density W per unit reference volume (inf for Neo-Hooke with det F <= 0)."""
+    """Strain energy density W per unit reference volume (inf for Neo-Hooke and rubber with det F <= 0)."""
+    if kind == RUBBER:
+        return rubber_energy(params, F)
     lam = params[2]
     mu = params[3]
     C = np.empty((3, 3))
