@@ -15,7 +15,7 @@ from numba import njit
 from ..elements.base import NNODES
 from ..elements.solid import SolidBody
 from ..fem.cells import any_face
-from ..loads import BodyForce, NodalForce, Pressure
+from ..loads import BodyForce, NodalForce, Pressure, Traction
 from .pattern import Pattern
 
 
@@ -88,8 +88,34 @@ def face_load_vector(X: np.ndarray, faces: np.ndarray, area_only: bool = False) 
     return out
 
 
+PLANAR_FORMULATIONS = ("plane_strain", "plane_stress", "axisymmetric")
+
+
+def is_planar(body) -> bool:
+    """Whether ``body`` (a ``covcontact.problem.Body``) is a plane strain, plane stress or axisymmetric body."""
+    return getattr(body, "formulation", "solid") in PLANAR_FORMULATIONS
+
+
+def cell_masses(body, cell_type: str, cells: np.ndarray, density: float) -> np.ndarray:
+    """Consistent scalar element mass matrices of ``cells`` of ``body`` (planar bodies: times the thickness or
+    2 pi R)."""
+    if is_planar(body):
+        from ..elements.planar import planar_masses
+
+        return planar_masses(cell_type, body.mesh.points, cells, density, body.formulation,
+                             float(body.options.get("thickness", 1.0)))
+    from ..elements.mass import element_masses
+
+    return element_masses(cell_type, body.mesh.points, cells, density)
+
+
 def _element_body(body, material, cell_type: str, cells: np.ndarray):
     """The element body of ``body``'s formulation over ``cells`` of ``cell_type`` with ``material``."""
+    if is_planar(body):
+        from ..elements.planar import PlanarBody
+
+        return PlanarBody(cell_type, body.mesh.points, cells, material, body.formulation,
+                          float(body.options.get("thickness", 1.0)), body.options.get("integration", "full"))
     if body.formulation == "solid-shell":
         from ..elements.solidshell import SolidShellBody
 
@@ -138,6 +164,10 @@ class System:
             self.blocks.append(BodyBlock(body.name, offset, body.mesh.n_nodes, solid))
             offset += body.mesh.n_nodes
         self.n_deformable = offset
+        #: the z-dofs of the nodes of planar bodies, held at zero with the Dirichlet conditions of every stage
+        self.planar_dofs = np.concatenate([np.zeros(0, dtype=np.int64)] + [
+            3 * (blk.offset + np.arange(blk.n_nodes, dtype=np.int64)) + 2
+            for blk, body in zip(self.blocks, bodies) if is_planar(body)])
         self.reference = self._reference_nodes(rigid, offset)
         for ref, rb in zip(self.reference, [rb for rb in rigid if rb.free or rb.attach]):
             if rb.attach:
@@ -161,7 +191,7 @@ class System:
         (``covcontact.elements.mass``), lumped with the ``massless`` nodes' mass redistributed when given (with
         ``consistent_interior`` only in the elements that have a massless node, consistent elsewhere); zero rows at
         reference nodes. A material without density is a ValueError."""
-        from ..elements.mass import assemble_mass, dof_matrix, element_masses
+        from ..elements.mass import assemble_mass, dof_matrix
 
         parts = []
         for blk, body in zip(self.blocks, self.bodies.values()):
@@ -170,7 +200,7 @@ class System:
                 if rho is None:
                     raise ValueError(f"body {body.name!r}: its material has no density (needed for the mass)")
                 cells = body.mesh.cells_of(idx)[1]
-                parts.append((cells + blk.offset, element_masses(cell_type, body.mesh.points, cells, rho)))
+                parts.append((cells + blk.offset, cell_masses(body, cell_type, cells, rho)))
         M = dof_matrix(assemble_mass(self.n_nodes, parts, lumped or massless is not None, massless,
                                      consistent_interior))
         if self.reference:  # rigid bodies with free components: mass on A, rotary inertia on B (small rotations)
@@ -224,17 +254,23 @@ class System:
         mesh = self.bodies[load.body].mesh
         faces = mesh.face_sets[load.set]
         off = self.offset(load.body)
-        if isinstance(load, Pressure):
-            f[off: off + mesh.n_nodes] -= float(value.reshape(-1)[0]) * face_load_vector(mesh.points, faces)
+        body = self.bodies[load.body]
+        if is_planar(body):  # edges: times the thickness or 2 pi R
+            from ..elements.planar import edge_load_vector
+
+            t = float(body.options.get("thickness", 1.0))
+            normal = edge_load_vector(mesh.points, faces, body.formulation, t, isinstance(load, Traction))
         else:
-            f[off: off + mesh.n_nodes] += face_load_vector(mesh.points, faces, area_only=True) * value[None, :]
+            normal = face_load_vector(mesh.points, faces, area_only=isinstance(load, Traction))
+        if isinstance(load, Pressure):
+            f[off: off + mesh.n_nodes] -= float(value.reshape(-1)[0]) * normal
+        else:
+            f[off: off + mesh.n_nodes] += normal * value[None, :]
         return f.ravel()
 
     def _body_force(self, load, value: np.ndarray) -> np.ndarray:
         """int N_a b dV0 over the load's cells: the row sums of the consistent mass matrix of unit density (or the
         material's, ``per_mass``) times b."""
-        from ..elements.mass import element_masses
-
         body = self.bodies[load.body]
         chosen = body.mesh.element_sets[load.cells] if load.cells else np.arange(body.mesh.n_cells)
         weight = np.zeros(self.n_nodes)
@@ -251,7 +287,7 @@ class System:
                 if rho is None:
                     raise ValueError(f"body {body.name!r}: a body force per mass needs the density of its material")
             cells = body.mesh.cells_of(chosen[idx])[1]
-            me = element_masses(cell_type, body.mesh.points, cells, rho)
+            me = cell_masses(body, cell_type, cells, rho)
             if load.axis is not None:
                 np.add.at(f, cells.ravel() + off, np.einsum("eab,ebi->eai", me, accel[cells]).reshape(-1, 3))
             else:
@@ -278,6 +314,7 @@ class System:
     def set_constraints(self, constrained: np.ndarray) -> None:
         """The dofs whose values are prescribed (a stage may free some)."""
         self.constrained = np.asarray(constrained, dtype=bool).copy()
+        self.constrained[getattr(self, "planar_dofs", np.zeros(0, dtype=np.int64))] = True  # (planar bodies' z)
         self.free = ~self.constrained
         self._eliminate_cache = None  # (indices, indptr, entries to zero, diagonal entries) of the last pattern
 

@@ -18,7 +18,7 @@ from ..fem.cells import NNODES as _OTHER_NNODES
 from ..fem.shapes import NNODES as _TENSOR_NNODES
 from ..materials.hyperelastic import VOIGT, VOIGT_PAIRS, Material
 
-NNODES = {**_TENSOR_NNODES, **_OTHER_NNODES}
+NNODES = {**_TENSOR_NNODES, **_OTHER_NNODES, "quad8": 8, "tri3": 3, "tri6": 6}  # (the last: planar cells)
 
 #: parallel blocks per thread and chunk (handed out dynamically, for load balance on shared cores)
 BLOCKS_PER_THREAD = 8

@@ -14,13 +14,16 @@ from ..description import Body
 from .validate import _REQUIRED, InputError, Section, suggest
 
 CELLS = ("hex8", "hex18", "hex27", "tet4", "tet10", "wedge6", "hex20")
+#: the cells of plane strain, plane stress and axisymmetric bodies (x-y plane)
+PLANAR_CELLS = ("quad4", "quad8", "quad9", "tri3", "tri6")
+PLANAR_FORMULATIONS = ("plane_strain", "plane_stress", "axisymmetric")
 
 
 def mesh_generators() -> dict:
     """The mesh generators a ``mesh = { generator = NAME }`` may name: name -> function."""
-    from ..mesh import generators, generators_solid
+    from ..mesh import generators, generators_planar, generators_solid
 
-    return {name: fn for mod in (generators, generators_solid) for name, fn in vars(mod).items()
+    return {name: fn for mod in (generators, generators_solid, generators_planar) for name, fn in vars(mod).items()
             if inspect.isfunction(fn) and not name.startswith("_") and fn.__module__ == mod.__name__
             and "cell" in inspect.signature(fn).parameters}
 
@@ -144,7 +147,7 @@ def build_mesh(sec: Section, base: Path, element: str | None):
     try:
         if element in SOURCE:  # bricks split (tet4, tet10, wedge6) or trimmed (hex20); no face sets
             return convert(fn(cell=SOURCE[element], **kwargs), element)
-        return fn(cell=element or "hex8", **kwargs)
+        return fn(cell=element or ("quad4" if getattr(fn, "planar", False) else "hex8"), **kwargs)
     except (ValueError, TypeError) as exc:
         sec.fail(f"generator {name!r}: {exc}")
 
@@ -310,7 +313,7 @@ def user_faces(sec: Section | None, mesh) -> None:
     same name (its nodes), as the generators' sets are."""
     if sec is None:
         return
-    from ..mesh.faces import all_boundary_faces, face_normals
+    from ..mesh.faces import all_boundary_faces, edge_normals, face_normals
 
     every = all_boundary_faces(mesh)
     X = mesh.points
@@ -362,7 +365,7 @@ def user_faces(sec: Section | None, mesh) -> None:
                 if box is not None:
                     keep &= np.all(inside[faces], axis=1)
                 if direction is not None:
-                    n = face_normals(X, faces)
+                    n = edge_normals(X, faces) if mesh.is_planar else face_normals(X, faces)
                     cosine = n @ direction / np.maximum(np.linalg.norm(n, axis=1) * np.linalg.norm(direction),
                                                         1e-300)
                     keep &= cosine >= np.cos(np.radians(angle)) - 1e-12
@@ -408,6 +411,36 @@ def _check_cells(sec: Section, mesh, formulation: str) -> None:
                  f"through a wedge's quadrilateral face", "mesh")
 
 
+def _check_planar(sec: Section, name: str, mesh, formulation: str, thickness: float | None) -> None:
+    """A planar formulation needs planar cells in the x-y plane (axisymmetric: at radius x >= 0) and the others
+    volume cells; ``thickness`` is for the two plane formulations. One line naming the body."""
+    planar = formulation in PLANAR_FORMULATIONS
+    if planar and not mesh.is_planar:
+        sec.fail(f"body {name!r}: formulation = \"{formulation}\" needs planar cells ({', '.join(PLANAR_CELLS)}) in "
+                 f"the x-y plane, got {' and '.join(mesh.cell_types)}", "formulation")
+    if not planar and mesh.is_planar:
+        sec.fail(f"body {name!r}: {' and '.join(mesh.cell_types)} cells are planar: give formulation = "
+                 f"\"plane_strain\", \"plane_stress\" or \"axisymmetric\" (formulation \"{formulation}\" needs "
+                 f"volume cells)", "formulation")
+    if thickness is not None and formulation not in ("plane_strain", "plane_stress"):
+        sec.fail(f"body {name!r}: thickness is for formulation = \"plane_strain\" or \"plane_stress\" (an "
+                 f"axisymmetric body spans the full circumference)", "thickness")
+    if not planar:
+        return
+    z = mesh.points[:, 2]
+    if np.any(z != 0.0):
+        k = int(np.argmax(np.abs(z)))
+        sec.fail(f"body {name!r}: a planar body lies in the x-y plane, but node {k} (numbered from 0) has z = "
+                 f"{z[k]:g}", "mesh")
+    if formulation == "axisymmetric":
+        x = mesh.points[:, 0]
+        tol = 1e-12 * max(1.0, float(np.abs(mesh.points).max()))
+        if np.any(x < -tol):
+            k = int(np.argmin(x))
+            sec.fail(f"body {name!r}: an axisymmetric body lies at radius x >= 0, but node {k} (numbered from 0) "
+                     f"has x = {x[k]:g}", "mesh")
+
+
 def _materials_by_set(sec: Section, mesh, default) -> dict:
     """``materials = { SET = {...}, ... }``: a material per element set of the body (the cells in no set take
     ``material``). One line for an unknown set, a cell in two sets, or cells left without a material."""
@@ -438,9 +471,12 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
         bname = b.get("name", "str")
         if any(x.name == bname for x in bodies):
             b.fail(f"duplicate body name {bname!r}", "name")
-        element = b.get("element", "str", None, choices=CELLS)
+        element = b.get("element", "str", None, choices=CELLS + PLANAR_CELLS)
         formulation_given = b.has("formulation")
-        formulation = b.get("formulation", "str", "solid", choices=("solid", "solid-shell", "fbar"))
+        formulation = b.get("formulation", "str", "solid", choices=("solid", "3d", "solid-shell", "fbar",
+                                                                    *PLANAR_FORMULATIONS))
+        formulation = "solid" if formulation == "3d" else formulation
+        thickness = b.get("thickness", "float", None, positive=True)
         options = b.get("options", "table", None)
         options = options.rest() if options is not None else {}
         material = read_material(b.get("material", "table")) if b.has("material") or not b.has("materials") else None
@@ -453,6 +489,7 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
             mesh = build_shell(b.get("shell", "table"), b.get("mesh", "table"), base)
         else:
             mesh = build_mesh(b.get("mesh", "table"), base, element)
+        _check_planar(b, bname, mesh, formulation, thickness)
         _check_cells(b, mesh, formulation)
         user_cells(b.get("cells", "table", None), mesh)
         user_sets(b.get("sets", "table", None), mesh)
@@ -479,6 +516,19 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
                 b.fail(f"form must be \"spatial\" or \"variational\", got {options['form']!r}", "options")
             if mesh.cell_type != "hex8" and options.get("form", "spatial") != "spatial":
                 b.fail(f"F-bar {mesh.cell_type} has the spatial form only; leave out 'form'", "options")
+        elif formulation in PLANAR_FORMULATIONS:
+            from ..fem.planar_cells import REDUCED_CELLS
+
+            unknown = sorted(set(options) - {"integration"})
+            if unknown:
+                b.fail(f"unknown option {unknown[0]!r} for formulation = \"{formulation}\" (known: integration)",
+                       "options")
+            if options.get("integration", "full") not in ("full", "reduced"):
+                b.fail(f"integration must be \"full\" or \"reduced\", got {options['integration']!r}", "options")
+            if options.get("integration") == "reduced" and any(t not in REDUCED_CELLS for t in mesh.cell_types):
+                b.fail(f"integration = \"reduced\" is for quad8 elements (as CPE8R, CPS8R, CAX8R), not "
+                       f"{' and '.join(mesh.cell_types)}: the others would have zero-energy modes", "options")
+            options = {**options, "thickness": 1.0 if thickness is None else thickness}
         elif options:
             unknown = sorted(set(options) - {"integration", "incompatible_modes"})
             if unknown:

@@ -66,6 +66,13 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     forces, pressures, tractions = read_loads(top, sets)
     body_forces = read_body_forces(top, bodies)
     contacts = read_contacts(top, sets, rigid)
+    planar = {b.name: b.formulation for b in bodies if b.formulation in ("plane_strain", "plane_stress",
+                                                                          "axisymmetric")}
+    for i, c in enumerate(contacts):  # (contact in the plane: not yet)
+        on = next((n for n in (c.slave[0], c.master[0]) if n in planar), None)
+        if on is not None:
+            top.fail(f"contact pair {c.name!r}: body {on!r} is a planar ({planar[on]}) body, and contact pairs "
+                     f"take three-dimensional bodies only", f"contact[{i}]")
     equations = read_equations(top, sets, dirichlet)
     springs, dashpots = read_springs(top, sets)
 

@@ -17,6 +17,9 @@ import numpy as np
 from ..fem import cells as other_cells
 from ..fem.quadrature import default_rule
 from ..fem.shapes import NODES, shape_functions
+from ..fem.planar_cells import CENTRE as PLANAR_CENTRE
+from ..fem.planar_cells import EDGES as PLANAR_EDGES
+from ..fem.planar_cells import reference_jacobians
 from .mesh import Mesh
 
 # face label -> (fixed axis, fixed value, axis of xi1, axis of xi2); tangents e_(xi1) x e_(xi2)
@@ -99,8 +102,16 @@ def _corners(ftype_nodes: int) -> int:
 
 
 def cell_face_tables(cell_type: str) -> list[np.ndarray]:
-    """The face tables of a cell type: one, or for wedges the triangles', then the quadrilaterals'."""
+    """The face tables of a cell type: one, or for wedges the triangles', then the quadrilaterals' (planar cells:
+    their edges)."""
+    if cell_type in PLANAR_EDGES:
+        return [PLANAR_EDGES[cell_type]]
     return list(WEDGE_FACES.values()) if cell_type == "wedge6" else [FACES[cell_type]]
+
+
+def _ncorners(mesh: Mesh, nfn: int) -> int:
+    """Corners of a face of ``nfn`` nodes of ``mesh``: edges of planar meshes 2, else :func:`_corners`."""
+    return 2 if mesh.is_planar else _corners(nfn)
 
 
 def _face_sizes(mesh: Mesh) -> list[int]:
@@ -130,7 +141,7 @@ def boundary_faces(mesh: Mesh, nfn: int | None = None) -> tuple[np.ndarray, np.n
         elem.append(b.first + k // nlf)
         local.append(k % nlf)
     allf = np.concatenate(allf)
-    corners = np.sort(allf[:, :_corners(nfn)], axis=1)
+    corners = np.sort(allf[:, :_ncorners(mesh, nfn)], axis=1)
     _, inv, cnt = np.unique(corners, axis=0, return_inverse=True, return_counts=True)
     idx = np.nonzero(cnt[inv.ravel()] == 1)[0]
     return np.ascontiguousarray(allf[idx]), np.concatenate(elem)[idx], np.concatenate(local)[idx]
@@ -167,7 +178,7 @@ def faces_on_nodes(mesh: Mesh, node_ids: np.ndarray, corners_only: bool = False)
     mask[np.asarray(node_ids, dtype=np.int64)] = True
     found = []
     for faces, _, _ in all_boundary_faces(mesh):
-        part = faces[:, :_corners(faces.shape[1])] if corners_only else faces
+        part = faces[:, :_ncorners(mesh, faces.shape[1])] if corners_only else faces
         found.append(np.ascontiguousarray(faces[np.all(mask[part], axis=1)]))
     hit = [f for f in found if len(f)]
     if len(hit) > 1:
@@ -185,7 +196,7 @@ def match_boundary_faces(mesh: Mesh, faces: np.ndarray) -> tuple[np.ndarray, np.
     """
     given = np.asarray(faces).shape[1] if np.ndim(faces) == 2 else 4
     bf, _, _ = boundary_faces(mesh, 3 if given == 3 else 4) if len(_face_sizes(mesh)) > 1 else boundary_faces(mesh)
-    nc = _corners(bf.shape[1])
+    nc = _ncorners(mesh, bf.shape[1])
     query = np.sort(np.asarray(faces, dtype=np.int64)[:, :nc], axis=1)
     if query.shape[0] == 0 or bf.shape[0] == 0:
         return np.empty((0, bf.shape[1]), dtype=np.int64), np.zeros(query.shape[0], dtype=bool)
@@ -215,12 +226,21 @@ def face_normals(points: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.cross(rho[:, 0], rho[:, 1])
 
 
+def edge_normals(points: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Unnormalised outward normals of the edges of a planar mesh: the chord from the first to the second corner
+    turned clockwise, (t_y, -t_x, 0), (nf, 3)."""
+    t = points[edges[:, 1]] - points[edges[:, 0]]
+    return np.column_stack([t[:, 1], -t[:, 0], np.zeros(len(t))])
+
+
 def jacobian_determinants(mesh: Mesh, points: np.ndarray | None = None) -> np.ndarray:
     """det(dX/dxi) of every element of a mesh of one cell type at natural ``points`` (npts, 3), (nelem, npts).
 
     The default points are the full Gauss rule of the cell type.
     """
     mesh.connectivity()
+    if mesh.cell_type in PLANAR_EDGES:
+        return reference_jacobians(mesh.cell_type, mesh.points, mesh.cells, points)
     if mesh.cell_type in other_cells.CELLS:
         pts = other_cells.rule(mesh.cell_type)[0] if points is None else np.atleast_2d(points)
         dN = other_cells.shapes(mesh.cell_type, pts)[1]
@@ -239,6 +259,7 @@ def check_orientation(mesh: Mesh) -> list[int]:
     """Elements whose Jacobian at the element centre is not positive (inverted node order)."""
     bad = []
     for first, piece in mesh.pieces():
-        det = jacobian_determinants(piece, np.array([_CENTRE.get(piece.cell_type, (0.0, 0.0, 0.0))]))[:, 0]
+        centre = PLANAR_CENTRE.get(piece.cell_type) or _CENTRE.get(piece.cell_type, (0.0, 0.0, 0.0))
+        det = jacobian_determinants(piece, np.array([centre]))[:, 0]
         bad += [first + int(e) for e in np.nonzero(~(det > 0.0))[0]]
     return bad

@@ -30,14 +30,20 @@ import numpy as np
 from ..fem.shapes import NODES
 from ..io.atomic import replacing
 from .faces import match_boundary_faces
-from .mesh import MIXABLE, Mesh
+from .mesh import MIXABLE, PLANAR_MIXABLE, Mesh
 
 if TYPE_CHECKING:
     import meshio
 
 _VOLUME = {"hexahedron": "hex8", "hexahedron27": "hex27", "tetra": "tet4", "tetra10": "tet10", "wedge": "wedge6",
            "hexahedron20": "hex20"}
-_TO_MESHIO = {v: k for k, v in _VOLUME.items()}
+#: the planar cells of a two-dimensional file (no volume cells: a plane strain, plane stress or axisymmetric body's
+#: mesh in the x-y plane; lines become edge sets)
+_PLANAR = {"quad": "quad4", "quad8": "quad8", "quad9": "quad9", "triangle": "tri3", "triangle6": "tri6"}
+_TO_MESHIO = {**{v: k for k, v in _VOLUME.items()}, **{v: k for k, v in _PLANAR.items()}}
+#: node permutations turning a clockwise planar cell counter-clockwise
+_PLANAR_FLIP = {"quad4": [0, 3, 2, 1], "quad8": [0, 3, 2, 1, 7, 6, 5, 4], "quad9": [0, 3, 2, 1, 7, 6, 5, 4, 8],
+                "tri3": [0, 2, 1], "tri6": [0, 2, 1, 5, 4, 3]}
 _FACE_CELLS = ("quad", "quad8", "quad9", "triangle", "triangle6")
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
@@ -190,6 +196,19 @@ def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,
     *SURFACE definitions ``surfaces`` (element, node: as ``abaqus.read_surfaces`` gives them) are read from ``p``
     unless given)."""
     found = sorted({_VOLUME[b.type] for b in m.cells if b.type in _VOLUME})
+    kinds, face_cells, note = _VOLUME, _FACE_CELLS, ""
+    flat = [b for b in m.cells if b.type in _PLANAR]
+    if not found and flat and m.points.shape[1] > 2 and np.any(m.points[np.unique(np.concatenate(
+            [b.data.ravel() for b in flat]))][:, 2] != 0.0):
+        note = " (two-dimensional cells make a planar body's mesh only in the x-y plane, z = 0)"
+    elif not found and flat:  # a two-dimensional mesh: planar cells, edge groups
+        kinds, face_cells = _PLANAR, ("line", "line3")
+        found = sorted({_PLANAR[b.type] for b in m.cells if b.type in _PLANAR})
+        planar_mixed = any(set(found) <= set(pair) for pair in PLANAR_MIXABLE)
+        if cell_type is None and len(found) > 1 and not planar_mixed:
+            raise MixedTypesError(_fail(p, f"holds {' and '.join(found)} cells, which one mesh does not mix (only "
+                                           f"quad4 with tri3, quad8 with tri6): take the cells of one type (a body's "
+                                           f"element = \"TYPE\")"))
     from meshio._mesh import topological_dimension
 
     other = sorted({b.type for b in m.cells if topological_dimension.get(b.type) == 3 and b.type not in _VOLUME})
@@ -200,9 +219,11 @@ def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,
         raise _fail(p, f"cell_type must be one of {', '.join(_TO_MESHIO)}, got {cell_type!r}")
     if not found:
         kinds = ", ".join(sorted({b.type for b in m.cells})) or "none"
-        raise _fail(p, f"no supported volume cells ({', '.join(_VOLUME)}); found: {kinds}")
+        raise _fail(p, f"no supported volume cells ({', '.join(_VOLUME)}); found: {kinds}{note}")
     if cell_type is None:
-        if len(found) > 1 and not set(found) <= set(MIXABLE):
+        if kinds is _PLANAR:
+            chosen = found
+        elif len(found) > 1 and not set(found) <= set(MIXABLE):
             raise MixedTypesError(_fail(p, f"holds {' and '.join(found)} cells, which one mesh does not mix (only "
                                            f"{', '.join(MIXABLE)} cells mix): take the cells of one type (a body's "
                                            f"element = \"TYPE\", read_mesh's cell_type)"))
@@ -211,14 +232,17 @@ def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,
         raise _fail(p, f"no {cell_type} cells; found: {', '.join(found)}")
     else:
         chosen = [cell_type]
-    vol = [b for b, blk in enumerate(m.cells) if _VOLUME.get(blk.type) in chosen]
+    vol = [b for b, blk in enumerate(m.cells) if kinds.get(blk.type) in chosen]
     first = np.cumsum([0] + [len(m.cells[b].data) for b in vol])
     pts = np.zeros((len(m.points), 3))
     pts[:, : min(3, m.points.shape[1])] = m.points[:, :3]
     used = np.unique(np.concatenate([m.cells[b].data.ravel() for b in vol]).astype(np.int64))
     new = np.full(len(pts), -1, dtype=np.int64)
     new[used] = np.arange(used.size)
-    mesh = Mesh.of_blocks(pts[used], [(_VOLUME[m.cells[b].type], new[m.cells[b].data.astype(np.int64)]) for b in vol])
+    blocks = [(kinds[m.cells[b].type], new[m.cells[b].data.astype(np.int64)]) for b in vol]
+    if kinds is _PLANAR:
+        blocks = [(t, _counter_clockwise(t, pts[used], c)) for t, c in blocks]
+    mesh = Mesh.of_blocks(pts[used], blocks)
 
     def keep(nodes: np.ndarray) -> np.ndarray:
         k = new[np.asarray(nodes, dtype=np.int64)]
@@ -233,7 +257,7 @@ def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,
             nodes.append(data.ravel())
             if b in vol:
                 elems.append(first[vol.index(b)] + ids)
-            elif m.cells[b].type in _FACE_CELLS and len(data):
+            elif m.cells[b].type in face_cells and len(data):
                 faces.append(new[data[:, :4]])
         if elems:
             mesh.element_sets[name] = np.unique(np.concatenate(elems)).astype(np.int64)
@@ -249,6 +273,17 @@ def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,
     if p.suffix.lower() == ".inp" or surfaces is not None:
         _abaqus_surfaces(p, m, mesh, vol, first, keep, surfaces)
     return mesh
+
+
+def _counter_clockwise(cell_type: str, points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """Planar ``cells`` with the clockwise ones (in the x-y plane) renumbered counter-clockwise."""
+    from ..fem.planar_cells import CENTRE, reference_jacobians
+
+    det = reference_jacobians(cell_type, points, cells, np.array([CENTRE[cell_type]]))[:, 0]
+    cells = cells.copy()
+    flip = det < 0.0
+    cells[flip] = cells[flip][:, _PLANAR_FLIP[cell_type]]
+    return cells
 
 
 def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep, surfaces=None) -> None:

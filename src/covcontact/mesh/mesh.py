@@ -9,13 +9,18 @@ from typing import NamedTuple
 import numpy as np
 
 #: volume cell type -> the type of its contact faces
-FACE_TYPE = {"hex8": "quad4", "hex18": "quad9", "hex27": "quad9", "tet4": "tri3", "tet10": "tri6", "hex20": "quad8"}
+FACE_TYPE = {"hex8": "quad4", "hex18": "quad9", "hex27": "quad9", "tet4": "tri3", "tet10": "tri6", "hex20": "quad8",
+             # the planar cells (plane strain, plane stress, axisymmetric bodies in the x-y plane): their edges
+             "quad4": "line2", "tri3": "line2", "quad8": "line3", "quad9": "line3", "tri6": "line3"}
 #: the face types of wedges (a face set holds one of them)
 WEDGE_FACE_TYPES = ("tri3", "quad4")
 #: nodes per face of each face type
-FACE_NODES = {"quad4": 4, "quad9": 9, "tri3": 3, "tri6": 6, "quad8": 8}
+FACE_NODES = {"quad4": 4, "quad9": 9, "tri3": 3, "tri6": 6, "quad8": 8, "line2": 2, "line3": 3}
 #: the cell types one mesh may mix: the linear cells, whose triangular and quadrilateral faces meet conformingly
 MIXABLE = ("hex8", "wedge6", "tet4")
+#: the planar cell types (x-y plane) and those one planar mesh may mix (edges of one type)
+PLANAR_CELLS = ("quad4", "quad8", "quad9", "tri3", "tri6")
+PLANAR_MIXABLE = (("quad4", "tri3"), ("quad8", "tri6"))
 
 
 class CellBlock(NamedTuple):
@@ -63,7 +68,9 @@ class Mesh:
             if len(kinds) < 2:
                 raise ValueError("a mixed mesh needs cells of at least two types; a mesh of one type is Mesh(points, "
                                  "cell_type, cells)")
-            if any(t not in MIXABLE for t in kinds):
+            if any(set(kinds) <= set(pair) for pair in PLANAR_MIXABLE):
+                pass
+            elif any(t not in MIXABLE for t in kinds):
                 raise ValueError(f"a mesh mixes only {', '.join(MIXABLE)} cells (their faces meet conformingly), "
                                  f"got {', '.join(kinds)}")
         else:
@@ -85,6 +92,11 @@ class Mesh:
         if len({t for t, _ in joined}) == 1:
             return cls(points, joined[0][0], np.concatenate([c for _, c in joined]))
         return cls(points, "mixed", None, mixed_blocks=joined)
+
+    @property
+    def is_planar(self) -> bool:
+        """Whether the cells are planar (quad4, quad8, quad9, tri3, tri6 in the x-y plane; their faces are edges)."""
+        return all(t in PLANAR_CELLS for t in self.cell_types)
 
     @property
     def is_mixed(self) -> bool:

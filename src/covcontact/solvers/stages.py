@@ -222,6 +222,7 @@ class StagePlan:
         constrained = np.zeros(sysm.n_dofs, dtype=bool)
         for c in conds:
             constrained[c.dofs] = True
+        constrained[getattr(sysm, "planar_dofs", np.zeros(0, dtype=np.int64))] = True  # planar bodies' z-dofs: zero
         parked = np.array(sorted(parked), dtype=np.int64)
         constrained[parked] = True
         released = released[~constrained[released]] if released.size else released
