@@ -139,11 +139,12 @@ def green_strain(H: np.ndarray) -> np.ndarray:
 
 def point_energies(solid, H: np.ndarray, state: dict) -> np.ndarray:
     """(n_elements, n_points) strain energy density per reference volume at the Gauss points: W(E) of St.
-    Venant-Kirchhoff and Neo-Hooke materials; for J2 plasticity the elastic (Hencky) energy of the elastic log strain
-    plus the accumulated plastic work, the whole stress work as CalculiX integrates it."""
+    Venant-Kirchhoff, Neo-Hooke and the rubber models; for J2 plasticity the elastic (Hencky) energy of the elastic
+    log strain plus the accumulated plastic work, the whole stress work as CalculiX integrates it."""
     from ..elements.composite import CompositeBody
-    from ..materials.hyperelastic import NEO_HOOKE, SVK
+    from ..materials.hyperelastic import NEO_HOOKE, SVK, material_energy
     from ..materials.plasticity import H_EP, H_WP, J2
+    from ..materials.rubber import RUBBER
 
     if isinstance(solid, CompositeBody):
         out = np.full(H.shape[:2], np.nan)
@@ -162,6 +163,9 @@ def point_energies(solid, H: np.ndarray, state: dict) -> np.ndarray:
     if kind == NEO_HOOKE:
         lnJ = np.log(np.linalg.det(F))
         return 0.5 * mu * (np.einsum("...ii->...", C) - 3.0) - mu * lnJ + 0.5 * lam * lnJ ** 2
+    if kind == RUBBER:  # (the rubber models: W point by point)
+        Fs = F.reshape(-1, 3, 3)
+        return np.array([material_energy(kind, params, np.ascontiguousarray(f)) for f in Fs]).reshape(H.shape[:-2])
     if kind != J2:
         raise ValueError(f"no strain energy for material kind {kind}")
     w, v = np.linalg.eigh(C)

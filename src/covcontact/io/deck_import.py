@@ -129,6 +129,17 @@ class _Writer:
             raise DeckError(f"{where}: *SOLID SECTION names the material {name!r}, which no *MATERIAL defines")
         if "unsupported" in mat:
             raise DeckError(mat["unsupported"])
+        if "hyperelastic" in mat:  # (*HYPERELASTIC: a rubber model of covcontact.materials.rubber)
+            if "E" in mat or "plastic" in mat or "kinematic" in mat:
+                raise DeckError(f"{mat['hyperelastic_where']}: *MATERIAL {name} has *HYPERELASTIC with *ELASTIC or "
+                                f"*PLASTIC: give one elastic law (covcontact's rubber models are elastic)")
+            for note in mat.get("notes", []):
+                if note not in self.notes:
+                    self.notes.append(note)
+            out = dict(mat["hyperelastic"])
+            if "density" in mat:
+                out["density"] = mat["density"]
+            return out
         if "E" not in mat:
             raise DeckError(f"{mat['where']}: *MATERIAL {name} has no *ELASTIC")
         out: dict = {"model": "svk", "E": mat["E"], "nu": mat["nu"]}
@@ -599,7 +610,8 @@ class _Writer:
 
     def _first_modulus(self) -> float:
         """The first elastic constant of the first material in the deck (CalculiX's reference for its defaults)."""
-        return next((mat["E"] for mat in self.m.materials.values() if "E" in mat), 0.0)
+        return next((mat.get("E", mat.get("E0")) for mat in self.m.materials.values() if "E" in mat or "E0" in mat),
+                    0.0)
 
     def _linear(self, entry: dict, it: Interaction, sts: bool, where: str) -> None:
         """PRESSURE-OVERCLOSURE=LINEAR as CalculiX reads it: face-to-face pairs the linear penalty law with slope K
@@ -651,7 +663,7 @@ class _Writer:
     def _hard_penalty(self, body: int) -> float:
         """10 E h of the master body (its smallest Young's modulus, h its mean element size), a force per length."""
         labels = self.b.el_labels[self.b.of_element == body]
-        mods = [self.m.materials[mat].get("E", 0.0) for s, mat, _ in self.m.sections
+        mods = [self.m.materials[mat].get("E", self.m.materials[mat].get("E0", 0.0)) for s, mat, _ in self.m.sections
                 if np.intersect1d(self.m.elsets.get(s, np.zeros(0, np.int64)), labels).size]
         X = self.m.X[self.b.of_node == body]
         h = float(np.prod(np.maximum(X.max(axis=0) - X.min(axis=0), 1e-300)) / max(labels.size, 1)) ** (1.0 / 3.0)

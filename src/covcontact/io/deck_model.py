@@ -31,6 +31,7 @@ NFACES = {"hex8": 6, "hex20": 6, "tet10": 4, "tet4": 4, "wedge6": 5}
 
 #: the keywords read (everything else is unsupported); output requests are read for the .dat table
 SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL", "ELASTIC", "PLASTIC", "DENSITY",
+             "HYPERELASTIC",
              "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
@@ -236,6 +237,8 @@ class _Reader(LoadCards):
                 m.materials[self.material] = {"where": c.where()}
             elif c.name in ("ELASTIC", "PLASTIC", "DENSITY"):
                 self._material(c)
+            elif c.name == "HYPERELASTIC":
+                self._hyperelastic(c)
             elif c.name == "SOLID SECTION":
                 m.sections.append((c.param("ELSET", required=True).upper(), c.param("MATERIAL", required=True).upper(),
                                    c.where()))
@@ -378,7 +381,8 @@ class _Reader(LoadCards):
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
                     c.name == "CONTACT PAIR" and p in ("ADJUST", "SMALL SLIDING")) or (
                     c.name == "EQUATION" and p in ("REMOVE", "REMOVE ALL")) or (
-                    c.name == "PLASTIC" and p == "HARDENING") or (c.name == "SECTION PRINT" and p == "SURFACE"):
+                    c.name == "PLASTIC" and p == "HARDENING") or (c.name == "SECTION PRINT" and p == "SURFACE") or (
+                    c.name == "HYPERELASTIC" and (p == "N" or _rubber_option(p) is not None)):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
@@ -699,6 +703,90 @@ class _Reader(LoadCards):
                 return
             mat["plastic"] = pts
 
+    def _hyperelastic(self, c: Card) -> None:
+        """*HYPERELASTIC, <model>, N=: the rubber models (covcontact.materials.rubber) with CalculiX's data-line order
+        (Abaqus's, eight values a line): ARRUDA-BOYCE mu, lambda_m, D; MOONEY-RIVLIN C10, C01, D1; NEO HOOKE C10, D1;
+        OGDEN mu_1, alpha_1, ..., mu_N, alpha_N, D_1..D_N; POLYNOMIAL C10, C01, C20, C11, C02, C30, ..., D_1..D_N;
+        REDUCED POLYNOMIAL C10, C20, ..., D_1..D_N; YEOH C10, C20, C30, D1, D2, D3 (no model: POLYNOMIAL, N=1). A
+        compressibility of 0 is replaced as CalculiX replaces it: D_i = (0.1 / mu)^i (an initial Poisson's ratio of
+        0.475), said in a note."""
+        if self.material is None:
+            raise c.fail("comes before any *MATERIAL")
+        mat = self.m.materials[self.material]
+        models = [m for m in (_rubber_option(p) for p in c.params) if m is not None]
+        if len(models) > 1:
+            raise c.fail(f"names {len(models)} models; give one of ARRUDA-BOYCE, MOONEY-RIVLIN, NEO HOOKE, OGDEN, "
+                         f"POLYNOMIAL, REDUCED POLYNOMIAL, YEOH")
+        model = models[0] if models else "polynomial"
+        if model == "van-der-waals":
+            mat["unsupported"] = f"{c.where()}: *HYPERELASTIC, VAN DER WAALS is not supported"
+            return
+        n_text = c.param("N", "1")
+        if not n_text.isdigit() or not 1 <= int(n_text):
+            raise c.fail(f"N={n_text}: the order is a whole number from 1 to 6")
+        N = int(n_text)
+        if model not in ("ogden", "polynomial", "reduced-polynomial") and N != 1:
+            raise c.fail(f"N={N} is for OGDEN, POLYNOMIAL and REDUCED POLYNOMIAL")
+        if N > 6:
+            raise c.fail(f"N={N}: the order is at most 6")
+        rows = c.rows()
+        if not rows:
+            raise c.fail("needs a data line")
+        if model == "polynomial":
+            names = [f"c{n - j}{j}" for n in range(1, N + 1) for j in range(n + 1)]
+        elif model == "reduced-polynomial":
+            names = [f"c{n}0" for n in range(1, N + 1)]
+        elif model == "ogden":
+            names = [f"{k}{p}" for p in range(1, N + 1) for k in ("mu", "alpha")]
+        else:
+            names = {"arruda-boyce": ["mu", "lambda_m"], "mooney-rivlin": ["c10", "c01"], "neo-hooke": ["c10"],
+                     "yeoh": ["c10", "c20", "c30"]}[model]
+        nd = 3 if model == "yeoh" else N
+        need = len(names) + nd
+        per = -(-(need + 1) // 8)  # data lines of one temperature (eight values a line)
+        if len(rows) > per:
+            self.m.unsupported.append(f"{c.where()}: *HYPERELASTIC: temperature-dependent hyperelasticity "
+                                      f"({-(-len(rows) // per)} temperatures) is not supported; with "
+                                      f"--ignore-unsupported the first temperature's constants are used")
+        values = []
+        for k, row in enumerate(rows[:per]):
+            for j in range(8 if k < per - 1 else need - len(values)):
+                values.append(c.number(k, j, row, f"constant {len(values) + 1}", 0.0))
+        const = dict(zip(names, values[:len(names)]))
+        D = values[len(names):need]
+        if model == "arruda-boyce":
+            um = const["mu"]
+        elif model == "ogden":
+            um = sum(const[f"mu{p}"] for p in range(1, N + 1))
+        else:
+            um = 2.0 * (const.get("c10", 0.0) + const.get("c01", 0.0))
+        for i in range(min(len(D), 3)):  # (CalculiX replaces its first three compressibilities)
+            if abs(D[i]) < 1e-10 and um > 0.0:
+                D[i] = (0.1 / um) ** (i + 1)
+                mat.setdefault("notes", []).append(
+                    f"{c.where()}: *HYPERELASTIC: the compressibility D{i + 1} = 0 is replaced by CalculiX's default "
+                    f"(0.1 / mu0)^{i + 1} = {D[i]:.6g} (an initial Poisson's ratio of 0.475)")
+        out: dict = {"model": model}
+        if model == "ogden":
+            out.update({"mu": [const[f"mu{p}"] for p in range(1, N + 1)],
+                        "alpha": [const[f"alpha{p}"] for p in range(1, N + 1)], "d": D})
+        elif model == "arruda-boyce":
+            out.update({"mu": const["mu"], "lambda_m": const["lambda_m"], "d": D[0]})
+        else:
+            out.update({k: v for k, v in const.items() if v != 0.0 or k == "c10"})
+            out.update({f"d{i + 1}": v for i, v in enumerate(D)})
+            if model in ("polynomial", "reduced-polynomial"):
+                out["n"] = N
+        from ..materials.rubber import RubberError, rubber_from_keys
+
+        try:  # (the constants checked at the card; E0, the initial Young's modulus, for the contact defaults)
+            keys = {k: v for k, v in out.items() if k != "model"}
+            mat["E0"] = rubber_from_keys(model, keys).E
+        except RubberError as exc:
+            raise c.fail(f"{exc.key}: {exc}" if exc.key else str(exc)) from None
+        mat["hyperelastic"] = out
+        mat["hyperelastic_where"] = c.where()
+
     def _interaction(self, c: Card) -> None:
         if self.interaction is None:
             raise c.fail("comes before any *SURFACE INTERACTION")
@@ -813,3 +901,11 @@ class _Reader(LoadCards):
                 raise c.fail(f"{key} must be a node label, got {v!r}")
             refs.append(int(v) if v is not None else None)
         self.m.rigid_bodies.append((np.asarray(nodes, dtype=np.int64), refs[0], refs[1], c.where()))
+
+
+def _rubber_option(param: str) -> str | None:
+    """The rubber model a *HYPERELASTIC parameter names (CalculiX drops the blanks: NEO HOOKE is NEOHOOKE), or None."""
+    key = param.upper().replace(" ", "").replace("_", "")
+    return {"ARRUDA-BOYCE": "arruda-boyce", "MOONEY-RIVLIN": "mooney-rivlin", "NEOHOOKE": "neo-hooke",
+            "OGDEN": "ogden", "POLYNOMIAL": "polynomial", "REDUCEDPOLYNOMIAL": "reduced-polynomial", "YEOH": "yeoh",
+            "VANDERWAALS": "van-der-waals"}.get(key)

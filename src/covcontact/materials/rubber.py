@@ -163,8 +163,8 @@ class Rubber:
         """'mooney-rivlin: initial shear modulus mu0 = 2 (c10 + c01) = 1.2, bulk modulus K0 = 2 / d1 = 1200 (K0 / mu0
         = 1000, initial Poisson's ratio 0.4995)'."""
         mu, K = initial_moduli(self)
-        how = {"arruda-boyce": "mu (1 + 3 / (5 lambda_m^2) + ...)", "gent": "mu", "ogden": "sum of mu_i"}.get(
-            self.model, "2 (c10 + c01)")
+        how = {"arruda-boyce": "mu (1 + 3 / (5 lambda_m^2) + ...)", "gent": "mu", "ogden": "sum of mu_i",
+               "neo-hooke": "2 c10", "reduced-polynomial": "2 c10", "yeoh": "2 c10"}.get(self.model, "2 (c10 + c01)")
         dname = "d" if self.model == "arruda-boyce" else "d1"
         return (f"{self.model}: initial shear modulus mu0 = {how} = {mu:.6g}, bulk modulus K0 = 2 / {dname} = {K:.6g} "
                 f"(K0 / mu0 = {K / mu:.4g}, initial Poisson's ratio {self.nu:.6g})")
