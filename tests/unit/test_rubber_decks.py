@@ -52,7 +52,7 @@ RF
 """
 
 #: (the *HYPERELASTIC card, the same model as covcontact's Rubber, CalculiX's total force on XMAX at the end): the
-#: deck above run by CalculiX 2.21 (ccx -i), its .dat's "total force (fx,fy,fz) for set XMAX" at time 1 (the cube
+#: deck above run by CalculiX 2.20 (ccx -i), its .dat's "total force (fx,fy,fz) for set XMAX" at time 1 (the cube
 #: stretched to twice its length), printed to 7 digits
 CASES = {
     "mooney-rivlin": ("*HYPERELASTIC, MOONEY-RIVLIN\n0.4, 0.1, 0.05",

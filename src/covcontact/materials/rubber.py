@@ -1,4 +1,4 @@
-"""Rubber: the hyperelastic models of the Abaqus and CalculiX manuals (docs/theory.md, section 25).
+"""Rubber: the hyperelastic models of the Abaqus and CalculiX manuals (docs/theory.md, section 26).
 
 Every model splits the strain energy density per unit reference volume into a deviatoric and a volumetric part,
 
