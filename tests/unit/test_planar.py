@@ -270,3 +270,44 @@ def test_bad_input_one_line(tmp_path, body, extra, expect):
     assert proc.returncode == 2, proc.stdout + proc.stderr
     lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and expect in lines[0], proc.stderr
+
+
+def test_gmsh_2d_file(tmp_path):
+    """A Gmsh 2D file: its quadrilaterals become a planar mesh (a clockwise cell turned counter-clockwise), its
+    physical curves edge sets with outward normals."""
+    from covcontact.mesh import read_mesh
+    from covcontact.mesh.faces import edge_normals
+
+    (tmp_path / "sq.msh").write_text(textwrap.dedent("""\
+        $MeshFormat
+        2.2 0 8
+        $EndMeshFormat
+        $PhysicalNames
+        2
+        1 1 "bottom"
+        2 2 "plate"
+        $EndPhysicalNames
+        $Nodes
+        6
+        1 0 0 0
+        2 1 0 0
+        3 1 1 0
+        4 0 1 0
+        5 2 0 0
+        6 2 1 0
+        $EndNodes
+        $Elements
+        4
+        1 1 2 1 1 1 2
+        2 1 2 1 1 2 5
+        3 3 2 2 1 1 4 3 2
+        4 3 2 2 1 2 5 6 3
+        $EndElements
+        """))
+    m = read_mesh(tmp_path / "sq.msh")
+    assert m.cell_type == "quad4" and m.is_planar and m.n_cells == 2
+    assert set(m.element_sets) >= {"plate"} and m.face_sets["bottom"].shape == (2, 2)
+    n = edge_normals(m.points, m.face_sets["bottom"])
+    assert np.all(n[:, 1] < 0.0)
+    from covcontact.mesh.faces import check_orientation
+    assert check_orientation(m) == []

@@ -298,7 +298,8 @@ def planar_chunk(kind, params, form, thick, X, u, conn, e0, N, dN, w, want_K, Ke
 @njit(parallel=True, cache=True)
 def planar_gauss_fields(kind, params, form, thick, X, u, conn, N, dN, w, mode, out, hist_n):
     """Per-element quantities: mode 0 strain energy int W dV; 1 minimum det J0 (axisymmetric: min(det J0, R)); 2
-    volume averages of Cauchy stress (with the out-of-plane or hoop component 33), S and Green-Lagrange E (Voigt)."""
+    volume averages of Cauchy stress (with the out-of-plane or hoop component 33), S and Green-Lagrange E (Voigt); 3
+    the Cauchy stress of every Gauss point g in out[e, 6 g: 6 g + 6]."""
     ne = conn.shape[0]
     nen = conn.shape[1]
     for e in prange(ne):
@@ -310,6 +311,7 @@ def planar_gauss_fields(kind, params, form, thick, X, u, conn, N, dN, w, mode, o
         S = np.empty(6)
         D = np.empty((6, 6))
         hscr = np.empty(hist_n.shape[2])
+        row = np.empty(12)
         _gather(X, u, conn, e, Xe, ue)
         for r in range(out.shape[1]):
             out[e, r] = 0.0
@@ -333,6 +335,13 @@ def planar_gauss_fields(kind, params, form, thick, X, u, conn, N, dN, w, mode, o
             _point_response(kind, params, form, F, H, hist_n[e, g], hscr, S, D)
             if mode == 0:
                 out[e, 0] += wd * material_energy(kind, params, F)
+                continue
+            if mode == 3:
+                for r in range(12):
+                    row[r] = 0.0
+                add_cauchy_pk2(F, S, 1.0, row)
+                for r in range(6):
+                    out[e, 6 * g + r] = row[r]
                 continue
             add_cauchy_pk2(F, S, wd, out[e])
             for I in range(6):
@@ -389,6 +398,15 @@ class PlanarBody(ElementBody):
             R = np.einsum("pa,ea->ep", self.N, self.X[self.cells][:, :, 0])
             self._gauss_volumes = det * self.weights[None, :] * _weight_factor(self.formulation, self.thickness, R)
         return self._gauss_volumes
+
+    def gauss_points(self) -> np.ndarray:
+        """(nelem, ngp, 2) reference x-y coordinates of the Gauss points (axisymmetric: R, Z)."""
+        return np.einsum("pa,eai->epi", self.N, self.X[self.cells][:, :, :2])
+
+    def gauss_cauchy(self, u: np.ndarray, state: dict | None = None) -> np.ndarray:
+        """(nelem, ngp, 6) Cauchy stress at every Gauss point (Voigt 11, 22, 33, 12, 23, 13; 33 the out-of-plane or
+        hoop stress) at displacement u and history ``state`` (default: the reference state)."""
+        return self._fields(u, 3, 6 * self.weights.size, state).reshape(self.n_elements, -1, 6)
 
     def _chunk(self, u, e0, want_K, Ke, fe, flags, nblocks, state) -> None:
         hist = state["hist"]
