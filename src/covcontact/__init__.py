@@ -10,3 +10,9 @@ __version__ = "0.1.0"
 # compilation; covcontact's output is plain text
 if _under_launcher():
     _os.environ.setdefault("NUMBA_DISABLE_ERROR_MESSAGE_HIGHLIGHTING", "1")
+
+# kernels compiled from older sources are not loaded (kernel_cache.py)
+if _os.environ.get("COVCONTACT_KEEP_KERNEL_CACHE") != "1":
+    from . import kernel_cache as _kernel_cache
+
+    _kernel_cache.check()
