@@ -113,6 +113,19 @@ def _parser() -> argparse.ArgumentParser:
                        "upgrading numba.")
     w.add_argument("--only", default=None, metavar="TEXT",
                    help="only the warm-up problems whose label contains TEXT (default: all)")
+    f = sub.add_parser("fit-material", help="fit a rubber model to test data: constants, errors, stability, plot",
+                       description="Fit the rubber models of the material tables with test_data (uniaxial, "
+                       "equibiaxial, planar nominal stress against nominal strain; docs/input.md) by least squares, "
+                       "incompressible as Abaqus fits; print the constants, the error of every test, Drucker's "
+                       "stability verdict and the problem-file line. An unstable fit is a warning (exit 0).")
+    f.add_argument("data", help="a TOML file with a [material] table (model, n, test_data) or a problem file")
+    f.add_argument("--model", default=None, help="fit this model instead of the table's (neo-hooke, mooney-rivlin, "
+                   "polynomial, reduced-polynomial, yeoh, arruda-boyce, gent, ogden)")
+    f.add_argument("--n", type=int, default=None, help="the order N (polynomial, reduced polynomial) or the number "
+                   "of Ogden terms")
+    f.add_argument("--error", default=None, choices=("relative", "absolute"),
+                   help="the error minimised (default: the table's, else relative, as Abaqus)")
+    f.add_argument("--plot", default=None, metavar="PNG", help="write a plot of the data and the fit")
     sub.add_parser("info", help="version, linear solvers, threads",
                    description="Print the version, the linear solvers available here and the thread count.")
     x = sub.add_parser("ccx", help="run a CalculiX deck as `ccx -i JOB` does (for pre-processors)",
@@ -471,6 +484,12 @@ def _ranks_info() -> str:
             f"where auto picks petsc-gamg")
 
 
+def cmd_fit_material(args) -> int:
+    from .materials.fit import fit_material_command
+
+    return fit_material_command(args.data, args.model, args.n, args.plot, args.error)
+
+
 def cmd_info(args) -> int:
     import numba
 
@@ -489,7 +508,8 @@ def cmd_info(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     handler = {"run": cmd_run, "study": cmd_study, "check-tangent": cmd_check_tangent,
-               "compile": cmd_compile, "info": cmd_info, "import": cmd_import, "ccx": cmd_ccx}[args.command]
+               "compile": cmd_compile, "info": cmd_info, "import": cmd_import, "ccx": cmd_ccx,
+               "fit-material": cmd_fit_material}[args.command]
     if args.command not in ("info", "compile"):
         from .compile_notice import install
 

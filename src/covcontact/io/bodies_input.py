@@ -187,6 +187,13 @@ def read_material(sec: Section):
     if model in MODELS[1:] or (model in ("neo-hooke", "neohooke") and not sec.has("E") and not sec.has("nu")):
         # the rubber models of the manuals (Neo-Hooke with c10 and d1; with E and nu the compressible Neo-Hooke)
         density = sec.get("density", "float", None, positive=True)
+        if sec.has("test_data"):  # (the constants fitted to test data: materials/fit.py)
+            from ..materials.fit import FitError, fitted_material
+
+            try:
+                return fitted_material(model, sec.rest(), Path(sec.file).parent, density)
+            except (FitError, RubberError) as exc:
+                sec.fail(str(exc), exc.key)
         try:
             return rubber_from_keys(model, sec.rest(), density)
         except RubberError as exc:

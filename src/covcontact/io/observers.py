@@ -269,8 +269,11 @@ class Progress(Observer):
     def started(self, run) -> None:
         for w in run.warnings:
             self.say(f"warning: {w}", always=True)
+        from ..materials.fit import fit_notes
         from ..materials.rubber import moduli_notes
 
+        for note in fit_notes(run.problem.bodies):  # (constants fitted to test data: the fit's report, once)
+            self.say(note, always=True) if note.startswith("warning: ") else self.say(f"note: {note}")
         for note in moduli_notes(run.problem.bodies):  # (the rubber models' initial moduli, to check the constants)
             self.say(f"note: {note}")
 
