@@ -79,7 +79,7 @@ class TestData:
     __test__ = False  # (not a pytest class)
 
 
-def test_data(kind: str, strain, stress, name: str = "") -> TestData:
+def make_test(kind: str, strain, stress, name: str = "") -> TestData:
     """A checked TestData: a known kind, numbers of equal counts (at least one point), finite, strains > -1 and
     strictly monotone (FitError naming the key: kind, strain, stress)."""
     k = _KIND_ALIASES.get(str(kind).strip().lower().replace(" ", "-"))
@@ -306,7 +306,7 @@ def stable_at(model: Rubber | Form, kind: str, lam: float) -> bool:
     return bool(tr > 0.0 and det > 0.0)
 
 
-def _first_unstable(form: Form, kind: str, lam_end: float, n: int = 2000) -> float | None:
+def _first_unstable(form: Form, kind: str, lam_end: float, n: int = 500) -> float | None:
     """The stretch, from 1 towards ``lam_end``, where the mode first becomes unstable (to 1e-10 in log stretch), or
     None."""
     L = np.linspace(0.0, math.log(lam_end), n + 1)[1:]
@@ -564,11 +564,11 @@ def fit(model: str, tests: list[TestData], n: int | None = None, error: str = "r
 
 
 def _ogden_starts(n: int) -> list[np.ndarray]:
-    """Starting exponents: the distinct n-subsets of a spread of alphas (at most 60, deterministic)."""
+    """Starting exponents: the distinct n-subsets of a spread of alphas (at most 20, deterministic)."""
     cand = [-6.0, -2.0, -1.0, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 8.0]
     combos = list(itertools.combinations(cand, n))
-    if len(combos) > 60:
-        idx = np.linspace(0, len(combos) - 1, 60).round().astype(int)
+    if len(combos) > 20:
+        idx = np.linspace(0, len(combos) - 1, 20).round().astype(int)
         combos = [combos[i] for i in idx]
     return [np.array(c) for c in combos]
 
@@ -616,7 +616,7 @@ def read_tests(entries, base: Path) -> list[TestData]:
                 raise FitError(f"no file {p}", f"{at}.file")
             try:
                 strain, stress = read_table(p)
-                out.append(test_data(e["kind"], strain, stress, p.name))
+                out.append(make_test(e["kind"], strain, stress, p.name))
             except FitError as exc:
                 raise FitError(str(exc), f"{at}.file" if exc.key in ("file", "strain", "stress") else f"{at}.kind") \
                     from None
@@ -628,7 +628,7 @@ def read_tests(entries, base: Path) -> list[TestData]:
             if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
                 raise FitError("must be an array of numbers", f"{at}.{key}")
         try:
-            out.append(test_data(e["kind"], e["strain"], e["stress"], ""))
+            out.append(make_test(e["kind"], e["strain"], e["stress"], ""))
         except FitError as exc:
             raise FitError(str(exc), f"{at}.{exc.key}") from None
     return out
