@@ -713,6 +713,10 @@ class _Reader(LoadCards):
         if self.material is None:
             raise c.fail("comes before any *MATERIAL")
         mat = self.m.materials[self.material]
+        if any(" ".join(p.upper().split()) == "TEST DATA INPUT" for p in c.params):
+            raise c.fail("TEST DATA INPUT: constants fitted from *UNIAXIAL, *BIAXIAL and *PLANAR TEST DATA are not "
+                         "read from decks; fit them with `covcontact fit-material` (test_data, docs/input.md) and give "
+                         "them on the data line")
         models = [m for m in (_rubber_option(p) for p in c.params) if m is not None]
         if len(models) > 1:
             raise c.fail(f"names {len(models)} models; give one of ARRUDA-BOYCE, MOONEY-RIVLIN, NEO HOOKE, OGDEN, "
