@@ -24,6 +24,7 @@ from .element import CASE_A, CASES
 from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, start_history, transfer_history
 from .kernels import contact_batch
 from .laws import is_active, linear_equivalents, uzawa_update
+from .planar import segment_pass
 from .reference import map_analytic, map_rigid_nodes
 from .search import candidates
 from .selfcontact import FRONT_COS, HOLD_COS, drop_excluded, facet_normals, slave_normals
@@ -164,6 +165,8 @@ class ContactManager:
             pcase = p.case if case is None else case
             if p.tied:
                 self._tied_pass(p, xe, t, want_K, want_parts, ev)
+            elif p.curve is not None:  # node-to-segment contact in the plane
+                segment_pass(self, p, xe, pcase, t, want_K, want_parts, ev)
             elif p.surface is not None:
                 self._mesh_pass(k, p, xe, pcase, c, g0, t, committed.x, want_K, want_parts, ev)
             else:
@@ -511,6 +514,9 @@ class ContactManager:
             if p.surface is not None:
                 f = state.passes[k].facet[act]
                 nodes.append(self.points.nodes(p.surface.faces[f[f >= 0]].ravel()))
+            elif p.curve is not None:
+                f = state.passes[k].facet[act]
+                nodes.append(p.curve.segments[f[f >= 0]].ravel())
         nodes = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, int)
         nodes = nodes[nodes < self.N]
         return (3 * nodes[:, None] + np.arange(3)).ravel()

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..mesh.faces import all_boundary_faces
+from . import planar
 from .analytic import Cylinder, Plane, Sphere
 from .element import CASES
 from .facets import patch_count, quad_patches
@@ -59,6 +60,7 @@ class Pass:
     slave_facet: np.ndarray | None = None  # sts: (ns,) each point's facet in slave_faces
     own_patch: np.ndarray | None = None    # sts self-contact: (ns,) each point's patch quadrilateral in surface
     law: object = None                     # a laws.PressureLaw evaluated in the Python layer (None: band's law)
+    curve: object = None                   # planar bodies: the master curve of node-to-segment contact (.planar)
 
     @property
     def ns(self) -> int:
@@ -193,6 +195,8 @@ def _pressure_law(pair) -> PressureLaw | None:
 def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None, surfaces=None) -> Pass:
     """The pass of ``slave`` against ``master`` of ``pair``; ``tangent`` overrides the pair's case. ``surfaces``:
     the (body, face set) list of a self-contact, merged into one surface that is both slave and master."""
+    if surfaces is None and planar.planar_body(num, slave[0]) is not None:  # contact in the plane (.planar)
+        return planar.make_pass(num, name, slave, master, pair, tangent, Pass, analytic_surface)
     X = num.reference()
     if surfaces is not None:
         slave_faces = np.vstack([num.mesh_of(b)[0].face_sets[f] + num.mesh_of(b)[1] for b, f in surfaces])

@@ -68,11 +68,13 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
     contacts = read_contacts(top, sets, rigid)
     planar = {b.name: b.formulation for b in bodies if b.formulation in ("plane_strain", "plane_stress",
                                                                           "axisymmetric")}
-    for i, c in enumerate(contacts):  # (contact in the plane: not yet)
-        on = next((n for n in (c.slave[0], c.master[0]) if n in planar), None)
-        if on is not None:
-            top.fail(f"contact pair {c.name!r}: body {on!r} is a planar ({planar[on]}) body, and contact pairs "
-                     f"take three-dimensional bodies only", f"contact[{i}]")
+    for i, c in enumerate(contacts):  # contact in the plane: node-to-segment (covcontact.contact.planar)
+        names = [b for b, _ in c.self_surfaces] if c.self_surfaces else [c.slave[0], c.master[0]]
+        if any(n in planar for n in names):
+            from ..contact.planar import check_pair
+            why = check_pair(c, bodies, rigid)
+            if why is not None:
+                top.fail(why, f"contact[{i}]")
     equations = read_equations(top, sets, dirichlet)
     springs, dashpots = read_springs(top, sets)
 

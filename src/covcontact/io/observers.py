@@ -197,7 +197,9 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
         for faces, pressure in model.contact.facet_fields(state.contact, fields[1]):
             keep = (faces < n).all(axis=1)
             if keep.any():
-                blocks.append((FACE_BY_NODES[faces.shape[1]], faces[keep],
+                planar = np.isin(3 * faces[keep][:, 0] + 2, getattr(sysm, "planar_dofs", ())).all()
+                blocks.append((("line", "line3")[faces.shape[1] - 2] if planar else FACE_BY_NODES[faces.shape[1]],
+                               faces[keep],
                                {"contact_facet_pressure": pressure[keep]}))
     points = sysm.X[:n].copy()
     pdata = {"displacement": U.copy(), "cauchy_nodal": cauchy}

@@ -18,7 +18,7 @@ _HEX18_SPLIT = np.array([
 ])
 _VTK_NAME = {"hex8": "hexahedron", "hex27": "hexahedron27", "quad4": "quad", "quad9": "quad9", "tet4": "tetra",
              "tet10": "tetra10", "wedge6": "wedge", "hex20": "hexahedron20", "tri3": "triangle", "tri6": "triangle6",
-             "quad8": "quad8"}
+             "quad8": "quad8", "line": "line", "line3": "line3"}
 
 
 def atomic_write_text(path: Path, text: str) -> None:

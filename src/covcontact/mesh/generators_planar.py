@@ -51,6 +51,7 @@ def _lattice(cell: str, n0: int, n1: int, bias0: float = 1.0) -> tuple[np.ndarra
     else:
         h = bias0 ** np.arange(n0)
         b0 = np.concatenate([[0.0], np.cumsum(h) / h.sum()])
+        b0[-1] = 1.0  # exactly: the last row of nodes makes the "outer" and "xmax" sets
     b1 = np.linspace(0.0, 1.0, n1 + 1)
 
     def refine(b):

@@ -1,0 +1,483 @@
+"""Covariant node-to-segment contact in the plane: slave nodes of a planar body against master curves made of the
+edges of a planar body (docs/theory.md section 28).
+
+The master curve of a segment is x(xi) = N_b(xi) x_b, xi in [-1, 1], with 2 nodes (linear; edges of quad4 and
+tri3) or 3 (quadratic: the two corners, then the mid-node; edges of quad8, quad9 and tri6). With the one convective
+coordinate xi:
+
+    rho = x,xi,  a = rho . rho (the metric a_11),  n = (rho_y, -rho_x) / sqrt(a)  (outward: the cells are
+    counter-clockwise and an edge runs from its first to its second corner),
+    h = x,xixi . n,  kappa = h / a (the curvature of the master curve),
+    g = (x_s - x(xi)) . n at the closest point (x_s - x(xi)) . rho = 0 (Newton on xi: f' = -(a - g h) = -c).
+
+Penalty (or augmented Lagrangian with the multiplier lam_k <= 0 held fixed): g_e = g + lam_k / eps,
+p = eps <-g_e>, energy W = eps / 2 <g_e>^2. With alpha = (-N_b, 1) and beta = (-N_b,xi, 0) over the master nodes
+and the slave (the slave last), the residual is R_b = eps g_e alpha_b n, and every tangent part has the block form
+
+    K_bc = eps [ alpha_b alpha_c (c_nn n(x)n + M rho(x)rho) + g_e (alpha_c n(x)u_b + alpha_b u_c(x)n)
+                 - g_e g s_bc n(x)n ],   u_b = beta_b W rho,   s_bc = beta_b S beta_c
+
+with (c_nn, M, W, S) = main (1, 0, 0, 0), rotational (0, 0, 1/a, 0), curvature (0, -g_e h / a^2, 0, 0) and second
+order (0, -g_e g h^2 / (a^2 c), 1/c - 1/a, 1/c), c = a - g h: the planar reduction of the 3D element
+(:mod:`.element`, one index). Their sum is the exact Hessian of W. All vectors carry three components, the z one
+zero: the planar bodies keep three dofs per node with u_z held at zero, and the contact does not see z.
+
+A slave whose projection lies on no segment (the closest point of the curve is a vertex between two segments, in the
+region behind a valley corner) is in contact with the vertex: g = s |x_s - x_v| with s the sign of
+(x_s - x_v) . (n_1 + n_2) over the two segments' normals, n = (x_s - x_v) / g, and the exact tangent
+eps [n(x)n + g_e / g (I - n(x)n)] (in-plane I) on the vertex-slave pair, for every tangent case (the 3D code's edge
+and vertex points do the same). The open ends of a master curve take no vertex contact.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .element import CASE_A, CASE_B, CASE_C, CASE_D, CASE_EXACT
+
+#: accepted distance outside [-1, 1] of a projection on a segment
+INSIDE_TOL = 1e-6
+#: largest number of Newton iterations of the projection
+MAX_ITER = 40
+
+
+@njit(cache=True)
+def segment_shapes(nen, xi, N, dN, ddN):
+    """N, N,xi, N,xixi of a 2-node (ends -1, 1) or 3-node (ends, then the mid-node at 0) segment."""
+    if nen == 2:
+        N[0] = 0.5 * (1.0 - xi)
+        N[1] = 0.5 * (1.0 + xi)
+        dN[0] = -0.5
+        dN[1] = 0.5
+        ddN[0] = 0.0
+        ddN[1] = 0.0
+    else:
+        N[0] = 0.5 * xi * (xi - 1.0)
+        N[1] = 0.5 * xi * (xi + 1.0)
+        N[2] = 1.0 - xi * xi
+        dN[0] = xi - 0.5
+        dN[1] = xi + 0.5
+        dN[2] = -2.0 * xi
+        ddN[0] = 1.0
+        ddN[1] = 1.0
+        ddN[2] = -2.0
+
+
+@njit(cache=True)
+def segment_point(xseg, xi):
+    """(x, rho, x,xixi) in the plane (2-vectors) of a segment (nen, >= 2) at xi."""
+    nen = xseg.shape[0]
+    N = np.empty(3)
+    dN = np.empty(3)
+    ddN = np.empty(3)
+    segment_shapes(nen, xi, N, dN, ddN)
+    x = np.zeros(2)
+    r = np.zeros(2)
+    r2 = np.zeros(2)
+    for b in range(nen):
+        for p in range(2):
+            x[p] += N[b] * xseg[b, p]
+            r[p] += dN[b] * xseg[b, p]
+            r2[p] += ddN[b] * xseg[b, p]
+    return x, r, r2
+
+
+@njit(cache=True)
+def project_on_segment(xseg, xs, xi0):
+    """Closest point of slave xs on the curve of segment xseg: Newton on (x_s - x(xi)) . rho = 0 from xi0.
+
+    Returns (xi, g, converged): g = (x_s - x(xi)) . n. Iterates leave [-2, 2]: not converged."""
+    xi = xi0
+    for _ in range(MAX_ITER):
+        x, r, r2 = segment_point(xseg, xi)
+        d0 = xs[0] - x[0]
+        d1 = xs[1] - x[1]
+        f = d0 * r[0] + d1 * r[1]
+        fp = -(r[0] * r[0] + r[1] * r[1]) + d0 * r2[0] + d1 * r2[1]
+        if fp >= 0.0:  # far on the concave side beyond the centre of curvature: step as on the chord
+            fp = -(r[0] * r[0] + r[1] * r[1])
+        step = -f / fp
+        xi += step
+        if abs(xi) > 2.0:
+            return xi, np.inf, False
+        if abs(step) < 1e-14:
+            break
+    x, r, r2 = segment_point(xseg, xi)
+    la = np.sqrt(r[0] * r[0] + r[1] * r[1])
+    if la == 0.0:
+        return xi, np.inf, False
+    g = ((xs[0] - x[0]) * r[1] - (xs[1] - x[1]) * r[0]) / la
+    return xi, g, True
+
+
+@njit(cache=True)
+def segment_core(xseg, xs, xi, eps, lam_k, case, want_parts, R, K, P):
+    """Residual R (3 (nen + 1)), tangent K of ``case`` and, with ``want_parts``, the four parts P (4, nd, nd) of a
+    slave xs on segment xseg (nen, 3) at its projection xi (all added into the zeroed outputs). Returns the gap g;
+    R, K, P stay zero when the pair is inactive (g + lam_k / eps > 0)."""
+    nen = xseg.shape[0]
+    nb = nen + 1
+    N = np.empty(3)
+    dN = np.empty(3)
+    ddN = np.empty(3)
+    segment_shapes(nen, xi, N, dN, ddN)
+    x = np.zeros(3)
+    rho = np.zeros(3)
+    r2 = np.zeros(3)
+    for b in range(nen):
+        for p in range(2):
+            x[p] += N[b] * xseg[b, p]
+            rho[p] += dN[b] * xseg[b, p]
+            r2[p] += ddN[b] * xseg[b, p]
+    a = rho[0] * rho[0] + rho[1] * rho[1]
+    la = np.sqrt(a)
+    n = np.zeros(3)
+    n[0] = rho[1] / la
+    n[1] = -rho[0] / la
+    g = (xs[0] - x[0]) * n[0] + (xs[1] - x[1]) * n[1]
+    ge = g + lam_k / eps
+    if ge > 0.0:
+        return g
+    h = r2[0] * n[0] + r2[1] * n[1]
+    c = a - g * h
+    alpha = np.empty(nb)
+    beta = np.empty(nb)
+    for b in range(nen):
+        alpha[b] = -N[b]
+        beta[b] = -dN[b]
+    alpha[nen] = 1.0
+    beta[nen] = 0.0
+    for b in range(nb):
+        for p in range(3):
+            R[3 * b + p] += eps * ge * alpha[b] * n[p]
+    # (c_nn, M, W, S) of main, rotational, curvature, second order
+    coef = np.zeros((4, 4))
+    coef[0, 0] = 1.0
+    coef[1, 2] = 1.0 / a
+    coef[2, 1] = -ge * h / (a * a)
+    coef[3, 1] = -ge * g * h * h / (a * a * c)
+    coef[3, 2] = 1.0 / c - 1.0 / a
+    coef[3, 3] = 1.0 / c
+    use = np.zeros(4)
+    use[0] = 1.0
+    if case == CASE_A or case == CASE_B or case == CASE_EXACT:
+        use[1] = 1.0
+    if case == CASE_A or case == CASE_C or case == CASE_EXACT:
+        use[2] = 1.0
+    if case == CASE_EXACT:
+        use[3] = 1.0
+    for part in range(4):
+        if use[part] == 0.0 and not want_parts:
+            continue
+        cnn, M, W, S = coef[part, 0], coef[part, 1], coef[part, 2], coef[part, 3]
+        for b in range(nb):
+            for cc in range(nb):
+                ab = alpha[b] * alpha[cc]
+                sbc = beta[b] * S * beta[cc]
+                for p in range(2):
+                    for q in range(2):
+                        v = ab * (cnn * n[p] * n[q] + M * rho[p] * rho[q])
+                        v += ge * (alpha[cc] * n[p] * beta[b] * W * rho[q] + alpha[b] * beta[cc] * W * rho[p] * n[q])
+                        v -= ge * g * sbc * n[p] * n[q]
+                        v *= eps
+                        if use[part] != 0.0:
+                            K[3 * b + p, 3 * cc + q] += v
+                        if want_parts:
+                            P[part, 3 * b + p, 3 * cc + q] += v
+    return g
+
+
+@njit(cache=True)
+def vertex_core(xv, xs, sign, eps, lam_k, R, K):
+    """A slave xs against the vertex xv (the closest point of the master curve): g = sign |x_s - x_v|, n =
+    (x_s - x_v) / g; residual and exact tangent on (vertex, slave) added into R (6) and K (6, 6). Returns g."""
+    d0 = xs[0] - xv[0]
+    d1 = xs[1] - xv[1]
+    dist = np.sqrt(d0 * d0 + d1 * d1)
+    if dist == 0.0:
+        return 0.0
+    g = sign * dist
+    ge = g + lam_k / eps
+    if ge > 0.0:
+        return g
+    n = np.array([d0 / g, d1 / g])
+    for p in range(2):
+        R[p] -= eps * ge * n[p]
+        R[3 + p] += eps * ge * n[p]
+    for p in range(2):
+        for q in range(2):
+            v = eps * (n[p] * n[q] + ge / g * ((1.0 if p == q else 0.0) - n[p] * n[q]))
+            K[p, q] += v
+            K[3 + p, 3 + q] += v
+            K[p, 3 + q] -= v
+            K[3 + p, q] -= v
+    return g
+
+
+# -- the curve: segments, their neighbours, search and projection --------------------------------------------------
+class Curve:
+    """The master curve of a pass: segments (nseg, nen) of extended node ids, each corner's segments."""
+
+    def __init__(self, segments: np.ndarray):
+        self.segments = np.ascontiguousarray(segments, dtype=np.int64)
+        self.nen = self.segments.shape[1]
+        corners = self.segments[:, :2]
+        self.vertex_segments: dict[int, list[int]] = {}
+        for s, (v0, v1) in enumerate(corners):
+            self.vertex_segments.setdefault(int(v0), []).append(s)
+            self.vertex_segments.setdefault(int(v1), []).append(s)
+        self.corner_nodes = np.unique(corners)
+
+    def normals(self, xe: np.ndarray) -> np.ndarray:
+        """Unit chord normals of the segments (nseg, 2)."""
+        t = xe[self.segments[:, 1], :2] - xe[self.segments[:, 0], :2]
+        n = np.column_stack([t[:, 1], -t[:, 0]])
+        return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+
+
+FACET, VERTEX = 1, 2
+
+
+def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float):
+    """Closest points of slaves xs (ns, 3) on the curve at positions xe: per slave (kind 0 none, FACET on a segment,
+    VERTEX at a vertex; segment (the vertex's first segment for VERTEX); xi (the vertex's xi there); g; vertex node
+    id (-1); sign). Candidates: the segments with a corner within ``reach`` (a segment length or more) of the slave;
+    among the projections inside their segment the one of smallest |g|; none inside: the nearest corner shared by
+    two segments."""
+    from scipy.spatial import cKDTree
+
+    ns = len(xs)
+    kind = np.zeros(ns, dtype=np.int64)
+    seg = np.full(ns, -1, dtype=np.int64)
+    xi = np.zeros(ns)
+    g = np.full(ns, np.inf)
+    vert = np.full(ns, -1, dtype=np.int64)
+    sign = np.ones(ns)
+    nodes = curve.corner_nodes
+    tree = cKDTree(xe[nodes, :2])
+    near = tree.query_ball_point(xs[:, :2], reach)
+    normals = curve.normals(xe)
+    for i in range(ns):
+        if not near[i]:
+            continue
+        cand = sorted({s for k in near[i] for s in curve.vertex_segments[int(nodes[k])]})
+        best = np.inf
+        for s in cand:
+            xseg = np.ascontiguousarray(xe[curve.segments[s]])
+            z, gap, ok = project_on_segment(xseg, xs[i], 0.0)
+            if ok and abs(z) <= 1.0 + INSIDE_TOL and abs(gap) < best:
+                best = abs(gap)
+                kind[i], seg[i], xi[i], g[i] = FACET, s, min(max(z, -1.0), 1.0), gap
+        if kind[i]:
+            continue
+        # no segment holds the projection: the nearest vertex between two segments
+        ks = sorted(near[i], key=lambda k: float(np.linalg.norm(xe[nodes[k], :2] - xs[i, :2])))
+        for k in ks:
+            v = int(nodes[k])
+            segs = curve.vertex_segments[v]
+            if len(segs) != 2:
+                continue
+            d = xs[i, :2] - xe[v, :2]
+            sg = 1.0 if float(d @ (normals[segs[0]] + normals[segs[1]])) >= 0.0 else -1.0
+            kind[i], seg[i], vert[i], sign[i] = VERTEX, segs[0], v, sg
+            xi[i] = -1.0 if curve.segments[segs[0], 0] == v else 1.0
+            g[i] = sg * float(np.linalg.norm(d))
+            break
+    return kind, seg, xi, g, vert, sign
+
+
+# -- weights -----------------------------------------------------------------------------------------------------
+def slave_weights(X: np.ndarray, edges: np.ndarray, formulation: str, thickness: float = 1.0) -> np.ndarray:
+    """Per node of X, the consistent tributary measure of the edges (nf, 2 or 3) in the reference configuration:
+    sum over the edges of int N_a t ds with t the thickness (plane strain, plane stress) or 2 pi R (axisymmetric,
+    R = X_x the reference radius): what a uniform unit pressure on the edges gives the nodes (a quadratic edge:
+    1/6, 2/3, 1/6 of its measure)."""
+    out = np.zeros(len(X))
+    if not len(edges):
+        return out
+    nen = edges.shape[1]
+    pts, wts = np.polynomial.legendre.leggauss(5)
+    N = np.zeros((len(pts), nen))
+    dN = np.zeros((len(pts), nen))
+    ddN = np.zeros(3)
+    for k, z in enumerate(pts):
+        n3, d3 = np.empty(3), np.empty(3)
+        segment_shapes(nen, float(z), n3, d3, ddN)
+        N[k], dN[k] = n3[:nen], d3[:nen]
+    Xe = X[edges][:, :, :2]  # (nf, nen, 2)
+    dx = np.einsum("ka,fai->fki", dN, Xe)
+    ds = np.linalg.norm(dx, axis=2) * wts[None, :]
+    if formulation == "axisymmetric":
+        ds = ds * 2.0 * np.pi * np.einsum("ka,fa->fk", N, Xe[:, :, 0])
+    else:
+        ds = ds * float(thickness)
+    np.add.at(out, edges.ravel(), np.einsum("fk,ka->fa", ds, N).ravel())
+    return out
+
+
+# -- pairs on planar bodies ----------------------------------------------------------------------------------------
+PLANAR_FORMULATIONS = ("plane_strain", "plane_stress", "axisymmetric")
+
+
+def _body(bodies, name):
+    return next((b for b in bodies if b.name == name), None)
+
+
+def check_pair(pair, bodies, rigid) -> str | None:
+    """Why the contact ``pair`` cannot run as planar contact (one line), or None. Called for pairs with a planar body
+    on either side."""
+    name = f"contact pair {pair.name!r}"
+    if pair.self_surfaces:
+        return f"{name}: self-contact of planar bodies is not available (give slave and master)"
+    sb, mb = _body(bodies, pair.slave[0]), _body(bodies, pair.master[0])
+    forms = {b.formulation for b in (sb, mb) if b is not None}
+    planar = forms & set(PLANAR_FORMULATIONS)
+    if forms - set(PLANAR_FORMULATIONS):
+        return (f"{name}: body {(sb if sb.formulation not in PLANAR_FORMULATIONS else mb).name!r} is three-dimensional "
+                f"and the other planar: a contact pair joins planar bodies only to planar bodies or rigid lines and "
+                f"circles")
+    if len(planar) > 1:
+        return f"{name}: the bodies have different formulations ({' and '.join(sorted(planar))})"
+    if pair.type != "nts":
+        return f"{name}: planar bodies take node-to-segment contact only (type = \"nts\")"
+    if pair.law not in ("penalty",):
+        return f"{name}: law = \"{pair.law}\" is not available on planar bodies (penalty, smoothing, augmented)"
+    if pair.adjust is not None:
+        return f"{name}: adjust is not available on planar bodies"
+    if pair.weighting == "boundary":
+        return f"{name}: weighting = \"boundary\" is not available on planar bodies (use \"area\" or \"nodal\")"
+    if sb is None:
+        return f"{name}: the slave of a planar pair is the edge set of a planar body, not the rigid body {pair.slave[0]!r}"
+    if mb is None:
+        rb = next((r for r in rigid if r.name == pair.master[0]), None)
+        if rb is None or rb.mesh is not None or rb.shape not in ("plane", "cylinder"):
+            return (f"{name}: the rigid master {pair.master[0]!r} of a planar pair must be an analytic line (shape = "
+                    f"\"plane\" with a normal in the x-y plane) or circle (shape = \"cylinder\" with its axis along z)")
+        vec = np.asarray(rb.params["normal" if rb.shape == "plane" else "axis"], dtype=float)
+        vec = vec / np.linalg.norm(vec)
+        if rb.shape == "plane" and abs(vec[2]) > 1e-12:
+            return f"{name}: the rigid plane {rb.name!r} of a planar pair needs a normal in the x-y plane (n_z = 0)"
+        if rb.shape == "cylinder" and abs(abs(vec[2]) - 1.0) > 1e-12:
+            return f"{name}: the rigid cylinder {rb.name!r} of a planar pair needs its axis along z ([0, 0, 1])"
+        if rb.shape == "cylinder" and sb.formulation == "axisymmetric":
+            return (f"{name}: a rigid circle in an axisymmetric model is a torus, not available; an axisymmetric "
+                    f"pair takes a rigid line")
+    elif pair.friction:
+        return (f"{name}: friction against the edges of a planar body is not available yet (frictionless, or a rigid "
+                f"line or circle)")
+    return None
+
+
+def planar_body(num, name):
+    """The planar Body ``name`` of the problem, or None."""
+    b = _body(num.problem.bodies, name)
+    return b if b is not None and b.formulation in PLANAR_FORMULATIONS else None
+
+
+def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, analytic_surface):
+    """The node-to-segment pass of ``slave`` (body, edge set) against ``master`` (a planar body's edge set, or a
+    rigid line or circle) of ``pair``: weights from :func:`slave_weights` (reference configuration), eps = penalty
+    times the weight with weighting "area" or penalty "auto" (eps per unit length per thickness or circumference),
+    the penalty itself per node with weighting "nodal"."""
+    from .element import CASES
+
+    X = num.reference()
+    sb = planar_body(num, slave[0])
+    smesh, soff = num.mesh_of(slave[0])
+    thickness = float(sb.options.get("thickness", 1.0))
+    if slave[1] not in smesh.node_sets:
+        raise ValueError(f"contact {pair.name}: no node set {slave[1]!r} on body {slave[0]!r}")
+    nodes = smesh.node_sets[slave[1]] + soff
+    faces = smesh.face_sets[slave[1]] + soff if slave[1] in smesh.face_sets else None
+    weight = slave_weights(X, faces, sb.formulation, thickness)[nodes] if faces is not None else np.ones(len(nodes))
+    mb = planar_body(num, master[0])
+    segments = None
+    if mb is not None:
+        mmesh, moff = num.mesh_of(master[0])
+        if master[1] not in mmesh.face_sets:
+            raise ValueError(f"contact {pair.name}: no edge set {master[1]!r} on body {master[0]!r}")
+        segments = mmesh.face_sets[master[1]] + moff
+    ref = segments if segments is not None else faces
+    h = float(np.mean(np.linalg.norm(X[ref[:, 1]] - X[ref[:, 0]], axis=1))) if ref is not None else 1.0
+    if pair.penalty == "auto":
+        body = mb if mb is not None else sb
+        penalty = pair.auto_factor * float(body.material.params[0]) / h
+    else:
+        penalty = float(pair.penalty)
+    if pair.weighting == "area" or pair.penalty == "auto":
+        if faces is None:
+            raise ValueError(f"contact {pair.name}: area weighting needs an edge set named {slave[1]!r}")
+        eps = penalty * weight
+    else:
+        eps = np.full(len(nodes), penalty)
+    ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
+    kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
+          "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
+          "slave_body": slave[0], "master_body": master[0], "band": float(pair.smoothing), "kind": "nts",
+          "slave_faces": faces}
+    if segments is not None:
+        p = Pass(name, nodes, eps, weight, **kw)
+        p.curve = Curve(segments)
+    else:
+        rb = next(r for r in num.problem.rigid if r.name == master[0])
+        p = Pass(name, nodes, eps, weight, analytic=analytic_surface(rb), rigid=rb.name, **kw)
+    if p.augmented:
+        p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
+    return p
+
+
+# -- the pass -------------------------------------------------------------------------------------------------------
+def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_parts: bool, ev) -> None:
+    """Evaluate the node-to-segment pass ``p`` (its ``curve``) at extended positions xe into ``ev`` (element blocks,
+    the parts) and the trial pass state ``t`` (facet: the segment, xi, gap, force)."""
+    from .laws import is_active, linear_equivalents
+
+    curve: Curve = p.curve
+    xs = xe[p.slaves]
+    lengths = np.linalg.norm(xe[curve.segments[:, 1], :2] - xe[curve.segments[:, 0], :2], axis=1)
+    reach = 1.5 * float(lengths.max()) if len(lengths) else 0.0
+    kind, seg, xi, g, vert, sign = closest_points(curve, xe, xs, reach)
+    ok = kind != 0
+    t.facet = np.where(ok, seg, -1).astype(np.int64)
+    t.xi = np.column_stack([np.where(ok, xi, 0.0), np.zeros(len(xi))])
+    t.gap = np.where(ok, g, np.inf)
+    t.hist_facet = t.facet.copy()
+    if p.band != 0.0:
+        eps_s, lam_s = linear_equivalents(t.gap, t.multiplier, p.eps, p.band)
+    else:
+        eps_s, lam_s = p.eps, t.multiplier
+    active = ok & is_active(t.gap, t.multiplier, p.eps, p.band)
+    nen = curve.nen
+    nd = 3 * (nen + 1)
+    idx = np.flatnonzero(active & (kind == FACET))
+    if idx.size:
+        conn = np.hstack([curve.segments[seg[idx]], p.slaves[idx][:, None]])
+        R = np.zeros((idx.size, nd))
+        K = np.zeros((idx.size, nd, nd))
+        P = np.zeros((idx.size, 4, nd, nd)) if want_parts else np.zeros((1, 4, nd, nd))
+        for j, s in enumerate(idx):
+            t.gap[s] = segment_core(np.ascontiguousarray(xe[conn[j, :nen]]), np.ascontiguousarray(xs[s]),
+                                    float(xi[s]), float(eps_s[s]), float(lam_s[s]), case, want_parts, R[j], K[j],
+                                    P[j] if want_parts else P[0])
+        t.force[idx] = -R[:, -3:]
+        manager._add(ev.blocks, conn, R, K if want_K else None, xe)
+        if want_parts:
+            for k in range(4):
+                ev.parts[k].add(conn, np.zeros_like(R), P[:, k])
+    idx = np.flatnonzero(active & (kind == VERTEX))
+    if idx.size:
+        conn = np.column_stack([vert[idx], p.slaves[idx]])
+        R = np.zeros((idx.size, 6))
+        K = np.zeros((idx.size, 6, 6))
+        for j, s in enumerate(idx):
+            t.gap[s] = vertex_core(np.ascontiguousarray(xe[vert[s]]), np.ascontiguousarray(xs[s]), float(sign[s]),
+                                   float(eps_s[s]), float(lam_s[s]), R[j], K[j])
+        t.force[idx] = -R[:, -3:]
+        manager._add(ev.blocks, conn, R, K if want_K else None, xe)
+        if want_parts:
+            ev.parts[0].add(conn, np.zeros_like(R), K)
+
+
+__all__ = ["CASE_A", "CASE_B", "CASE_C", "CASE_D", "CASE_EXACT", "Curve", "closest_points", "project_on_segment",
+           "segment_core", "segment_pass", "slave_weights", "vertex_core", "check_pair", "make_pass"]
