@@ -300,3 +300,128 @@ def test_contact_patch_test(tmp_path, form, cell):
     total = -np.abs(state.force[:, 1]).sum()
     area = math.pi * (2.0**2 - 1.0**2) if form == "axisymmetric" else 1.0
     assert total == pytest.approx(-area, rel=1e-9)
+
+
+E_, NU_ = 1000.0, 0.3
+
+
+def hertz_text(nt: int, nr: int, d: float) -> str:
+    return f"""
+[problem]
+name = "hertz"
+[[bodies]]
+name = "cyl"
+formulation = "plane_strain"
+element = "quad4"
+mesh = {{ generator = "annulus", r_inner = 0.3, r_outer = 1.0, nr = {nr}, nt = {nt}, angle = 180.0, bias = 0.9 }}
+material = {{ model = "neo-hooke", E = {E_}, nu = {NU_} }}
+[[rigid]]
+name = "floor"
+shape = "plane"
+point = [1.0, 0.0, 0.0]
+normal = [-1.0, 0.0, 0.0]
+[[dirichlet]]
+set = "cyl.angle0"
+components = "y"
+value = 0.0
+[[dirichlet]]
+set = "cyl.angle1"
+components = "y"
+value = 0.0
+[[dirichlet]]
+set = "cyl.inner"
+components = "x"
+value = {d}
+[[contact]]
+name = "c"
+slave = "cyl.outer"
+master = "floor"
+penalty = 1e7
+weighting = "area"
+[steps]
+factors = [0.25, 0.5, 0.75, 1.0]
+"""
+
+
+def test_hertz_line_contact(tmp_path):
+    """A cylinder (R = 1, plane strain, the upper half of a ring r = 0.3 .. 1 of 360 x 24 quad4 cells graded to the
+    surface) pressed by its bore onto a rigid line: half-width a = sqrt(4 P R / (pi E*)) and peak pressure
+    p0 = 2 P / (pi a) (Johnson, Contact Mechanics, section 4.2), P the force per unit length (twice the half
+    model's). a from the second moment of the nodal forces (sum f y^2 / sum f = a^2 / 4 for Hertz's pressure), p0
+    the largest nodal pressure (force over weight). Neo-Hooke: p0 / E* = a / (2 R) = 2.3 %, where St. Venant-
+    Kirchhoff would soften by about that much (docs/verification.md, Hertz 3D)."""
+    res = run(tmp_path, "hertz", hertz_text(360, 24, 0.004))
+    st, p = res.state.contact.passes[0], res.model.contact.passes[0]
+    f = np.abs(st.force[:, 0])
+    y = res.model.system.X[p.slaves, 1] + np.asarray(res.u).reshape(-1, 3)[p.slaves, 1]
+    P = 2.0 * f.sum()
+    Es = E_ / (1 - NU_**2)
+    a = math.sqrt(4 * P / (math.pi * Es))
+    p0 = 2 * P / (math.pi * a)
+    a_m = 2.0 * math.sqrt((f * y**2).sum() / f.sum())
+    p_max = (f / p.area).max()
+    print(f"Hertz line contact: P = {P:.4f}, a = {a:.5f}, a_m / a - 1 = {a_m / a - 1:+.4f}, "
+          f"p_max / p0 - 1 = {p_max / p0 - 1:+.4f}, contact nodes {np.count_nonzero(f)}")
+    assert abs(a_m / a - 1) < 0.03
+    assert abs(p_max / p0 - 1) < 0.03
+
+
+def shrink_text(method: str, penalty: float) -> str:
+    bodies = "".join(f"""
+[[bodies]]
+name = "{n}"
+formulation = "plane_strain"
+element = "quad8"
+mesh = {{ generator = "annulus", r_inner = {ri}, r_outer = {ro}, nr = 4, nt = {nt} }}
+material = {{ model = "neo-hooke", E = {E_}, nu = {NU_} }}
+[[dirichlet]]
+set = "{n}.angle0"
+components = "y"
+value = 0.0
+[[dirichlet]]
+set = "{n}.angle1"
+components = "x"
+value = 0.0
+""" for n, ri, ro, nt in (("hub", 0.5, 1.001, 16), ("ring", 1.0, 1.5, 17)))
+    return f"""
+[problem]
+name = "shrink"
+{bodies}
+[[contact]]
+name = "fit"
+slave = "hub.outer"
+master = "ring.inner"
+penalty = {penalty}
+weighting = "area"
+method = "{method}"
+""" + ("gap_tolerance = 1e-7\n" if method == "augmented" else "")
+
+
+@pytest.mark.parametrize("method,penalty", [("penalty", 1e8), ("augmented", 1e5)])
+def test_shrink_fit_against_lame(tmp_path, method, penalty):
+    """A hub (r 0.5 .. 1.001) shrunk into a ring (1 .. 1.5), plane strain, quarter models of quad8 with non-matching
+    edges (16 and 17 cells around): the mean contact pressure against Lame's (Timoshenko and Goodier, section 33):
+    p = delta / ((1 + nu) / E (b^2 / (c^2 - b^2) ((1 - 2 nu) b + c^2 / b) + b^2 / (b^2 - a^2) ((1 - 2 nu) b + a^2 / b)))."""
+    a, b, c, dl = 0.5, 1.0, 1.5, 1e-3
+    res = run(tmp_path, f"shrink_{method}", shrink_text(method, penalty))
+    st, p = res.state.contact.passes[0], res.model.contact.passes[0]
+    k = (1 + NU_) / E_
+    exact = dl / (k * (b**2 / (c**2 - b**2) * ((1 - 2 * NU_) * b + c**2 / b)
+                       + b**2 / (b**2 - a**2) * ((1 - 2 * NU_) * b + a**2 / b)))
+    mean = np.linalg.norm(st.force, axis=1).sum() / p.area.sum()
+    print(f"shrink fit ({method}): p / p_Lame - 1 = {mean / exact - 1:+.5f}, "
+          f"largest penetration {-st.gap[np.isfinite(st.gap)].min():.2e}")
+    assert abs(mean / exact - 1) < 0.01
+
+
+def test_bad_planar_pairs(tmp_path):
+    """A planar pair the code cannot take: one line naming the pair (exit 2 from the command line)."""
+    text = blocks("plane_strain", "quad4", 4, 0.0, "").replace('weighting = "area"\n', 'weighting = "area"\ntype = "sts"\n')
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(Exception, match="node-to-segment"):
+        load_problem(path)
+    text = blocks("plane_strain", "quad4", 4, 0.0, "").replace('weighting = "area"\n', 'weighting = "area"\nfriction = 0.2\n')
+    path.write_text(text)
+    with pytest.raises(Exception, match="friction against the edges"):
+        load_problem(path)
