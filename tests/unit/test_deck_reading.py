@@ -125,21 +125,23 @@ def test_laws_kept_or_refused(tmp_path):
 
 
 def test_pairs_on_elements_not_read_are_listed_not_crashed(tmp_path):
-    """A slave node surface of shell (S4) nodes and a master SPOS face of a shell: the pairs cannot be built, so
-    they are listed with their lines (before: an IndexError); with --ignore-unsupported the rest runs."""
+    """A slave node surface of membrane (M3D4) nodes and a master SPOS face of a membrane: the pairs cannot be built,
+    so they are listed with their lines (before: an IndexError); with --ignore-unsupported the rest runs. (Shells are
+    read: tests/unit/test_deck_shells.py.)"""
     text = two_block_deck(tmp_path / "tb.inp").read_text()
     text = text.replace("*NODE, NSET=NALL\n", "*NODE, NSET=NALL\n9101, 0.,0.,3.\n9102, 1.,0.,3.\n9103, 1.,1.,3.\n"
                         "9104, 0.,1.,3.\n")
-    text = text.replace("*ELEMENT, TYPE=C3D8, ELSET=BASE", "*ELEMENT, TYPE=S4, ELSET=PLATE\n9001, 9101, 9102, 9103, "
+    text = text.replace("*ELEMENT, TYPE=C3D8, ELSET=BASE", "*ELEMENT, TYPE=M3D4, ELSET=PLATE\n9001, 9101, 9102, 9103, "
                         "9104\n*ELEMENT, TYPE=C3D8, ELSET=BASE")
     deck = tmp_path / "s4.inp"
     deck.write_text(text.replace("*NSET, NSET=NSLAVE\n", "*NSET, NSET=NSLAVE\n9101, 9102, 9103, 9104\n*NSET, NSET=X\n"))
     lines = import_deck(deck, tmp_path / "a" / "p.toml").unsupported
-    assert any("TYPE=S4 is not supported" in ln for ln in lines)
+    assert any("TYPE=M3D4 is not supported" in ln for ln in lines)
     assert any("SSLAV's nodes belong to elements covcontact does not read" in ln for ln in lines)
     deck.write_text(text.replace("BASETOP, S2", "9001, SPOS"))
     lines = import_deck(deck, tmp_path / "b" / "p.toml").unsupported
-    assert any("SPOS, a shell face" in ln for ln in lines) and any("the surface SMAST has no faces" in ln for ln in lines)
+    assert any("SPOS on element 9001, an M3D4" in ln for ln in lines)
+    assert any("the surface SMAST has no faces" in ln for ln in lines)
     proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
                            "--ignore-unsupported", "--quiet"], capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
@@ -240,23 +242,24 @@ def test_a_coupling_on_elements_not_read_names_their_type_and_line(tmp_path):
 
 
 def test_loads_on_elements_not_read_are_listed_with_their_type(tmp_path):
-    """GRAV on a set with shell elements (made by ELSET= of their *ELEMENT line, or by an *ELSET that names that
+    """GRAV on a set with membrane elements (M3D4; shells are read: tests/unit/test_deck_shells.py; made by ELSET=
+    of their *ELEMENT line, or by an *ELSET that names that
     set): listed as unsupported with the element's type and *ELEMENT line, the solids keep their weight with
     --ignore-unsupported; a face load on them is listed with its line; an element no line defines is an error."""
     text = two_block_deck(tmp_path / "tb.inp").read_text()
-    text = text.replace("*NSET, NSET=BOTTOM", "*ELEMENT, TYPE=S4, ELSET=SKIN\n9001, 1, 2, 5, 4\n*NSET, NSET=BOTTOM", 1)
+    text = text.replace("*NSET, NSET=BOTTOM", "*ELEMENT, TYPE=M3D4, ELSET=SKIN\n9001, 1, 2, 5, 4\n*NSET, NSET=BOTTOM", 1)
     text = text.replace("*ELSET, ELSET=BASETOP", "*ELSET, ELSET=ALL\nBASE, SKIN\n*ELSET, ELSET=BASETOP", 1)
     text = text.replace("1000.0, 0.3\n", "1000.0, 0.3\n*DENSITY\n1.0\n")
-    shell = text.splitlines().index("*ELEMENT, TYPE=S4, ELSET=SKIN") + 1
+    shell = text.splitlines().index("*ELEMENT, TYPE=M3D4, ELSET=SKIN") + 1
     deck = tmp_path / "m.inp"
     for k, (load, said) in enumerate([
-            ("SKIN, GRAV, 9.81, 0, 0, -1", "*DLOAD GRAV on SKIN: element 9001 is an S4 (*ELEMENT, TYPE=S4 at "
+            ("SKIN, GRAV, 9.81, 0, 0, -1", "*DLOAD GRAV on SKIN: element 9001 is an M3D4 (*ELEMENT, TYPE=M3D4 at "
              f"{deck}:{shell}), a type covcontact does not read; with --ignore-unsupported the load acts on no "
              "element (left out)"),
-            ("ALL, GRAV, 9.81, 0, 0, -1", "*DLOAD GRAV on ALL: element 9001 is an S4 (*ELEMENT, TYPE=S4 at "
+            ("ALL, GRAV, 9.81, 0, 0, -1", "*DLOAD GRAV on ALL: element 9001 is an M3D4 (*ELEMENT, TYPE=M3D4 at "
              f"{deck}:{shell}), a type covcontact does not read; with --ignore-unsupported the load acts on the "
              "set's other elements alone"),
-            ("SKIN, P1, 1.0", f"P1 on element 9001, a S4 (not read), from *ELEMENT, TYPE=S4 at {deck}:{shell}")]):
+            ("SKIN, P1, 1.0", f"P1 on element 9001, a M3D4 (not read), from *ELEMENT, TYPE=M3D4 at {deck}:{shell}")]):
         deck.write_text(text.replace("*NODE PRINT", f"*DLOAD\n{load}\n*NODE PRINT"))
         at = deck.read_text().splitlines().index(load) + 1
         imp = import_deck(deck, tmp_path / f"i{k}" / "p.toml")

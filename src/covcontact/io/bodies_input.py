@@ -68,7 +68,14 @@ def build_shell(shell: Section, sec: Section, base: Path):
     mid-surface mesh (mesh/shell.py ``extrude_surface``)."""
     from ..mesh.shell import OFFSETS, ShellMeshError, extrude_surface, read_surface
 
-    thickness = shell.get("thickness", "float", positive=True)
+    thickness = shell.get("thickness", "any")
+    per_node = isinstance(thickness, list)
+    values = thickness if per_node else [thickness]
+    if not values or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
+                             for v in values):
+        shell.fail(f"must be a positive number or an array of them (one per node of the surface mesh), got "
+                   f"{thickness if not per_node else next((v for v in values if not (isinstance(v, (int, float)) and v > 0)), values)!r}",
+                   "thickness")
     offset = shell.get("offset", "any", "middle")
     if isinstance(offset, str):
         if offset not in OFFSETS:
@@ -76,6 +83,16 @@ def build_shell(shell: Section, sec: Section, base: Path):
                        f"{suggest(offset, list(OFFSETS))}", "offset")
     elif isinstance(offset, bool) or not isinstance(offset, (int, float)) or not -0.5 <= offset <= 0.5:
         shell.fail(f"must be \"middle\", \"top\", \"bottom\" or a number in [-0.5, 0.5], got {offset!r}", "offset")
+    faces = shell.get("faces", "table", None)
+    face_rows = {}
+    if faces is not None:  # NAME = [["ELSET", "top" | "bottom"], ...]: the faces of those cells on that side
+        for name in list(faces.data):
+            rows = faces.get(name, "any")
+            if not (isinstance(rows, list) and rows and all(isinstance(r, list) and len(r) == 2 and isinstance(r[0], str)
+                                                            and r[1] in ("top", "bottom") for r in rows)):
+                faces.fail("must be an array of [\"ELEMENT SET\", \"top\" or \"bottom\"] pairs", name)
+            face_rows[name] = rows
+        faces.done()
     shell.done()
     if not sec.has("file"):
         sec.fail("a shell body's mesh is a surface mesh file: give mesh = { file = \"SURFACE.msh\" }")
@@ -85,9 +102,19 @@ def build_shell(shell: Section, sec: Section, base: Path):
     if not path.exists():
         sec.fail(f"mesh file {fname!r} does not exist (looked for {path}; a relative path is taken from the "
                  f"problem file's folder)", "file")
+    key = (str(path.resolve()), path.stat().st_mtime_ns)
+    if key in _PRELOADED:  # (the solid-shells a deck's import built from this file)
+        return _PRELOADED[key]
     try:
         points, cell_type, cells, node_sets, element_sets = read_surface(path)
-        return extrude_surface(points, cell_type, cells, thickness, offset, node_sets, element_sets)
+        if per_node and len(values) != points.shape[0]:
+            shell.fail(f"has {len(values)} values for the {points.shape[0]} nodes of {fname}", "thickness")
+        missing = [e for rows in face_rows.values() for e, _ in rows if e not in element_sets]
+        if missing:
+            shell.fail(f"faces: no element set {missing[0]!r} in {fname}", "faces")
+        face_sets = {name: [(element_sets[e], side) for e, side in rows] for name, rows in face_rows.items()}
+        return extrude_surface(points, cell_type, cells, np.asarray(values, dtype=float) if per_node else thickness,
+                               offset, node_sets, element_sets, face_sets)
     except ShellMeshError as exc:
         sec.fail(str(exc), "file")
 

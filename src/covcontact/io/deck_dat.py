@@ -393,15 +393,30 @@ class _Now:
             self._forces = forces
         return self._forces
 
+    def shell_nodes(self) -> dict[int, tuple[int, int]]:
+        """Deck label of a shell node -> its bottom and top global nodes (deck_shells)."""
+        out = {}
+        for blk in self.blocks:
+            labels, n = self.info.get("shells", {}).get(blk.name, ([], 0))
+            out.update((lab, (blk.offset + i, blk.offset + i + n)) for i, lab in enumerate(labels))
+        return out
+
     def node_blocks(self, nset: str, variables, totals: str) -> list[str]:
         where = self.where()
-        labels = [lab for lab in self.info["nsets"][nset] if lab in where]
-        rows = np.array([where[lab] for lab in labels], dtype=np.int64)
+        shells = self.shell_nodes()
+        labels = [lab for lab in self.info["nsets"][nset] if lab in where or lab in shells]
+        rows = np.array([shells[lab][0] if lab in shells else where[lab] for lab in labels], dtype=np.int64)
+        other = np.array([shells[lab][1] if lab in shells else where[lab] for lab in labels], dtype=np.int64)
+        pair = rows != other  # (a shell node: U the mean of its layers, as CalculiX prints the mid-surface; RF their sum)
         text = []
         for var in variables:
             if var not in _BLOCK:
                 continue
-            values = self.U[rows] if var == "U" else self.forces()[rows]
+            if var == "U":
+                values = np.where(pair[:, None], 0.5 * (self.U[rows] + self.U[other]), self.U[rows])
+            else:
+                F = self.forces()
+                values = np.where(pair[:, None], F[rows] + F[other], F[rows])
             if var != "RF" or totals != "ONLY":
                 text.append(f"\n {_BLOCK[var]} for set {nset} and time {fortran_e(self.time)}\n\n")
                 text += [f"{lab:10d}" + _row(row) + "\n" for lab, row in zip(labels, values)]

@@ -23,6 +23,7 @@ from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 from .deck_coupling import DeckCouplings
 from .deck_rigid import DeckRigid
+from .deck_shells import DeckShells
 from .deck_springs import DeckSprings
 
 _COMP = "xyz"
@@ -80,11 +81,13 @@ class _Writer:
         self.m, self.deck, self.out, self.dialect = m, deck, out, dialect
         self.unsupported = list(m.unsupported)
         self.notes: list[str] = list(m.notes)
-        if not m.blocks:  # (the types it has, at their *ELEMENT lines: the first of them is the line said)
+        if not m.blocks and not m.shell_blocks:  # (the types it has, at their *ELEMENT lines: the first is said)
             first = m.skipped_blocks[0][1] if m.skipped_blocks else str(deck)
             found = f"the deck's elements are {m.element_types()}" if m.skipped_blocks else "the deck has no *ELEMENT"
             raise DeckError(f"{first}: no solid elements: {found}; covcontact reads {', '.join(ELEMENTS)}")
         self.b = Parts(m)
+        self.shells = DeckShells(m, self.b, dialect)  # (shell elements made into solid-shells: bodies after these)
+        self.notes += self.shells.notes
         self.body_names = self._body_names()
         self.rigid = DeckRigid(m, self.b)
         self.couplings = DeckCouplings(m, self.b, self.rigid, self.unsupported, self.notes, dialect)
@@ -92,10 +95,11 @@ class _Writer:
         self.extra_nsets: dict[str, np.ndarray] = {}
         self.extra_elsets: dict[str, np.ndarray] = {}
         self.extra_surfaces: dict[str, list[tuple[np.ndarray, int]]] = {}
-        cell_of = np.concatenate([np.full(len(b[2]), b[1], dtype=object) for b in m.blocks])
+        cell_of = np.concatenate([np.full(len(b[2]), b[1], dtype=object) for b in m.blocks] + [np.zeros(0, object)])
         faces = [(els, face, where, "S") for kind, refs in m.surfaces.values() if kind == "ELEMENT"
                  for els, face, where in refs]
         faces += [(ld.elements, ld.dof, ld.where, "P") for st in m.steps for ld in st.loads if ld.kind == "dload"]
+        faces = [(els[self.shells.elements_body(els) < 0], face, where, letter) for els, face, where, letter in faces]
         for els, face, where, letter in faces:  # a face the element does not have: the line that names it
             idx = self.b.el_index[els[(els >= 0) & (els < self.b.el_index.size)]]
             if idx.size < els.size or np.any(idx < 0):
@@ -121,12 +125,18 @@ class _Writer:
             exact = [s for s, _, _ in self.m.sections if set(self.m.elsets.get(s, np.zeros(0)).tolist()) == els]
             name = _name(exact[0]) if exact else f"PART{k + 1}"
             names.append(name if name not in names else f"{name}_{k + 1}")
+        for j, info in enumerate(self.shells.bodies):
+            els = set(info["elements"].tolist())
+            exact = [s for s, _, _, _, _ in self.m.shell_sections
+                     if set(self.m.elsets.get(s, np.zeros(0)).tolist()) == els]
+            name = _name(exact[0]) if exact else f"SHELL{j + 1}"
+            names.append(name if name not in names else f"{name}_{self.b.n + j + 1}")
         return names
 
-    def _material(self, name: str, where: str) -> dict:
+    def _material(self, name: str, where: str, card: str = "*SOLID SECTION") -> dict:
         mat = self.m.materials.get(name)
         if mat is None:
-            raise DeckError(f"{where}: *SOLID SECTION names the material {name!r}, which no *MATERIAL defines")
+            raise DeckError(f"{where}: {card} names the material {name!r}, which no *MATERIAL defines")
         if "unsupported" in mat:
             raise DeckError(mat["unsupported"])
         if "hyperelastic" in mat:  # (*HYPERELASTIC: a rubber model of covcontact.materials.rubber)
@@ -161,9 +171,41 @@ class _Writer:
             out["density"] = mat["density"]
         return out
 
+    def _shell_bodies_toml(self) -> str:
+        """The shell bodies (deck_shells): their surface mesh files, ``shell = { thickness, offset, faces }``, the
+        materials of their *SHELL SECTIONs; the meshes are built here (``self.shell_meshes``) with every set the
+        conditions and contacts made."""
+        text = ""
+        self.shell_meshes = {}
+        nsets = {**{_name(n): v for n, v in self.m.nsets.items()}, **self.extra_nsets}
+        nsets.update({_name(n): v for n, (kind, v) in self.m.surfaces.items() if kind == "NODE" and _name(n) not in nsets})
+        elsets = {**{_name(n): v for n, v in self.m.elsets.items()}, **self.extra_elsets}
+        faces = {**{n: [(els, side) for els, side, _ in rows] for n, rows in self.m.shell_surfaces.items()},
+                 **self.shell_faces}
+        for j, info in enumerate(self.shells.bodies):
+            k = self.b.n + j
+            name = self.body_names[k]
+            mesh, surface, table = self.shells.build(j, nsets, elsets, faces)
+            path = self.mesh_path.with_suffix(f".{k + 1}.inp")
+            self.shell_meshes[path] = (mesh, surface)
+            secs = info["sections"]
+            entries: dict = {"name": name, "mesh": {"file": path.name}, "shell": table}
+            entries["material"] = self._material(secs[0][1], secs[0][2], "*SHELL SECTION")
+            if len(secs) > 1:
+                entries["materials"] = {_name(s): self._material(mat, w, "*SHELL SECTION") for s, mat, w in secs[1:]}
+            if info["cell"] == "quad4" and any(t == "S4R" for t, _, labs, _ in self.m.shell_blocks
+                                               if np.intersect1d(labs, info["elements"]).size):
+                self.notes.append(f"{info['where']}: S4R: the solid-shell (ANS + EAS, full integration) has no "
+                                  f"reduced-integration counterpart; S4R elements are read as S4")
+            sets = self.shells.layer_sets(k)
+            if sets:
+                entries["sets"] = sets
+            text += _table("[[bodies]]", entries)
+        return text
+
     def _bodies_toml(self) -> str:
         text = ""
-        for k, name in enumerate(self.body_names):
+        for k, name in enumerate(self.body_names[: self.b.n]):
             mine = self.b.of_element == k
             labels = self.b.el_labels[mine]
             types = {self.m.blocks[j][0] for j in range(len(self.m.blocks))
@@ -198,6 +240,7 @@ class _Writer:
     def _node_targets(self, name: str, labels: np.ndarray, where: str) -> list[tuple[int, str]]:
         """(body, set name) of the nodes ``labels`` (a deck set ``name`` or a single node), per body."""
         bodies = self.b.nodes_body(labels)
+        bodies = np.where(bodies >= 0, bodies, self.shells.nodes_body(labels))
         if np.all(bodies < 0):  # nodes of no element carry no unknowns (a support of nothing)
             return []
         set_name = _name(name) if not name.isdigit() else f"_N{name}"
@@ -428,6 +471,17 @@ class _Writer:
 
     def _boundary_keys(self, b: Boundary, where: dict) -> dict:
         out = {}
+        if self.shells.n:  # shell nodes: the components their two layers share (the rest are equations: deck_shells)
+            plain, both = self.shells.boundary_split(b.nodes, b.dofs)
+            for c, labs in both.items():
+                name = self._shell_set(labs)
+                for body, set_name in self._node_targets(name, labs, b.where):
+                    key = (body, set_name, c)
+                    where.setdefault(key, b.where)
+                    out[key] = 0.0 if b.value is None else b.value
+            if plain.size == 0:
+                return out
+            b = replace(b, nodes=plain)
         labels, keys = self.couplings.boundary_keys(b)  # (reference nodes' dofs 1-6: deck_coupling)
         for key in keys:
             where.setdefault(key, b.where)
@@ -439,7 +493,40 @@ class _Writer:
                 out[key] = 0.0 if b.value is None else b.value
         return out
 
+    def _shell_set(self, labels: np.ndarray) -> str:
+        """The name of a node set of these shell node labels (one per distinct set)."""
+        key = tuple(np.asarray(labels).tolist())
+        names = self.__dict__.setdefault("_shell_sets", {})
+        if key not in names:
+            names[key] = f"_SB{len(names) + 1}"
+        return names[key]
+
     def _load_keys(self, ld: Load):
+        if ld.kind == "cload" and self.shells.n and ld.dof > 3 and np.any(self.shells.is_shell(ld.nodes)):
+            lab = int(ld.nodes[self.shells.is_shell(ld.nodes)][0])
+            raise DeckError(f"{ld.where}: *CLOAD: a moment (dof {ld.dof}) on shell node {lab}: not supported "
+                            f"(CalculiX turns it into a mean rotation of the node's expansion)")
+        if ld.kind == "dload" and self.shells.n and np.any(self.shells.elements_body(ld.elements) >= 0):
+            sb = self.shells.elements_body(ld.elements)
+            side = self.shells.pressure_side(ld.dof, ld.where)
+            for body in np.unique(sb[sb >= 0]):
+                name = f"_P{_name(ld.target)}_{side}"
+                self.shell_faces[name] = [(ld.elements[sb == body], side)]
+                yield ("dload", int(body), name, ld.dof)
+            ld = replace(ld, elements=ld.elements[sb < 0])
+            if not ld.elements.size:
+                return
+        if ld.kind in ("grav", "centrif") and self.shells.n:
+            sb = self.shells.elements_body(ld.elements)
+            for body in np.unique(sb[sb >= 0]):
+                name = _name(ld.target) if not ld.target.isdigit() else f"_E{ld.target}"
+                if ld.target.isdigit():
+                    self.extra_elsets[name] = ld.elements
+                yield (ld.kind, int(body), name, ld.direction) if ld.kind == "grav" else \
+                    (ld.kind, int(body), name, ld.direction, ld.point)
+            if np.all(sb >= 0):
+                return
+            ld = replace(ld, elements=ld.elements[sb < 0])
         if ld.kind == "cload":
             labels, rigid = self.couplings.load_keys(ld)  # (reference nodes' dofs 1-6: deck_coupling)
             yield from rigid
@@ -486,15 +573,14 @@ class _Writer:
         return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v)} | (
             {"distribution": "per_node"} if key[0] == "cload" else {})
 
-    @staticmethod
-    def _load_value(key: tuple, v: float):
+    def _load_value(self, key: tuple, v: float):
         if key[0] == "centrif":  # a stage target of a spin is its angular velocity
             return float(np.sqrt(max(v, 0.0)))
         if key[0] == "grav":
             return [float(v) * d for d in key[3]]
         if key[0] == "cload":
             vec = [0.0, 0.0, 0.0]
-            vec[key[3]] = float(v)
+            vec[key[3]] = float(v) * (0.5 if key[1] >= self.b.n else 1.0)  # (a shell node: half on each layer)
             return vec
         return float(v)
 
@@ -573,11 +659,11 @@ class _Writer:
         return text
 
     def _on_skipped(self, names: list[str], where: str) -> bool:
-        """Whether one of the element surfaces ``names`` is empty or lies on elements not read (shells, beams): then
+        """Whether one of the element surfaces ``names`` is empty or lies on elements not read (beams): then
         the pair is listed as unsupported (left out with --ignore-unsupported)."""
         for name in names:
             kind, refs = self.m.surfaces[name]
-            if kind != "ELEMENT":
+            if kind != "ELEMENT" or name in self.m.shell_surfaces:
                 continue
             els = np.concatenate([e for e, _, _ in refs]) if refs else np.zeros(0, np.int64)
             gone = [int(e) for e in els if int(e) in self.m.skipped_elements]
@@ -670,7 +756,9 @@ class _Writer:
         return 10.0 * min(mods) * h
 
     def _surface_body(self, name: str, refs, where: str) -> int:
-        bodies = np.unique(np.concatenate([self.b.elements_body(els) for els, _, _ in refs]))
+        parts = [self.b.elements_body(els) for els, _, _ in refs]
+        parts += [self.shells.elements_body(els) for els, _, _ in self.m.shell_surfaces.get(name, [])]
+        bodies = np.unique(np.concatenate(parts)) if parts else np.zeros(0, np.int64)
         if bodies.size != 1 or bodies[0] < 0:
             raise DeckError(f"{where}: the surface {name} must lie on one part of the mesh (found {bodies.size})")
         return int(bodies[0])
@@ -683,10 +771,15 @@ class _Writer:
             for node, dof, coef in terms:
                 if not 1 <= dof <= 3:
                     break
+                if self.shells.n and self.shells.is_shell(np.array([node]))[0]:
+                    raise DeckError(f"{where}: *EQUATION on shell node {node}: not supported (CalculiX ties its "
+                                    f"expanded nodes to it; covcontact's shell node is two nodes, bottom and top)")
                 (body, set_name), = self._node_targets(str(node), np.array([node]), where)
                 out.append([self._ref(body, set_name), _COMP[dof - 1], coef])
             else:
                 text += _table("[[equation]]", {"name": f"eq{k + 1}", "terms": out})
+        for entry in self.shells.equations(self._ref):  # (shell nodes' conditions: deck_shells)
+            text += _table("[[equation]]", entry)
         return text
 
     def _removed_equations(self, step) -> list[str]:
@@ -700,9 +793,17 @@ class _Writer:
 
     def write(self) -> Imported:
         self.mesh_path = self.out.with_suffix(".mesh.inp")
+        self.shell_faces: dict = {}
+        for nodes, _, _, where in self.m.rigid_bodies:
+            if self.shells.n and np.any(self.shells.is_shell(nodes)):
+                raise DeckError(f"{where}: *RIGID BODY on shell node {int(nodes[self.shells.is_shell(nodes)][0])}: "
+                                f"not supported (a shell node is two nodes here, bottom and top)")
         bodies = self._bodies_toml()
+        self.shells.plan_boundaries()
+        self.notes += [n for n in self.shells.notes if n not in self.notes]
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
+        bodies += self._shell_bodies_toml()
         rigid = "".join(_table("[[rigid]]", e) for e in self.rigid.entries(self.extra_nsets, self._ref))
         springs = "".join(_table(kind, e) for kind, e in DeckSprings(self).entries())  # (SPRINGA, ..., DASHPOTA)
         conds += "".join(_table("[[force]]", e) for e in self.couplings.entries(self.extra_nsets, self._ref))
@@ -716,8 +817,13 @@ class _Writer:
         self._write_mesh()
         labels = self.out.with_suffix(".nodes.json")
         per_body = {}
-        for k, name in enumerate(self.body_names):
+        for k, name in enumerate(self.body_names[: self.b.n]):
             per_body[name] = self.m.node_labels[self.b.of_node == k].tolist()
+        shells = {}  # shell body -> (its surface nodes' deck labels, n): label i is mesh nodes i and i + n
+        start = int(self.m.node_labels.max()) + 1 if self.m.node_labels.size else 1
+        for j, (info, labs) in enumerate(zip(self.shells.bodies, self.shells.frd_labels(start))):
+            per_body[self.body_names[self.b.n + j]] = labs.tolist()  # (the .frd's expanded nodes, numbered anew)
+            shells[self.body_names[self.b.n + j]] = [info["nodes"].tolist(), info["n"]]
         # every stage of a deck step prints its requests: at the increments FREQUENCY picks and where a step or a
         # time point ends (print_every, print_end)
         # each request with its place among the step's print cards (CalculiX prints them in the order of its cards,
@@ -740,7 +846,8 @@ class _Writer:
         missing = sorted(el_wanted - set(self.m.elsets))
         if missing:
             raise DeckError(f"{self.deck}: *EL PRINT names the element set {missing[0]!r}, which no *ELSET defines")
-        labels.write_text(json.dumps({"bodies": per_body, "node_print": prints, "rigid": self.rigid.labels(),
+        labels.write_text(json.dumps({"bodies": per_body, "shells": shells, "node_print": prints,
+                                      "rigid": self.rigid.labels(),
                                       "elements": self.element_labels, "el_print": el_prints,
                                       "contact_print": contact_prints, "contact_card": contact_cards,
                                       "contact_pairs": self._contact_pairs(),
@@ -751,7 +858,7 @@ class _Writer:
                                       "periods": [d for _, d in self.stage_steps],
                                       "deck_step": [k for k, _ in self.stage_steps],
                                       "print_end": self.print_end, "print_every": self.print_every}))
-        meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n)]
+        meshes = [self.mesh_path.with_suffix(f".{k + 1}.inp") for k in range(self.b.n + self.shells.n)]
         return Imported(self.out, meshes, labels, list(dict.fromkeys(self.unsupported)),
                         list(dict.fromkeys(self.notes)), self.meshes)
 
@@ -817,3 +924,20 @@ class _Writer:
             self.element_labels[self.body_names[k]] = np.concatenate([lab for _, lab, _ in content["blocks"]]).tolist()
             path.write_text(body_text(content))
             self.meshes[path] = mesh_from_meshio(body_meshio(content), path, surfaces=(surface_refs(content), {}))
+        start = max([int(e) for labs in self.element_labels.values() for e in labs]
+                    + [int(e) for _, _, labs, _ in self.m.shell_blocks for e in labs] + [0]) + 1
+        for j, info in enumerate(self.shells.bodies):  # shell bodies: their surface files, the solid-shells built
+            k = self.b.n + j
+            path = self.mesh_path.with_suffix(f".{k + 1}.inp")
+            mesh, text = self.shell_meshes[path]
+            path.write_text(text)
+            self.meshes[path] = mesh
+            # (a split triangle's three cells: the deck's label, then labels after the deck's largest)
+            per_cell = info["elements"] if info["cell"] != "tri3" else np.repeat(info["elements"], 3)
+            if info["cell"] == "tri3":
+                extra = np.ones(per_cell.size, dtype=bool)
+                extra[::3] = False
+                per_cell = per_cell.copy()
+                per_cell[extra] = start + np.arange(int(extra.sum()))
+                start += int(extra.sum())
+            self.element_labels[self.body_names[k]] = per_cell.tolist()

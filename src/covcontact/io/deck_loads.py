@@ -144,6 +144,8 @@ class LoadCards:
                     st.loads.append(Load("grav", ref, 0, g, c.where(k), elements=els, amplitude=c.param("AMPLITUDE"),
                                          direction=tuple(n / np.linalg.norm(n)), delay=self._delay(c)))
                     continue
+                if lab == "P":  # (a shell's pressure, without a face number: deck_shells; refused on solids)
+                    lab = "P0"
                 if not (lab.startswith("P") and lab[1:].isdigit()):
                     self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (face pressures P1..P6, GRAV and "
                                               f"CENTRIF are read)")

@@ -54,7 +54,8 @@ class Parts:
         self.of_element = np.searchsorted(kinds, el_comp)      # body number of each element (deck order)
         self.n = kinds.size
         node_body = np.full(nn, -1, dtype=np.int64)
-        node_body[cols] = np.repeat(self.of_element, np.concatenate([np.full(len(c), c.shape[1]) for c in conn]))
+        if conn:  # (a deck of shells alone has no solid part)
+            node_body[cols] = np.repeat(self.of_element, np.concatenate([np.full(len(c), c.shape[1]) for c in conn]))
         self.of_node = node_body                                # body of each node (-1: in no element)
 
     def _lookup(self, labels: np.ndarray) -> np.ndarray:

@@ -16,6 +16,8 @@ import numpy as np
 from .deck import Card, DeckError, numbers, read_deck
 from .deck_coupling import COUPLING_CARDS, read_coupling_card
 from .deck_loads import Boundary, Load, LoadCards
+from .deck_shells import (SHELL_CARDS, SHELL_ELEMENTS, read_shell_card, read_shell_elements, refuse_shell_type,
+                          shell_surface_row)
 from .deck_springs import BEAMS, SPRING_CARDS, SPRING_ELEMENTS, read_spring_card, read_spring_elements
 
 #: Abaqus / CalculiX element type -> (covcontact cell type, options); C3D8R is the full-integration hex8 (there is
@@ -36,7 +38,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY",
-             "TIME POINTS", "SECTION PRINT") + COUPLING_CARDS
+             "TIME POINTS", "SECTION PRINT") + COUPLING_CARDS + SHELL_CARDS
 #: keywords only Abaqus reads: a deck with one of them is read in Abaqus' dialect (import_deck's "auto")
 _ABAQUS_ONLY = ("PART", "END PART", "ASSEMBLY", "END ASSEMBLY", "INSTANCE", "END INSTANCE")
 #: output requests: accepted; the .dat tabulates what _print lists for *NODE PRINT, *EL PRINT, *CONTACT PRINT and
@@ -141,6 +143,16 @@ class DeckModel:
     notes: list[str] = field(default_factory=list)
     #: "abaqus" where the deck has keywords only Abaqus reads (*PART, *ASSEMBLY, *INSTANCE), else "calculix"
     dialect: str = "calculix"
+    #: shell elements (S3, S4, S4R, S8, S8R; covcontact.io.deck_shells): (deck type, surface cell type, labels,
+    #: connectivity as node labels) per *ELEMENT card, and where each card is
+    shell_blocks: list[tuple[str, str, np.ndarray, np.ndarray]] = field(default_factory=list)
+    shell_where: list[str] = field(default_factory=list)
+    #: *SHELL SECTION: (elset, material, thickness or None, offset, where)
+    shell_sections: list[tuple[str, str, float | None, float, str]] = field(default_factory=list)
+    #: *NODAL THICKNESS: node label -> (thickness, where)
+    nodal_thickness: dict[int, tuple[float, str]] = field(default_factory=dict)
+    #: the shell faces of element surfaces: name -> [(element labels, "SPOS" | "SNEG", where)]
+    shell_surfaces: dict[str, list[tuple[np.ndarray, str, str]]] = field(default_factory=dict)
 
     def skipped_card(self, label: int) -> str:
         """The *ELEMENT line of element ``label`` of a type covcontact does not read: '*ELEMENT, TYPE=S8R at
@@ -215,6 +227,9 @@ class _Reader(LoadCards):
                 continue
             if c.name in COUPLING_CARDS:  # (deck_coupling checks its own parameters)
                 read_coupling_card(self, c, cards[k] if k < len(cards) else None)
+                continue
+            if c.name in SHELL_CARDS:  # (*SHELL SECTION, *NODAL THICKNESS: deck_shells)
+                read_shell_card(self, c)
                 continue
             self._check_params(c)
             if c.name == "HEADING":
@@ -554,6 +569,10 @@ class _Reader(LoadCards):
         if etype in SPRING_ELEMENTS:  # (springs and dashpots, no solids: deck_springs)
             read_spring_elements(self, c, etype)
             return
+        if etype in SHELL_ELEMENTS:  # (shells, made into solid-shells at import: deck_shells)
+            read_shell_elements(self, c, etype)
+            return
+        refuse_shell_type(c, etype)
         if etype not in ELEMENTS:
             self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported "
                                       + BEAMS.get(etype, f"(covcontact reads {', '.join(ELEMENTS)})"))
@@ -644,9 +663,7 @@ class _Reader(LoadCards):
             return
         refs = []
         for k, row in enumerate(c.rows()):
-            if len(row) >= 2 and row[1].upper() in ("SPOS", "SNEG"):  # (a shell's sides: shells are not read)
-                self.m.unsupported.append(f"{c.where(k)}: *SURFACE {name}: {row[1].upper()}, a shell face (shell "
-                                          f"elements are not read)")
+            if shell_surface_row(self, c, k, row, name):  # (a shell's sides: deck_shells)
                 continue
             if len(row) < 2 or not row[1].upper().startswith("S") or not row[1][1:].isdigit():
                 raise c.fail("an element surface line is 'element set or label, S1..S6'", k)

@@ -30,6 +30,9 @@ from .deck_dat import output_due
 #: deck's node order of C3D8, C3D6, C3D4, C3D10 and C3D20 is covcontact's (VTK's); the frd lists a 20-node brick's
 #: vertical mid-edge nodes (deck nodes 17-20) before those of the top face (13-16), and a 15-node wedge's vertical ones
 #: (13-15) before the top ones (10-12) after the first ten
+#: a hex18 (quad9 bottom 0-8, quad9 top 9-17: corners, mid-sides, centre) as four hex8 over its quarters
+_HEX18_SPLIT = tuple(tuple(q) + tuple(i + 9 for i in q) for q in ((0, 4, 8, 7), (4, 1, 5, 8), (8, 5, 2, 6),
+                                                                  (7, 8, 6, 3)))
 FRD_CELLS = {
     "hex8": (1, tuple(range(8))),
     "wedge6": (2, tuple(range(6))),
@@ -212,12 +215,26 @@ class FrdFile(Observer):
             for _, idx, material, _ in body.material_parts():
                 number[idx] = materials.setdefault(repr(material), len(materials) + 1)
             for b in body.mesh.blocks:
+                if b.cell_type == "hex18":  # (no 18-node brick in the .frd: four C3D8 of its 2 x 2 x 1 corners)
+                    for e, cell in enumerate(b.cells.tolist()):
+                        for q, sub in enumerate(_HEX18_SPLIT):
+                            lab = int(elab[b.first + e]) if q == 0 else self._extra_label(elab)
+                            elements.append((lab, 1, int(number[b.first + e]), nlab[[cell[i] for i in sub]].tolist()))
+                    continue
                 if b.cell_type not in FRD_CELLS:
                     raise ValueError(f"body {blk.name}: {b.cell_type} cells have no CalculiX frd element type")
                 kind, order = FRD_CELLS[b.cell_type]
                 for e, cell in enumerate(b.cells[:, list(order)].tolist()):
                     elements.append((int(elab[b.first + e]), kind, int(number[b.first + e]), nlab[cell].tolist()))
         return mesh_text(np.concatenate(labels), np.vstack(coords), elements)
+
+    def _extra_label(self, elab) -> int:
+        """An element label after every label of the run (the .frd's extra C3D8 of a split hex18)."""
+        top = getattr(self, "_next_label", None)
+        if top is None:
+            top = max([int(v) for labs in self.info["elements"].values() for v in labs] + [0]) + 1
+        self._next_label = top + 1
+        return top
 
     def _results(self, run, lam: float, step: int, increment: int, t: float, dynamic: bool) -> str:
         model = run.model

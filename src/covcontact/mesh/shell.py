@@ -139,11 +139,14 @@ def _directors(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndar
 
 
 def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thickness, offset="middle",
-                    node_sets: dict | None = None, element_sets: dict | None = None) -> Mesh:
+                    node_sets: dict | None = None, element_sets: dict | None = None,
+                    face_sets: dict | None = None) -> Mesh:
     """The solid-shell mesh (hex8 or hex18, one element through the thickness) of the surface mesh (``points``,
     ``cell_type`` in SURFACE_CELLS, ``cells``) with ``thickness`` (a number, or one per surface node) and ``offset``
-    ("middle", "top", "bottom" or a number in [-1/2, 1/2]); the module docstring says how. ShellMeshError (a
-    ValueError) for a surface that cannot be made into one."""
+    ("middle", "top", "bottom" or a number in [-1/2, 1/2]); the module docstring says how. ``face_sets``: name ->
+    [(surface cells, "top" or "bottom")], the face set (and node set, unless one of that name exists) of those cells'
+    faces on that side of each cell's own normal (by its corner order as given, whichever way the orientation turned
+    it: a deck's SPOS and SNEG). ShellMeshError (a ValueError) for a surface that cannot be made into one."""
     points = np.asarray(points, dtype=np.float64)
     cells = np.asarray(cells, dtype=np.int64)
     if cell_type not in SURFACE_CELLS:
@@ -166,7 +169,9 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     elif cell_type == "tri3":
         points, t, cells, cell_of = _split_triangles(points, t, cells)
         cell_type = "quad4"
+    given = cells
     cells = _orient(cells, cell_type)
+    turned = np.any(cells != given, axis=1)  # (cells whose top is the side against their own normal)
     d = _directors(points, cells, cell_type)
     mid = points - (o * t)[:, None] * d
     bottom = mid - 0.5 * t[:, None] * d
@@ -201,6 +206,22 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             mesh.add_face_set(name, f)
     for name, ids in (element_sets or {}).items():
         mesh.element_sets[name] = np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64)))
+    for name, rows in (face_sets or {}).items():
+        chosen = []
+        for ids, side in rows:
+            if side not in ("top", "bottom"):
+                raise ShellMeshError(f"face set {name!r}: side must be 'top' or 'bottom', got {side!r}")
+            sel = np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64)))
+            up = turned[sel] != (side == "top")  # (the mesh's top face)
+            if np.any(up):
+                chosen.append(top_faces[sel[up]])
+            if np.any(~up):
+                chosen.append(bottom_faces[sel[~up]])
+        if chosen:
+            f = np.vstack(chosen)
+            mesh.add_face_set(name, f)
+            if name not in mesh.node_sets:
+                mesh.add_node_set(name, np.unique(f))
     return mesh
 
 
@@ -250,6 +271,10 @@ def read_surface(path) -> tuple[np.ndarray, str, np.ndarray, dict, dict]:
     points[:, : pts.shape[1]] = pts[used]
     node_sets: dict[str, np.ndarray] = {}
     element_sets: dict[str, np.ndarray] = {}
+    for name, ids in m.point_sets.items():  # (an Abaqus file's *NSET)
+        nodes = renumber[np.asarray(ids, dtype=np.int64)]
+        if np.any(nodes >= 0):
+            node_sets[name] = np.unique(nodes[nodes >= 0])
     for name, parts in _groups(m).items():
         for b, ids in parts:
             if b in blocks:

@@ -1,0 +1,287 @@
+"""Shell elements of decks made into solid-shells (io/deck_shells.py; docs/input.md, "Abaqus and CalculiX decks"):
+an S4 plate cantilever against the plate generator's solid-shells and the closed form, S8R, *NODAL THICKNESS, a
+pinned edge against a clamp, an SPOS contact surface, and the refusals (one line, exit 2)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from covcontact.io.deck import DeckError
+from covcontact.io.deck_import import import_deck
+from covcontact.io.loader import load_problem
+
+E, NU = 210000.0, 0.3
+
+
+def plate_deck(kind="S4", nx=10, ny=4, L=10.0, B=8.0, t=0.1, P=1e-4, fix="1, 6", section=None, extra="",
+               loads=True, both_ends=False) -> str:
+    """A cantilever plate [0, L] x [0, B] of S4 (or S8R, S8) elements clamped at x = 0 (FIX, dofs ``fix``), a
+    total force P along z on the edge x = L (TIP) as consistent nodal loads; ``both_ends``: the edge x = L held
+    alike and the force on the line x = L / 2 instead (nx even)."""
+    quad8 = kind.startswith("S8")
+    mx, my = (2 * nx, 2 * ny) if quad8 else (nx, ny)
+
+    def lab(i, j):
+        return 1 + i + j * (mx + 1)
+
+    used, els = set(), []
+    for j in range(ny):
+        for i in range(nx):
+            if quad8:
+                a, b = 2 * i, 2 * j
+                n = [lab(a, b), lab(a + 2, b), lab(a + 2, b + 2), lab(a, b + 2), lab(a + 1, b), lab(a + 2, b + 1),
+                     lab(a + 1, b + 2), lab(a, b + 1)]
+            else:
+                n = [lab(i, j), lab(i + 1, j), lab(i + 1, j + 1), lab(i, j + 1)]
+            used.update(n)
+            els.append(n)
+    lines = ["*NODE, NSET=NALL"]
+    lines += [f"{lab(i, j)}, {L * i / mx!r}, {B * j / my!r}, 0.0" for j in range(my + 1) for i in range(mx + 1)
+              if lab(i, j) in used]
+    lines.append(f"*ELEMENT, TYPE={kind}, ELSET=PLATE")
+    lines += [", ".join(map(str, [k + 1, *n])) for k, n in enumerate(els)]
+    fixn = [lab(0, j) for j in range(my + 1) if lab(0, j) in used]
+    tipn = [lab(mx, j) for j in range(my + 1) if lab(mx, j) in used]
+    if both_ends:
+        fixn += tipn
+        tipn = [lab(mx // 2, j) for j in range(my + 1) if lab(mx // 2, j) in used]
+    lines += ["*NSET, NSET=FIX", ", ".join(map(str, fixn)), "*NSET, NSET=TIP", ", ".join(map(str, tipn))]
+    lines += ["*MATERIAL, NAME=STEEL", "*ELASTIC", f"{E}, {NU}",
+              section or f"*SHELL SECTION, ELSET=PLATE, MATERIAL=STEEL\n{t}", extra,
+              "*STEP", "*STATIC", "*BOUNDARY", f"FIX, {fix}"]
+    if loads:
+        w: dict[int, float] = {}
+        for k in range(ny):
+            nodes = tipn[2 * k: 2 * k + 3] if quad8 else tipn[k: k + 2]
+            for n, s in zip(nodes, (1 / 6, 2 / 3, 1 / 6) if quad8 else (0.5, 0.5), strict=True):
+                w[n] = w.get(n, 0.0) + s * P / ny
+        lines += ["*CLOAD"] + [f"{n}, 3, {v!r}" for n, v in w.items()]
+    lines += ["*NODE PRINT, NSET=TIP", "U", "*NODE PRINT, NSET=FIX", "RF", "*END STEP"]
+    return "\n".join(x for x in lines if x) + "\n"
+
+
+def _run_deck(tmp_path: Path, text: str, name: str = "p") -> tuple[Path, subprocess.CompletedProcess]:
+    deck = tmp_path / f"{name}.inp"
+    deck.write_text(text)
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / name),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    return tmp_path / name / f"{name}.dat", proc
+
+
+def _dat(path: Path) -> dict[str, dict[int, np.ndarray]]:
+    out: dict[str, dict[int, np.ndarray]] = {}
+    cur = None
+    for line in path.read_text().splitlines():
+        if "displacements" in line or "forces" in line:
+            cur = "U" if "displacements" in line else "RF"
+            continue
+        f = line.split()
+        if cur and len(f) == 4 and f[0].isdigit():
+            out.setdefault(cur, {})[int(f[0])] = np.array([float(x) for x in f[1:]])
+    return out
+
+
+def _generator_problem(tmp_path: Path, nx, ny, L, B, t, P) -> Path:
+    """The same plate from the plate generator as solid-shells, with the deck's clamp as the import maps it (x, y of
+    both layers held, u_z bottom + u_z top = 0) and the tip force shared by the layers."""
+    from covcontact.mesh.generators import plate
+
+    mesh = plate(L, B, t, nx, ny, "hex8", origin=(0.0, 0.0, -t / 2))
+    X = mesh.points
+    clamp = np.flatnonzero(np.isclose(X[:, 0], 0.0))
+    tip = np.flatnonzero(np.isclose(X[:, 0], L))
+    bottom = clamp[X[clamp, 2] < 0.0]
+    top = [int(clamp[(X[clamp, 2] > 0.0) & np.isclose(X[clamp, 1], X[b, 1])][0]) for b in bottom]
+    sets = {f"b{k}": {"nodes": [int(b)]} for k, b in enumerate(bottom)}
+    sets |= {f"t{k}": {"nodes": [t_]} for k, t_ in enumerate(top)}
+    sets |= {f"f{k}": {"nodes": [int(n)]} for k, n in enumerate(tip)}
+    text = ["[problem]", 'name = "gen"', "[[bodies]]", 'name = "p"',
+            f'mesh = {{ generator = "plate", lx = {L}, ly = {B}, t = {t}, nx = {nx}, ny = {ny}, '
+            f"origin = [0.0, 0.0, {-t / 2!r}] }}", 'formulation = "solid-shell"',
+            f'material = {{ model = "svk", E = {E}, nu = {NU} }}',
+            "sets = { " + ", ".join(f'{k} = {{ nodes = {v["nodes"]} }}' for k, v in sets.items()) + " }",
+            "[[dirichlet]]", 'set = "p.xmin"', 'components = "xy"', "value = 0.0"]
+    for k in range(len(bottom)):
+        text += ["[[equation]]", f'terms = [["p.t{k}", "z", 1.0], ["p.b{k}", "z", 1.0]]']
+    for k, n in enumerate(tip):
+        y = X[n, 1]
+        share = 0.5 if np.isclose(y, 0.0) or np.isclose(y, B) else 1.0
+        text += ["[[force]]", f'set = "p.f{k}"', f"value = [0.0, 0.0, {share * P / ny / 2!r}]"]
+    text += ["[steps]", "initial = 1.0", "[output]", "vtu = false"]
+    path = tmp_path / "gen.toml"
+    path.write_text("\n".join(text) + "\n")
+    return path
+
+
+def test_s4_cantilever_against_the_plate_generator_and_the_closed_form(tmp_path):
+    """An S4 plate clamped (1-6) at one edge with a tip force: its import (mesh built in memory, and read back from
+    the surface file) gives the plate generator's solid-shell result to 1e-10 with the clamp as CalculiX expands it;
+    the tip deflection is within 5 % of Euler-Bernoulli's with the plate modulus E / (1 - nu^2) (a wide plate:
+    B = 0.8 L); U of a shell node is the mean of its two layers, RF the sum (the clamp's reactions balance P)."""
+    nx, ny, L, B, t, P = 10, 4, 10.0, 8.0, 0.1, 1e-4
+    dat, proc = _run_deck(tmp_path, plate_deck(nx=nx, ny=ny, L=L, B=B, t=t, P=P))
+    assert proc.returncode == 0, proc.stderr
+    assert "drilling rotation" in proc.stderr  # (dof 6 of a flat shell in the x-y plane: dropped, said)
+    got = _dat(dat)
+    w_deck = np.mean([u[2] for u in got["U"].values()])
+    assert sum(r[2] for r in got["RF"].values()) == pytest.approx(-P, rel=1e-6)
+    ref = load_problem(_generator_problem(tmp_path, nx, ny, L, B, t, P)).run(out=tmp_path / "gen", quiet=True)
+    U = ref.u.reshape(-1, 3)
+    from covcontact.mesh.generators import plate
+
+    X = plate(L, B, t, nx, ny, "hex8", origin=(0.0, 0.0, -t / 2)).points
+    w_gen = U[np.isclose(X[:, 0], L), 2].mean()
+    assert w_deck == pytest.approx(w_gen, rel=1e-6)  # (the .dat's seven digits)
+    imp = import_deck(tmp_path / "p.inp", tmp_path / "imp" / "p.toml")
+    alone = load_problem(imp.problem).run(out=tmp_path / "alone", quiet=True)  # (the surface file read back)
+    (mesh,) = imp.read.values()
+    np.testing.assert_allclose(mesh.points, X, rtol=0, atol=1e-14)  # (the generator's nodes, in its order)
+    np.testing.assert_allclose(alone.u, ref.u, rtol=0, atol=1e-10 * np.abs(ref.u).max())
+    closed = P * L ** 3 / (3.0 * E / (1.0 - NU ** 2) * B * t ** 3 / 12.0)
+    assert w_deck == pytest.approx(closed, rel=0.05)
+
+
+def test_s8r_and_a_pinned_edge_against_a_clamp(tmp_path):
+    """S8R plates (quad8 -> hex18 with the centre node): a cantilever against the closed form; a strip supported at
+    both ends under a centre line force, pinned (1-3: the mid-surface held, u_bottom + u_top = 0 per component) and
+    clamped (1-6), against F L^3 / (48 E' I) and a quarter of it."""
+    clamp, proc = _run_deck(tmp_path, plate_deck("S8R", nx=4, ny=1, B=2.0, P=1e-4), "clamp")
+    assert proc.returncode == 0, proc.stderr
+    w_clamp = np.mean([u[2] for u in _dat(clamp)["U"].values()])
+    Ep, I = E / (1 - NU ** 2), 2.0 * 0.1 ** 3 / 12.0
+    assert 1e-4 * 1e3 / (3.0 * Ep * I) < w_clamp < 1e-4 * 1e3 / (3.0 * E * I) * 1.01  # (a strip: E' < . < E)
+    res = {}
+    for name, dofs in (("pinned", "1, 3"), ("clamped", "1, 6")):
+        dat, proc = _run_deck(tmp_path, plate_deck("S8R", nx=8, ny=1, B=2.0, P=1e-4, fix=dofs, both_ends=True), name)
+        assert proc.returncode == 0, proc.stderr
+        res[name] = np.mean([u[2] for u in _dat(dat)["U"].values()])
+    pinned = 1e-4 * 1e3 / (48 * Ep * I)
+    assert res["pinned"] == pytest.approx(pinned, rel=0.1)
+    assert res["clamped"] == pytest.approx(pinned / 4.0, rel=0.1)
+
+
+def test_nodal_thickness(tmp_path):
+    """*SHELL SECTION, NODAL THICKNESS with *NODAL THICKNESS: the thickness per node (a uniform one gives the
+    section's result exactly); without the parameter the section's thickness holds (a note), as in CalculiX."""
+    base = plate_deck(nx=4, ny=1, B=2.0)
+    nodal = base.replace("*SHELL SECTION, ELSET=PLATE, MATERIAL=STEEL\n0.1",
+                         "*SHELL SECTION, ELSET=PLATE, MATERIAL=STEEL, NODAL THICKNESS\n*NODAL THICKNESS\nNALL, 0.1")
+    a = import_deck(_write(tmp_path / "a.inp", base), tmp_path / "a" / "a.toml")
+    b = import_deck(_write(tmp_path / "b.inp", nodal), tmp_path / "b" / "b.toml")
+    (ma,), (mb,) = a.read.values(), b.read.values()
+    np.testing.assert_array_equal(ma.points, mb.points)
+    thick = nodal.replace("NALL, 0.1", "NALL, 0.1\nTIP, 0.2")
+    c = import_deck(_write(tmp_path / "c.inp", thick), tmp_path / "c" / "c.toml")
+    (mc,) = c.read.values()
+    n = mc.points.shape[0] // 2
+    t = np.linalg.norm(mc.points[n:] - mc.points[:n], axis=1)
+    assert sorted(set(np.round(t, 12))) == [0.1, 0.2]
+    assert "thickness = [" in c.problem.read_text()
+    ignored = base.replace("*STEP", "*NODAL THICKNESS\nTIP, 0.2\n*STEP")
+    d = import_deck(_write(tmp_path / "d.inp", ignored), tmp_path / "d" / "d.toml")
+    (md,) = d.read.values()
+    np.testing.assert_array_equal(md.points, ma.points)
+    assert any("no NODAL THICKNESS parameter" in note for note in d.notes)
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text)
+    return path
+
+
+def test_spos_contact_surface_and_cload_split(tmp_path):
+    """*SURFACE with SPOS (and S2 of a shell, CalculiX's name) is the top face set of those elements' solid-shells,
+    usable in *CONTACT PAIR; a *CLOAD on a shell node is split equally between its two layers."""
+    text = plate_deck(nx=2, ny=1, B=2.0)
+    text = text.replace("*MATERIAL", "*SURFACE, NAME=UP\nPLATE, SPOS\n*SURFACE, NAME=DOWN\nPLATE, S1\n*MATERIAL")
+    imp = import_deck(_write(tmp_path / "s.inp", text), tmp_path / "s" / "s.toml")
+    (mesh,) = imp.read.values()
+    n = mesh.points.shape[0] // 2
+    assert np.all(mesh.face_sets["UP"] >= n) and mesh.face_sets["UP"].shape == (2, 4)
+    assert np.all(mesh.face_sets["DOWN"] < n) and mesh.face_sets["DOWN"].shape == (2, 4)
+    up = mesh.points[mesh.face_sets["UP"]]  # (outward: along +z, the elements' normal)
+    normal = np.cross(up[:, 1] - up[:, 0], up[:, 3] - up[:, 0])
+    assert np.all(normal[:, 2] > 0)
+    toml = imp.problem.read_text()
+    assert 'faces = { UP = [["__UP_1", "top"]], DOWN = [["__DOWN_1", "bottom"]] }' in toml
+    assert ", 3, 5e-05" in text and "value = [0.0, 0.0, 2.5e-05]" in toml  # (half on each layer)
+
+
+def test_sts_contact_of_a_block_on_a_shell(tmp_path):
+    """A C3D8 block pressed onto an S4 plate's SPOS face (surface-to-surface): the contact force balances the push."""
+    plate = plate_deck(nx=4, ny=2, L=4.0, B=4.0, t=0.2, loads=False, fix="1, 3")
+    plate = plate.replace("*NSET, NSET=FIX\n", "*NSET, NSET=FIX\n").replace("*MATERIAL", """*NODE
+1001, 1.5, 1.5, 0.1
+1002, 2.5, 1.5, 0.1
+1003, 2.5, 2.5, 0.1
+1004, 1.5, 2.5, 0.1
+1005, 1.5, 1.5, 1.1
+1006, 2.5, 1.5, 1.1
+1007, 2.5, 2.5, 1.1
+1008, 1.5, 2.5, 1.1
+*ELEMENT, TYPE=C3D8, ELSET=BLOCK
+1001, 1001, 1002, 1003, 1004, 1005, 1006, 1007, 1008
+*NSET, NSET=BTOP
+1005, 1006, 1007, 1008
+*SURFACE, NAME=UP
+PLATE, SPOS
+*SURFACE, NAME=BBOT
+BLOCK, S1
+*SOLID SECTION, ELSET=BLOCK, MATERIAL=STEEL
+*SURFACE INTERACTION, NAME=SI
+*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR
+1.0e6
+*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE
+BBOT, UP
+*MATERIAL""")
+    plate = plate.replace("*BOUNDARY\nFIX, 1, 3", "*BOUNDARY\nFIX, 1, 3\nNALL, 1, 2\nBTOP, 1, 2\nBTOP, 3, 3, -1e-3")
+    plate = plate.replace("*NODE PRINT, NSET=TIP\nU\n", "")
+    plate = plate.replace("*NODE PRINT, NSET=FIX\nRF", "*NODE PRINT, NSET=FIX, TOTALS=ONLY\nRF\n"
+                                                       "*NODE PRINT, NSET=BTOP, TOTALS=ONLY\nRF")
+    dat, proc = _run_deck(tmp_path, plate, "sts")
+    assert proc.returncode == 0, proc.stderr
+    totals = [ln for ln in dat.read_text().splitlines() if ln.startswith("      ") and ln.strip()]
+    fix, top = (np.array([float(v) for v in ln.split()]) for ln in totals[-2:])
+    assert top[2] < 0 and fix[2] == pytest.approx(-top[2], rel=1e-4)
+
+
+@pytest.mark.parametrize("change, message", [
+    (("TYPE=S4,", "TYPE=S6,"), "TYPE=S6 is not supported"),
+    (("FIX, 1, 6", "FIX, 4, 4"), "rotation dof 4 of shell node 1 without the translation 2"),
+    (("FIX, 1, 6", "FIX, 1, 6, 0.01"), "rotation (dof 4) prescribed non-zero"),
+    (("FIX, 1, 6", "FIX, 3, 3, 0.01"), "non-zero value on dof 3 of shell node 1"),
+    (("MATERIAL=STEEL\n0.1", "MATERIAL=STEEL\n"), "needs the thickness on its data line"),
+    (("MATERIAL=STEEL\n0.1", "MATERIAL=STEEL\n-0.1"), "the thickness must be positive"),
+    (("MATERIAL=STEEL\n0.1", "MATERIAL=STEEL, OFFSET=0.7\n0.1"), "OFFSET=0.7"),
+])
+def test_refusals_are_one_line_exit_2(tmp_path, change, message):
+    text = plate_deck(nx=2, ny=1, B=2.0).replace(*change)
+    if "S6" in change[1]:
+        text = text.replace("*ELEMENT, TYPE=S6, ELSET=PLATE\n1, 1, 2, 5, 4\n2, 2, 3, 6, 5",
+                            "*ELEMENT, TYPE=S6, ELSET=PLATE\n1, 1, 3, 6, 2, 5, 4")
+    deck = _write(tmp_path / "bad.inp", text)
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
+                           "--quiet"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip() and "note:" not in ln]
+    assert len(lines) == 1 and message in lines[0], proc.stderr
+    with pytest.raises(DeckError):
+        import_deck(deck, tmp_path / "i" / "bad.toml")
+
+
+def test_symmetry_plane_maps_onto_both_layers(tmp_path):
+    """XSYMM-like 1, 5, 6 on a flat shell in the x-y plane: both layers' x held (a symmetry plane); rotations 4, 5
+    with the translations free: the tangential components of u_top - u_bottom vanish (equations)."""
+    imp = import_deck(_write(tmp_path / "x.inp", plate_deck(nx=2, ny=1, B=2.0, fix="1, 1\nFIX, 5, 6")),
+                      tmp_path / "x" / "x.toml")
+    toml = imp.problem.read_text()
+    assert 'components = "x"' in toml and "[[equation]]" not in toml
+    imp = import_deck(_write(tmp_path / "r.inp", plate_deck(nx=2, ny=1, B=2.0, fix="4, 5")),
+                      tmp_path / "r" / "r.toml")
+    toml = imp.problem.read_text()
+    assert toml.count("[[equation]]") == 2 * 2 and "[[dirichlet]]" not in toml
