@@ -14,7 +14,8 @@ import pytest
 
 from covcontact.io.deck import DeckError, read_deck
 from covcontact.io.deck_import import import_deck
-from covcontact.io.deck_model import read_model
+from covcontact.io.deck_model import ELEMENTS, read_model
+from covcontact.io.deck_planar import element_names
 from covcontact.io.loader import load_problem
 
 from test_deck import two_block_deck
@@ -210,7 +211,7 @@ def _run(deck: Path, tmp_path: Path) -> subprocess.CompletedProcess:
                            "--quiet"], capture_output=True, text=True, timeout=600)
 
 
-@pytest.mark.parametrize("etype", ["S4", "CPS4"])
+@pytest.mark.parametrize("etype", ["M3D4", "DC2D4"])
 def test_a_deck_without_solids_names_its_element_types_and_lines(tmp_path, etype):
     """A deck whose only elements are of a type covcontact does not read, with a GRAV load on their ELSET=: one
     line naming the *ELEMENT line and the type (not the *DLOAD's set as undefined), exit 2."""
@@ -222,18 +223,18 @@ def test_a_deck_without_solids_names_its_element_types_and_lines(tmp_path, etype
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     (line,) = [ln for ln in proc.stderr.splitlines() if "error" in ln]
     assert line == (f"covcontact: error: {deck}:7: no solid elements: the deck's elements are {etype} ({deck}:7); "
-                    f"covcontact reads C3D8, C3D8R, C3D20, C3D8I, C3D20R, C3D10, C3D4, C3D6")
+                    f"covcontact reads {element_names(ELEMENTS)}")
 
 
 def test_a_coupling_on_elements_not_read_names_their_type_and_line(tmp_path):
     deck = tmp_path / "d.inp"
-    deck.write_text(_QUAD + "*ELEMENT, TYPE=CPS6, ELSET=Eall\n48, 1, 2, 3, 4\n*SURFACE, NAME=Sload\n48, S2\n"
+    deck.write_text(_QUAD + "*ELEMENT, TYPE=DC2D6, ELSET=Eall\n48, 1, 2, 3, 4\n*SURFACE, NAME=Sload\n48, S2\n"
                     "*COUPLING, SURFACE=Sload, REF NODE=9, CONSTRAINT NAME=load\n*KINEMATIC\n1, 3\n*MATERIAL, "
                     "NAME=steel\n*ELASTIC\n210000, 0.3\n*STEP\n*STATIC\n*CLOAD\n9, 1, 1.\n*END STEP\n")
     proc = _run(deck, tmp_path)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
     (line,) = [ln for ln in proc.stderr.splitlines() if "error" in ln]
-    assert line.startswith(f"covcontact: error: {deck}:10: *SURFACE SLOAD: element 48 is a CPS6 (*ELEMENT, TYPE=CPS6 "
+    assert line.startswith(f"covcontact: error: {deck}:10: *SURFACE SLOAD: element 48 is a DC2D6 (*ELEMENT, TYPE=DC2D6 "
                            f"at {deck}:7), a type covcontact does not read (it reads C3D8, ")
     assert line.endswith(f"the surface of *COUPLING LOAD at {deck}:11")
     deck.write_text(deck.read_text().replace("48, S2", "47, S2"))  # (an element no line defines)

@@ -206,6 +206,9 @@ def _faces(m, refs, surface: str = "", owner: str = "") -> list:
             hit = np.isin(els, labels)
             if not hit.any():
                 continue
+            if cell not in FACE_NODES:  # (planar elements' faces are edges)
+                raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: {etype} elements: a coupling "
+                                f"on planar elements is not supported{owner}")
             table = FACE_NODES[cell]
             if face not in table:
                 raise DeckError(f"{where}: S{face}: {cell} elements have the faces S1..S{len(table)}")
@@ -219,8 +222,9 @@ def _faces(m, refs, surface: str = "", owner: str = "") -> list:
                 raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: element {bad} is not "
                                 f"defined{owner}")
             from .deck_model import ELEMENTS  # (deck_model reads *COUPLING through this module)
+            from .deck_planar import element_names
             raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: element {bad} is {what}, a type "
-                            f"covcontact does not read (it reads {', '.join(ELEMENTS)}){owner}")
+                            f"covcontact does not read (it reads {element_names(ELEMENTS)}){owner}")
     return out
 
 

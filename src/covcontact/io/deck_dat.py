@@ -54,6 +54,11 @@ _MID = {"hex20": {(0, 1): 8, (1, 2): 9, (2, 3): 10, (3, 0): 11, (4, 5): 12, (5, 
         "tet10": {(0, 1): 4, (1, 2): 5, (0, 2): 6, (0, 3): 7, (1, 3): 8, (2, 3): 9}}
 
 
+#: the .dat's forces of an axisymmetric body's nodes are those of CalculiX's expanded segment of 2 degrees (its
+#: .frd's, and covcontact's own results, are totals over the circumference: 180 such segments)
+AXISYMMETRIC_SEGMENTS = 180.0
+
+
 def fortran_e(x: float) -> str:
     """x as CalculiX prints a time: 0.dddddddE+xx."""
     if x == 0.0:
@@ -390,6 +395,9 @@ class _Now:
                     force, moment = model.loading.rigid_load(name, lam)
                     forces[ref.A] = Rr[ref.A] + force
                     forces[ref.B] = Rr[ref.B] + tangent_map(run.u[3 * ref.B: 3 * ref.B + 3]).T @ moment
+            for blk, body in zip(model.system.blocks, model.problem.bodies):  # (CalculiX's .dat: its 2 degree
+                if getattr(body, "formulation", "") == "axisymmetric":           # segment of an axisymmetric model)
+                    forces[blk.offset: blk.offset + blk.n_nodes] /= AXISYMMETRIC_SEGMENTS
             self._forces = forces
         return self._forces
 

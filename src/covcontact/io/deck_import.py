@@ -22,6 +22,7 @@ from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 from .deck_coupling import DeckCouplings
+from .deck_planar import element_names, planar_body, planar_dof3, planar_pair
 from .deck_rigid import DeckRigid
 from .deck_shells import DeckShells
 from .deck_springs import DeckSprings
@@ -84,7 +85,7 @@ class _Writer:
         if not m.blocks and not m.shell_blocks:  # (the types it has, at their *ELEMENT lines: the first is said)
             first = m.skipped_blocks[0][1] if m.skipped_blocks else str(deck)
             found = f"the deck's elements are {m.element_types()}" if m.skipped_blocks else "the deck has no *ELEMENT"
-            raise DeckError(f"{first}: no solid elements: {found}; covcontact reads {', '.join(ELEMENTS)}")
+            raise DeckError(f"{first}: no solid elements: {found}; covcontact reads {element_names(ELEMENTS)}")
         self.b = Parts(m)
         self.shells = DeckShells(m, self.b, dialect)  # (shell elements made into solid-shells: bodies after these)
         self.notes += self.shells.notes
@@ -229,6 +230,7 @@ class _Writer:
                                 f"for its element set)")
             entries: dict = {"name": name, "mesh": {"file": self.mesh_path.with_suffix(f".{k + 1}.inp").name}}
             entries["material"] = self._material(secs[0][1], secs[0][2])
+            entries.update(planar_body(self, k, name, types, secs, labels))  # (CPE, CPS, CAX: deck_planar)
             if len(secs) > 1:
                 entries["materials"] = {_name(s): self._material(mat, w) for s, mat, w in secs[1:]}
             if options:
@@ -488,6 +490,8 @@ class _Writer:
             out[key] = 0.0 if b.value is None else b.value
         for body, set_name in self._node_targets(b.name, labels, b.where):
             for d in (d for d in b.dofs if d <= 3):
+                if d == 3 and planar_dof3(self, body, b.where, b.value):  # (held anyway: deck_planar)
+                    continue
                 key = (body, set_name, d - 1)
                 where.setdefault(key, b.where)
                 out[key] = 0.0 if b.value is None else b.value
@@ -536,6 +540,8 @@ class _Writer:
             if not targets and not rigid:
                 raise DeckError(f"{ld.where}: *CLOAD on nodes of no element ({ld.target})")
             for body, set_name in targets:
+                if ld.dof == 3 and planar_dof3(self, body, ld.where, None, load=True):
+                    continue
                 yield ("cload", body, set_name, ld.dof - 1)
         else:
             bodies = self.b.elements_body(ld.elements)
@@ -620,6 +626,7 @@ class _Writer:
             else:
                 sb = self._surface_body(slave, sref, where)
                 sname = _name(slave)
+            planar_pair(self, (sb, mb), where)  # (contact in the plane: deck_planar)
             entry: dict = {"name": f"pair{k + 1}", "slave": self._ref(sb, sname), "master": self._ref(mb, _name(master))}
             if sts:
                 entry["type"] = "sts"

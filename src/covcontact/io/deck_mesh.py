@@ -135,7 +135,9 @@ def body_content(m: DeckModel, parts: Parts, k: int, extra_nsets: dict, extra_el
 
 def body_text(c: dict) -> str:
     """The body's mesh file: *NODE, *ELEMENT per block, *ELSET, *NSET, *SURFACE (Abaqus, as covcontact reads it)."""
-    abaqus_type = {"hex8": "C3D8", "hex20": "C3D20", "tet10": "C3D10", "tet4": "C3D4", "wedge6": "C3D6"}
+    from .deck_planar import MESH_TYPE
+
+    abaqus_type = {"hex8": "C3D8", "hex20": "C3D20", "tet10": "C3D10", "tet4": "C3D4", "wedge6": "C3D6", **MESH_TYPE}
 
     def label_lines(values) -> list[str]:
         v = np.asarray(values).tolist()

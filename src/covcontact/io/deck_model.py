@@ -16,6 +16,7 @@ import numpy as np
 from .deck import Card, DeckError, numbers, read_deck
 from .deck_coupling import COUPLING_CARDS, read_coupling_card
 from .deck_loads import Boundary, Load, LoadCards
+from .deck_planar import PLANAR_ELEMENTS, PLANAR_NFACES, PLANAR_NNODE, element_names
 from .deck_shells import (SHELL_CARDS, SHELL_ELEMENTS, read_shell_card, read_shell_elements, refuse_shell_type,
                           shell_surface_row)
 from .deck_springs import BEAMS, SPRING_CARDS, SPRING_ELEMENTS, read_spring_card, read_spring_elements
@@ -30,6 +31,10 @@ ELEMENTS = {"C3D8": ("hex8", {}), "C3D8R": ("hex8", {}), "C3D20": ("hex20", {}),
 NNODE = {"hex8": 8, "hex20": 20, "tet10": 10, "tet4": 4, "wedge6": 6}
 #: faces per cell (S1..Sn, P1..Pn)
 NFACES = {"hex8": 6, "hex20": 6, "tet10": 4, "tet4": 4, "wedge6": 5}
+# plane strain, plane stress and axisymmetric elements (CPE, CPS, CAX): planar cells (deck_planar)
+ELEMENTS.update(PLANAR_ELEMENTS)
+NNODE.update(PLANAR_NNODE)
+NFACES.update(PLANAR_NFACES)
 
 #: the keywords read (everything else is unsupported); output requests are read for the .dat table
 SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL", "ELASTIC", "PLASTIC", "DENSITY",
@@ -111,6 +116,9 @@ class DeckModel:
     surfaces: dict[str, tuple[str, object]] = field(default_factory=dict)
     materials: dict[str, dict] = field(default_factory=dict)
     sections: list[tuple[str, str, str]] = field(default_factory=list)   # (elset, material, where)
+    #: the first field of each *SOLID SECTION's data line (the thickness of planar elements) by the card's where:
+    #: (text, where of the data line)
+    section_thickness: dict[str, tuple[str, str]] = field(default_factory=dict)
     interactions: dict[str, Interaction] = field(default_factory=dict)
     pairs: list[tuple[str, str, str, str, str]] = field(default_factory=list)  # (interaction, type, slave, master, where)
     #: ADJUST= of a *CONTACT PAIR by its line (where): a distance, or a node set's name
@@ -257,6 +265,8 @@ class _Reader(LoadCards):
             elif c.name == "SOLID SECTION":
                 m.sections.append((c.param("ELSET", required=True).upper(), c.param("MATERIAL", required=True).upper(),
                                    c.where()))
+                if c.rows() and c.rows()[0]:  # (read for planar elements: deck_planar)
+                    m.section_thickness[c.where()] = (c.rows()[0][0], c.where(0))
             elif c.name == "SURFACE INTERACTION":
                 self.interaction = c.param("NAME", required=True).upper()
                 m.interactions[self.interaction] = Interaction(self.interaction, where=c.where())
@@ -396,6 +406,7 @@ class _Reader(LoadCards):
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
                     c.name == "CONTACT PAIR" and p in ("ADJUST", "SMALL SLIDING")) or (
                     c.name == "EQUATION" and p in ("REMOVE", "REMOVE ALL")) or (
+                    c.name == "SOLID SECTION" and p == "OFFSET") or (
                     c.name == "PLASTIC" and p == "HARDENING") or (c.name == "SECTION PRINT" and p == "SURFACE") or (
                     c.name == "HYPERELASTIC" and (p == "N" or _rubber_option(p) is not None)):
                 continue
@@ -575,7 +586,7 @@ class _Reader(LoadCards):
         refuse_shell_type(c, etype)
         if etype not in ELEMENTS:
             self.m.unsupported.append(f"{c.where()}: *ELEMENT, TYPE={etype} is not supported "
-                                      + BEAMS.get(etype, f"(covcontact reads {', '.join(ELEMENTS)})"))
+                                      + BEAMS.get(etype, f"(covcontact reads {element_names(ELEMENTS)})"))
             cont = False
             labels = []
             for line in c.data:  # (their labels and nodes: a surface or set on them is named as such later)

@@ -40,6 +40,11 @@ FRD_CELLS = {
     "hex20": (4, (*range(12), 16, 17, 18, 19, 12, 13, 14, 15)),
     "wedge15": (5, (*range(9), 12, 13, 14, 9, 10, 11)),
     "tet10": (6, tuple(range(10))),
+    # planar cells as CalculiX writes 2D elements (OUTPUT=2D): tr3, tr6, qu4, qu8 in the deck's node order
+    "tri3": (7, tuple(range(3))),
+    "tri6": (8, tuple(range(6))),
+    "quad4": (9, tuple(range(4))),
+    "quad8": (10, tuple(range(8))),
 }
 
 #: the result blocks: name -> (frd component lines (name, type, row, column), with an ALL line)

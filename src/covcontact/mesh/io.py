@@ -45,6 +45,12 @@ _TO_MESHIO = {**{v: k for k, v in _VOLUME.items()}, **{v: k for k, v in _PLANAR.
 _PLANAR_FLIP = {"quad4": [0, 3, 2, 1], "quad8": [0, 3, 2, 1, 7, 6, 5, 4], "quad9": [0, 3, 2, 1, 7, 6, 5, 4, 8],
                 "tri3": [0, 2, 1], "tri6": [0, 2, 1, 5, 4, 3]}
 _FACE_CELLS = ("quad", "quad8", "quad9", "triangle", "triangle6")
+#: the edges S1..Sn of the planar cells (face k from corner k to corner k + 1, as Abaqus numbers them; the mid-node
+#: of a quadratic edge matches with its corners)
+_PLANAR_EDGES = {"quad4": {1: (0, 1), 2: (1, 2), 3: (2, 3), 4: (3, 0)},
+                 "quad8": {1: (0, 1), 2: (1, 2), 3: (2, 3), 4: (3, 0)},
+                 "quad9": {1: (0, 1), 2: (1, 2), 3: (2, 3), 4: (3, 0)},
+                 "tri3": {1: (0, 1), 2: (1, 2), 3: (2, 0)}, "tri6": {1: (0, 1), 2: (1, 2), 3: (2, 0)}}
 _DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
         "quad9": 2}
 
@@ -306,7 +312,7 @@ def _abaqus_surfaces(p: Path, m, mesh: Mesh, vol: list, first: np.ndarray, keep,
                 if len(ids):
                     ctype, cells = mesh.cells_of(first[k] + ids)
                     table = (TET_FACES if ctype in ("tet4", "tet10") else WEDGE_FACES if ctype == "wedge6"
-                             else HEX_FACES)
+                             else _PLANAR_EDGES[ctype] if ctype in _PLANAR_EDGES else HEX_FACES)
                     if face not in table:
                         raise _fail(p, f"*SURFACE {name}: {ctype} elements have the faces S1..S{len(table)}, "
                                        f"not S{face}")

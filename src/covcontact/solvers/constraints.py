@@ -49,6 +49,11 @@ class LinearConstraints:
         self.Tt = self.T.T.tocsr()
         self.rows = A[self.dependent].tocsr()
         self.unit = sp.diags(self.mask.astype(float)).tocsr()  # (the dependent dofs' diagonal: kept in the pattern)
+        planar = getattr(system, "planar_dofs", np.zeros(0, dtype=np.int64))
+        if len(planar):  # (planar bodies' z-dofs, held: their zero diagonal, which T^T K T drops, kept as 1)
+            on = self.mask.astype(float)
+            on[planar] = 1.0
+            self.unit = sp.diags(on).tocsr()
 
     def complete(self, u: np.ndarray) -> None:
         """Set the dependent dofs of ``u`` (in place) from the others."""

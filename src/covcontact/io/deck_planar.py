@@ -1,0 +1,169 @@
+"""Plane strain (CPE), plane stress (CPS) and axisymmetric (CAX) elements of an Abaqus or CalculiX deck as planar
+bodies (docs/input.md, "Abaqus and CalculiX decks"; covcontact.elements.planar).
+
+The element types map to the planar cells: 3 -> tri3, 4 and 4R -> quad4 (there is no hourglass-controlled quad4:
+the R types take full integration, said in a note), 6 -> tri6, 8 -> quad8, 8R -> quad8 with reduced (2 x 2)
+integration. The deck's node order is covcontact's (VTK's): corners counter-clockwise in the x-y plane, then the
+mid-nodes of the edges 1-2, 2-3, 3-4 (4-1); face k (S k of *SURFACE, P k of *DLOAD) runs from node k to node k + 1
+(the last to the first), as in both manuals. A body of CPE elements is ``formulation = "plane_strain"``, of CPS
+elements ``"plane_stress"``, each with the thickness of its *SOLID SECTION's data line (default 1); a body of CAX
+elements ``"axisymmetric"`` (x the radius, y the axis; the section's value has no effect, as in CalculiX). Forces mean
+what they mean in CalculiX: a *CLOAD on a plane body acts on its thickness, on an axisymmetric body on the full
+circumference (CalculiX's manual: "the point forces on the axisymmetric elements are to be given for the complete
+circumference"); pressures are per area; the reactions of the .dat are of the same totals.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .deck import DeckError
+
+#: the deck's type prefix -> the body's formulation
+PLANAR_FORMULATION = {"CPE": "plane_strain", "CPS": "plane_stress", "CAX": "axisymmetric"}
+#: the planar element types -> (cell type, options)
+PLANAR_ELEMENTS = {f"{p}{n}": cell for p in PLANAR_FORMULATION for n, cell in (
+    ("3", ("tri3", {})), ("4", ("quad4", {})), ("4R", ("quad4", {})), ("6", ("tri6", {})), ("8", ("quad8", {})),
+    ("8R", ("quad8", {"integration": "reduced"})))}
+#: nodes and faces (edges) of the planar cells
+PLANAR_NNODE = {"quad4": 4, "quad8": 8, "tri3": 3, "tri6": 6}
+PLANAR_NFACES = {"quad4": 4, "quad8": 4, "tri3": 3, "tri6": 3}
+#: the type written into an imported body's mesh file for each planar cell (types meshio reads as these cells)
+MESH_TYPE = {"quad4": "CPS4", "quad8": "S8R", "tri3": "CPS3", "tri6": "CPE6"}
+
+
+def is_planar_type(etype: str) -> bool:
+    return etype in PLANAR_ELEMENTS
+
+
+def formulation_of(etype: str) -> str | None:
+    """The formulation of a planar element type (None: not planar)."""
+    return PLANAR_FORMULATION[etype[:3]] if etype in PLANAR_ELEMENTS else None
+
+
+def planar_body(w, k: int, name: str, types: set, secs: list, labels: np.ndarray) -> dict:
+    """The planar keys of body ``k`` of the import ``w`` (deck_import._Writer) of deck element ``types``:
+    ``formulation`` and ``thickness``; {} for a body of volume elements. One line (DeckError) for a body that mixes
+    planar and volume elements or two formulations, a node off the x-y plane, an axisymmetric node at negative radius,
+    a clockwise element, cells one mesh does not mix, several thicknesses; notes for the R types of quad4 and a
+    thickness on CAX elements."""
+    m = w.m
+    planar = sorted(t for t in types if t in PLANAR_ELEMENTS)
+    if not planar:
+        return {}
+    where = {t: next(wh for (bt, _, _, _), wh in zip(m.blocks, m.block_where) if bt == t) for t in types}
+    if len(planar) < len(types):
+        solid = sorted(set(types) - set(planar))
+        raise DeckError(f"{where[solid[0]]}: body {name} joins {solid[0]} elements with planar {planar[0]} elements "
+                        f"({where[planar[0]]}) through shared nodes: a body is planar or three-dimensional")
+    forms = sorted({formulation_of(t) for t in planar})
+    if len(forms) > 1:
+        a, b = (next(t for t in planar if formulation_of(t) == f) for f in forms[:2])
+        raise DeckError(f"{where[b]}: body {name} joins {a} ({forms[0]}) and {b} ({forms[1]}) elements through shared "
+                        f"nodes: a body has one of plane strain (CPE), plane stress (CPS), axisymmetric (CAX)")
+    form = forms[0]
+    cells = sorted({PLANAR_ELEMENTS[t][0] for t in planar})
+    if len(cells) > 1 and set(cells) not in ({"quad4", "tri3"}, {"quad8", "tri6"}):
+        a, b = (next(t for t in planar if PLANAR_ELEMENTS[t][0] == c) for c in cells[:2])
+        raise DeckError(f"{where[b]}: body {name} joins {a} and {b} elements: a planar body mixes only linear "
+                        f"quadrilaterals with linear triangles and quadratic ones with quadratic ones")
+    mine = w.b.of_node == k
+    X, node_labels = m.X[mine], m.node_labels[mine]
+    off = np.abs(X[:, 2]) > 0.0
+    if off.any():
+        j = int(np.flatnonzero(off)[0])
+        raise DeckError(f"{where[planar[0]]}: node {int(node_labels[j])} of the {planar[0]} elements has z = "
+                        f"{X[j, 2]:g}: plane strain, plane stress and axisymmetric elements lie in the x-y plane "
+                        f"(z = 0)")
+    if form == "axisymmetric" and np.any(X[:, 0] < 0.0):
+        j = int(np.flatnonzero(X[:, 0] < 0.0)[0])
+        raise DeckError(f"{where[planar[0]]}: node {int(node_labels[j])} of the {planar[0]} elements has x = "
+                        f"{X[j, 0]:g}: x is the radius of an axisymmetric model (x >= 0)")
+    index = m.node_index()
+    for (etype, cell, elabels, conn), wh in zip(m.blocks, m.block_where):
+        if etype not in planar:
+            continue
+        xy = m.X[index[conn[:, :3 if cell.startswith("tri") else 4]]][:, :, :2]
+        area = 0.5 * np.sum(xy[:, :, 0] * np.roll(xy[:, :, 1], -1, axis=1)
+                            - np.roll(xy[:, :, 0], -1, axis=1) * xy[:, :, 1], axis=1)
+        bad = np.flatnonzero((area <= 0.0) & np.isin(elabels, labels))
+        if bad.size:
+            raise DeckError(f"{wh}: element {int(elabels[bad[0]])} ({etype}) is clockwise or of no area in the x-y "
+                            f"plane: the corners of planar elements go counter-clockwise (CalculiX stops at its "
+                            f"negative Jacobian)")
+    quad_r = [t for t in planar if t.endswith("4R")]
+    if quad_r:
+        w.notes.append(f"{where[quad_r[0]]}: {', '.join(quad_r)}: covcontact's quad4 has no hourglass control; read as "
+                       f"{', '.join(t[:-1] for t in quad_r)} (full integration, 2 x 2 points)")
+    values = {}
+    for s, _, swhere in secs:
+        text, dwhere = m.section_thickness.get(swhere, ("", swhere))
+        if text:
+            try:
+                t = float(text.replace("d", "e").replace("D", "E"))
+            except ValueError:
+                raise DeckError(f"{dwhere}: *SOLID SECTION: the thickness must be a number, got {text!r}") from None
+            if not t > 0.0 and form != "axisymmetric":
+                raise DeckError(f"{dwhere}: *SOLID SECTION: the thickness must exceed zero, got {text}")
+            values[swhere] = t
+    out = {"formulation": form}
+    if form == "axisymmetric":
+        if values:
+            w.notes.append(f"{next(iter(values))}: *SOLID SECTION of {planar[0]} elements: the thickness has no effect "
+                           f"(an axisymmetric model spans the full circumference; CalculiX ignores it too)")
+        return out
+    thick = {values.get(swhere, 1.0) for _, _, swhere in secs}
+    if len(thick) > 1:
+        raise DeckError(f"{secs[1][2]}: body {name} has *SOLID SECTIONs of thicknesses "
+                        f"{', '.join(f'{t:g}' for t in sorted(thick))}: a planar body has one thickness")
+    out["thickness"] = thick.pop()
+    return out
+
+
+def _planar_bodies(w) -> dict[int, str]:
+    """The bodies of the import ``w`` made of planar elements: body -> the first deck type."""
+    if "_planar_bodies" not in w.__dict__:
+        out: dict[int, str] = {}
+        for j, (etype, _, _, _) in enumerate(w.m.blocks):
+            if etype in PLANAR_ELEMENTS:
+                for body in np.unique(w.b.of_element[w.b.block_range(j)]):
+                    out.setdefault(int(body), etype)
+        w._planar_bodies = out
+    return w._planar_bodies
+
+
+def planar_dof3(w, body: int, where: str, value: float | None, load: bool = False) -> bool:
+    """Whether dof 3 (z) of nodes of ``body`` is left out: a planar body's z is held at zero everywhere (CalculiX holds
+    the out-of-plane motion of its expanded 2D elements too), so a *BOUNDARY of z = 0 is what it is anyway; a nonzero
+    one is listed as unsupported, a *CLOAD along z (a reaction of the held dof) said in a note."""
+    etype = _planar_bodies(w).get(int(body))
+    if etype is None:
+        return False
+    if load:
+        w.notes.append(f"{where}: *CLOAD along dof 3 on nodes of {etype} elements: the out-of-plane direction is held; "
+                       f"the force is left out")
+    elif value:
+        w.unsupported.append(f"{where}: *BOUNDARY of {value:g} on dof 3 of nodes of {etype} elements: the out-of-plane "
+                             f"displacement of plane strain, plane stress and axisymmetric nodes is zero; with "
+                             f"--ignore-unsupported it is left out")
+    return True
+
+
+def planar_pair(w, bodies, where: str) -> None:
+    """One line (DeckError) for a contact pair or tie on planar elements (a deck's pairs are not mapped onto contact in
+    the plane yet)."""
+    for body in bodies:
+        etype = _planar_bodies(w).get(int(body))
+        if etype is not None:
+            raise DeckError(f"{where}: a contact pair or *TIE on {etype} elements (body {w.body_names[int(body)]}): "
+                            f"contact pairs of decks on planar elements are not mapped yet (a problem file's [[contact]] "
+                           f"takes node-to-segment pairs on planar bodies: docs/input.md)")
+
+
+def element_names(types) -> str:
+    """The element types a deck may have, as a message lists them: the planar ones grouped per formulation
+    ('C3D8, C3D8R, ..., CPE3/4/4R/6/8/8R, CPS3/..., CAX3/...')."""
+    plain = [t for t in types if t not in PLANAR_ELEMENTS]
+    groups = [p + "/".join(t[3:] for t in types if t in PLANAR_ELEMENTS and t.startswith(p)) for p in PLANAR_FORMULATION
+              if any(t.startswith(p) for t in types if t in PLANAR_ELEMENTS)]
+    return ", ".join(plain + groups)
