@@ -201,9 +201,10 @@ def test_cax8_thick_cylinder_against_lame(tmp_path):
     assert bd["formulation"] == "axisymmetric" and "thickness" not in bd
 
 
-#: CalculiX 2.21 (Debian's ccx) on the deck of test_cax4_point_loads_are_for_the_full_circumference with NLGEOM added
-#: to its *STEP: the .dat's displacements of nodes 1-4 and the forces of the bottom nodes 1, 2 (dof 2)
-_CCX_CAX4_U = {1: (-1.271813e-04, 0.0), 2: (-2.092580e-04, 0.0), 3: (-1.627888e-04, 2.526201e-04),
+#: produced by running CalculiX 2.20 (Debian's ccx, "ccx -i cax4") on the deck test_cax4_point_loads_are_for_the_full_
+#: circumference writes (its *STEP has NLGEOM): the .dat's displacements of nodes 1-4 at the step's end and the forces
+#: of the bottom nodes 1, 2 along dof 2
+_CCX_CAX4_U = {1: (-1.271068e-04, 0.0), 2: (-2.092580e-04, 0.0), 3: (-1.627888e-04, 2.526201e-04),
                4: (-7.142236e-05, 3.661376e-04)}
 _CCX_CAX4_RF = {1: -1.640335, 2: -1.692998}
 
