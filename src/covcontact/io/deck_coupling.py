@@ -61,6 +61,7 @@ _RULES = {
 #: the rule CalculiX integrates a face of each deck element type with (couplings.f: mint), per face node count
 _RULE = {"C3D8": "quad2", "C3D8I": "quad2", "C3D8R": "quad1", "C3D20R": "quad2", "C3D20": "quad3", "C3D10": "tri3",
          "C3D4": "tri1", "C3D6": {3: "tri1", 4: "quad1"}}
+_RULE.update({f"{t}H": _RULE[t] for t in ("C3D8", "C3D8R", "C3D20", "C3D20R", "C3D10", "C3D4", "C3D6")})
 
 
 def _shape(n: int, xi: float, eta: float) -> tuple[np.ndarray, np.ndarray]:

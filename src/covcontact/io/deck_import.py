@@ -217,6 +217,7 @@ class _Writer:
             if len({ELEMENTS[t][1].get("incompatible_modes", False) for t in types if ELEMENTS[t][0] == "hex8"}) > 1:
                 self.unsupported.append(f"{self.deck}: body {name} mixes C3D8I with C3D8 or C3D8R elements")
             options = {k: v for t in sorted(types) for k, v in ELEMENTS[t][1].items()}  # its element types' options
+            hybrid = self._hybrid(name, types, options)
             secs = [(s, mat, w) for s, mat, w in self.m.sections
                     if np.intersect1d(self.m.elsets.get(s, np.zeros(0, np.int64)), labels).size]
             for s, _, w in self.m.sections:
@@ -233,10 +234,40 @@ class _Writer:
             entries.update(planar_body(self, k, name, types, secs, labels))  # (CPE, CPS, CAX: deck_planar)
             if len(secs) > 1:
                 entries["materials"] = {_name(s): self._material(mat, w) for s, mat, w in secs[1:]}
+            if hybrid:
+                entries["formulation"] = "fbar"
             if options:
                 entries["options"] = options
             text += _table("[[bodies]]", entries)
         return text
+
+    def _hybrid(self, name: str, types: set, options: dict) -> bool:
+        """Whether body ``name`` (of deck element ``types``) is of hybrid elements, which become F-bar bodies (the
+        mixed u/p elements of the manuals have no counterpart; F-bar is covcontact's element without volumetric
+        locking, docs/theory.md), said in a note; ``options`` lose the flag. Mixing hybrid and other elements in a
+        body, and hybrid cells F-bar does not have, are listed as unsupported."""
+        from ..elements.fbar import FBAR_CELLS
+
+        flags = {ELEMENTS[t][1].get("hybrid", False) for t in types}
+        options.pop("hybrid", None)
+        if True not in flags:
+            return False
+        hyb = sorted(t for t in types if ELEMENTS[t][1].get("hybrid", False))
+        if len(flags) > 1:
+            self.unsupported.append(f"{self.deck}: body {name} mixes hybrid ({', '.join(hyb)}) with other elements "
+                                    f"({', '.join(sorted(set(types) - set(hyb)))}): give all of them one kind")
+            return False
+        cells = {ELEMENTS[t][0] for t in hyb}
+        if not cells <= set(FBAR_CELLS):
+            self.unsupported.append(f"{self.deck}: body {name}: {', '.join(hyb)} (hybrid): covcontact's element "
+                                    f"without volumetric locking (F-bar) has {', '.join(FBAR_CELLS)} cells only")
+            return False
+        if options.pop("integration", None) == "reduced":
+            pass  # (F-bar hex20 integrates on its 27 points)
+        self.notes.append(f"{self.deck}: body {name}: {', '.join(hyb)} (hybrid, mixed u/p in the manuals) become "
+                          f"F-bar elements (formulation = \"fbar\": the volume change of the element centre or its "
+                          f"projection; no volumetric locking; docs/theory.md)")
+        return True
 
     # -- sets per body --------------------------------------------------------------------------
     def _node_targets(self, name: str, labels: np.ndarray, where: str) -> list[tuple[int, str]]:

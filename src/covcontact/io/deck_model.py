@@ -26,7 +26,12 @@ from .deck_springs import BEAMS, SPRING_CARDS, SPRING_ELEMENTS, read_spring_card
 ELEMENTS = {"C3D8": ("hex8", {}), "C3D8R": ("hex8", {}), "C3D20": ("hex20", {}),
             "C3D8I": ("hex8", {"incompatible_modes": True}),
             "C3D20R": ("hex20", {"integration": "reduced"}), "C3D10": ("tet10", {}), "C3D4": ("tet4", {}),
-            "C3D6": ("wedge6", {})}
+            "C3D6": ("wedge6", {}),
+            # hybrid elements (nearly incompressible materials): covcontact's F-bar (deck_import, a note)
+            "C3D8H": ("hex8", {"hybrid": True}), "C3D8RH": ("hex8", {"hybrid": True}),
+            "C3D20H": ("hex20", {"hybrid": True}), "C3D20RH": ("hex20", {"hybrid": True}),
+            "C3D10H": ("tet10", {"hybrid": True}), "C3D4H": ("tet4", {"hybrid": True}),
+            "C3D6H": ("wedge6", {"hybrid": True})}
 #: nodes per cell (the deck's node order is covcontact's, VTK's, for every one of these cells)
 NNODE = {"hex8": 8, "hex20": 20, "tet10": 10, "tet4": 4, "wedge6": 6}
 #: faces per cell (S1..Sn, P1..Pn)
