@@ -4,13 +4,15 @@ pinned edge against a clamp, an SPOS contact surface, and the refusals (one line
 
 from __future__ import annotations
 
-import subprocess
-import sys
+import contextlib
+import io
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from covcontact.cli import main
 from covcontact.io.deck import DeckError
 from covcontact.io.deck_import import import_deck
 from covcontact.io.loader import load_problem
@@ -65,11 +67,19 @@ def plate_deck(kind="S4", nx=10, ny=4, L=10.0, B=8.0, t=0.1, P=1e-4, fix="1, 6",
     return "\n".join(x for x in lines if x) + "\n"
 
 
-def _run_deck(tmp_path: Path, text: str, name: str = "p") -> tuple[Path, subprocess.CompletedProcess]:
+def _cli(args: list[str]) -> SimpleNamespace:
+    """``covcontact ARGS`` in this process (a subprocess would pay the interpreter's and the kernels' start each
+    time): its exit code and what it wrote to standard error."""
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = main([str(a) for a in args])
+    return SimpleNamespace(returncode=code, stderr=err.getvalue())
+
+
+def _run_deck(tmp_path: Path, text: str, name: str = "p") -> tuple[Path, SimpleNamespace]:
     deck = tmp_path / f"{name}.inp"
     deck.write_text(text)
-    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / name),
-                           "--quiet"], capture_output=True, text=True, timeout=600)
+    proc = _cli(["run", deck, "--out", tmp_path / name, "--quiet"])
     return tmp_path / name / f"{name}.dat", proc
 
 
@@ -265,8 +275,7 @@ def test_refusals_are_one_line_exit_2(tmp_path, change, message):
         text = text.replace("*ELEMENT, TYPE=S6, ELSET=PLATE\n1, 1, 2, 5, 4\n2, 2, 3, 6, 5",
                             "*ELEMENT, TYPE=S6, ELSET=PLATE\n1, 1, 3, 6, 2, 5, 4")
     deck = _write(tmp_path / "bad.inp", text)
-    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(deck), "--out", str(tmp_path / "o"),
-                           "--quiet"], capture_output=True, text=True, timeout=600)
+    proc = _cli(["run", deck, "--out", tmp_path / "o", "--quiet"])
     assert proc.returncode == 2, proc.stderr
     lines = [ln for ln in proc.stderr.splitlines() if ln.strip() and "note:" not in ln]
     assert len(lines) == 1 and message in lines[0], proc.stderr
