@@ -111,6 +111,11 @@ def cell_masses(body, cell_type: str, cells: np.ndarray, density: float) -> np.n
 
 def _element_body(body, material, cell_type: str, cells: np.ndarray):
     """The element body of ``body``'s formulation over ``cells`` of ``cell_type`` with ``material``."""
+    if is_planar(body) and body.options.get("fbar"):
+        from ..elements.planar_fbar import PlanarFbarBody
+
+        return PlanarFbarBody(cell_type, body.mesh.points, cells, material, body.formulation,
+                              float(body.options.get("thickness", 1.0)))
     if is_planar(body):
         from ..elements.planar import PlanarBody
 

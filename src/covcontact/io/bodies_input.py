@@ -553,10 +553,25 @@ def read_bodies(top: Section, base: Path) -> list[Body]:
         elif formulation in PLANAR_FORMULATIONS:
             from ..fem.planar_cells import REDUCED_CELLS
 
-            unknown = sorted(set(options) - {"integration"})
+            unknown = sorted(set(options) - {"integration", "fbar"})
             if unknown:
-                b.fail(f"unknown option {unknown[0]!r} for formulation = \"{formulation}\" (known: integration)",
-                       "options")
+                b.fail(f"unknown option {unknown[0]!r} for formulation = \"{formulation}\" (known: integration, "
+                       f"fbar)", "options")
+            fbar = options.get("fbar", False)
+            if not isinstance(fbar, bool):
+                b.fail(f"fbar must be true or false, got {fbar!r}", "options")
+            if fbar:
+                from ..elements.planar_fbar import PLANAR_FBAR_CELLS
+
+                if formulation == "plane_stress":
+                    b.fail(f"body {bname!r}: fbar = true is for plane_strain and axisymmetric bodies (plane stress "
+                           f"has no volume constraint to relieve: leave it out)", "options")
+                bad = [t for t in mesh.cell_types if t not in PLANAR_FBAR_CELLS]
+                if bad:
+                    b.fail(f"body {bname!r}: fbar = true needs {', '.join(PLANAR_FBAR_CELLS)} cells, got "
+                           f"{' and '.join(bad)} (tri3 has one point: nothing to relieve)", "options")
+                if options.get("integration", "full") != "full":
+                    b.fail(f"body {bname!r}: fbar = true takes full integration; leave out integration", "options")
             if options.get("integration", "full") not in ("full", "reduced"):
                 b.fail(f"integration must be \"full\" or \"reduced\", got {options['integration']!r}", "options")
             if options.get("integration") == "reduced" and any(t not in REDUCED_CELLS for t in mesh.cell_types):
