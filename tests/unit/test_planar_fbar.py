@@ -4,6 +4,8 @@ meshes, exact; axisymmetric radial expansion, exact), F_bar = F for a homogeneou
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from test_planar import (
@@ -167,3 +169,26 @@ def test_bad_input_one_line(tmp_path, body, expect):
     assert proc.returncode == 2, proc.stdout + proc.stderr
     lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and expect in lines[0], proc.stderr
+
+
+@pytest.mark.parametrize("cell", ["quad4", "quad8", "quad9", "tri6"])
+def test_disc_generator(cell):
+    """The O-grid disc: counter-clockwise cells, the circle's nodes (mid-nodes included) on the circle, the area
+    of the polygon close to pi a^2, no duplicate nodes, the named sets."""
+    from covcontact.fem.planar_cells import reference_jacobians
+    from covcontact.mesh.generators_planar import disc
+
+    a, c = 2.5, np.array([20.0, 1.0])
+    m = disc(a, 6, 3, cell=cell, center=c, bias=0.8)
+    X = m.points
+    assert np.all(reference_jacobians(cell, X, m.cells) > 0.0)
+    o = m.node_sets["outer"]
+    assert np.abs(np.hypot(*(X[o, :2] - c).T) - a).max() < 1e-12
+    assert len(m.face_set("outer")) == 24
+    assert len(np.unique(np.round(X[:, :2], 9), axis=0)) == m.n_nodes
+    assert np.unique(m.cells).size == m.n_nodes
+    area = reference_jacobians(cell, X, m.cells).sum() * (4.0 if cell.startswith("quad") else 0.5) / \
+        (reference_jacobians(cell, X, m.cells).shape[1])
+    assert area == pytest.approx(math.pi * a**2, rel=0.03)
+    assert set(m.node_sets) >= {"all", "core", "outer", "top", "bottom", "left", "right"}
+    assert np.all(X[m.node_sets["top"], 1] >= c[1] - 1e-12)

@@ -1,5 +1,5 @@
-"""Structured planar meshes (x-y plane) for plane strain, plane stress and axisymmetric bodies: a rectangle and an
-annulus sector, of quad4, quad8, quad9, tri3 or tri6 cells, with named node and edge sets.
+"""Structured planar meshes (x-y plane) for plane strain, plane stress and axisymmetric bodies: a rectangle, an
+annulus sector and a full disc (an O-grid), of quad4, quad8, quad9, tri3 or tri6 cells, with named node and edge sets.
 
 A structured lattice of parameters u in [0, 1]^2 (with mid-nodes at the parameter midpoints for the quadratic
 cells) is mapped through the exact geometry, so the mid-nodes of an annulus lie on its circles. Triangles split each
@@ -162,5 +162,80 @@ def annulus(r_inner: float, r_outer: float, nr: int, nt: int, angle: float = 90.
     return _build(cell, U, cells, place, sets)
 
 
-for _fn in (rectangle, annulus):
+def disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Sequence[float] = (0.0, 0.0),
+         core: float = 0.5, bias: float = 1.0) -> Mesh:
+    """A full disc of ``radius`` about ``center`` in the x-y plane by an O-grid: a square core of n x n cells (half
+    side ``core`` times the radius) and four blocks of nr x n cells between its sides and the circle (nr across,
+    sizes changing outward by the ratio ``bias``: below 1 refines toward the circle). Mid-nodes lie on the exact
+    geometry (those of the circle on it). An axisymmetric O-ring section is a disc with center = (mean radius, 0).
+
+    Sets: node and edge set "outer" (the circle); node sets "all", "core" (the square), "top", "bottom", "left",
+    "right" (the nodes of the circle with y - cy >= 0, <= 0, x - cx <= 0, >= 0) with their edge sets.
+    """
+    _check(cell)
+    a = _positive("radius", radius)
+    n = _count("n", n)
+    nr = _count("nr", nr)
+    s = _positive("core", core) * a
+    if not 0.0 < core < 0.9:
+        raise ValueError(f"core must lie in (0, 0.9), got {core!r}")
+    c = np.asarray(center, dtype=float).reshape(-1)[:2]
+    pts, cls, outer = [], [], []
+    offset = 0
+    # the core
+    U, cells = _lattice(cell, n, n)
+    pts.append(-s + 2.0 * s * U)
+    cls.append(cells)
+    outer.append(np.zeros(len(U), dtype=bool))
+    offset += len(U)
+    for k in range(4):  # east, north, west, south: u0 outward, u1 counter-clockwise
+        U, cells = _lattice(cell, nr, n, _positive("bias", bias))
+        t = U[:, 1]
+        inner = np.column_stack([np.full(len(U), s), -s + 2.0 * s * t])
+        th = math.pi / 2.0 * (t - 0.5)
+        out = a * np.column_stack([np.cos(th), np.sin(th)])
+        xy = (1.0 - U[:, [0]]) * inner + U[:, [0]] * out
+        ck, sk = math.cos(k * math.pi / 2.0), math.sin(k * math.pi / 2.0)
+        xy = xy @ np.array([[ck, sk], [-sk, ck]])
+        pts.append(xy)
+        cls.append(cells + offset)
+        outer.append(U[:, 0] == 1.0)
+        offset += len(U)
+    xy = np.concatenate(pts)
+    cells = np.concatenate(cls)
+    on_circle = np.concatenate(outer)
+    # merge the nodes the blocks share (equal coordinates up to round-off)
+    key = np.round(xy / (a * 1e-9)).astype(np.int64)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.ravel()
+    cells = inverse[cells]
+    xy = xy[first]
+    circle = np.zeros(len(first), dtype=bool)
+    circle[inverse[on_circle]] = True
+    used = np.unique(cells)
+    new = np.full(len(first), -1, dtype=np.int64)
+    new[used] = np.arange(used.size)
+    xy = xy[used]
+    circle = circle[used]
+    X = np.column_stack([c + xy, np.zeros(len(used))])
+    mesh = Mesh(X, cell, new[cells])
+    faces, _, _ = boundary_faces(mesh)
+    tol = 1e-9 * a
+    sets = {"all": np.ones(len(used), dtype=bool), "core": np.all(np.abs(xy) <= s + tol, axis=1), "outer": circle,
+            "top": circle & (xy[:, 1] >= -tol), "bottom": circle & (xy[:, 1] <= tol),
+            "left": circle & (xy[:, 0] <= tol), "right": circle & (xy[:, 0] >= -tol)}
+    for name, mask in sets.items():
+        nodes = np.flatnonzero(mask)
+        mesh.add_node_set(name, nodes)
+        if name in ("all", "core"):
+            continue
+        on = np.zeros(mesh.n_nodes, dtype=bool)
+        on[nodes] = True
+        f = faces[np.all(on[faces], axis=1)]
+        if len(f):
+            mesh.add_face_set(name, f)
+    return mesh
+
+
+for _fn in (rectangle, annulus, disc):
     _fn.planar = True
