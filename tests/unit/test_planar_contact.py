@@ -421,7 +421,3 @@ def test_bad_planar_pairs(tmp_path):
     path.write_text(text)
     with pytest.raises(Exception, match="node-to-segment"):
         load_problem(path)
-    text = blocks("plane_strain", "quad4", 4, 0.0, "").replace('weighting = "area"\n', 'weighting = "area"\nfriction = 0.2\n')
-    path.write_text(text)
-    with pytest.raises(Exception, match="friction against the edges"):
-        load_problem(path)

@@ -145,3 +145,117 @@ def test_history_across_segments():
     # a new slave sticks at its projection
     h = start_history(s2, np.array([2.0, -0.01, 0.0]), 0.0, EPS_T)
     assert h[H_XI] == pytest.approx(0.0, abs=1e-14) and h[H_T] == 0.0 and h[H_FLAG] == 1.0
+
+
+# -- problems ------------------------------------------------------------------------------------------------------
+def run(tmp_path, name: str, text: str):
+    path = tmp_path / f"{name}.toml"
+    path.write_text(textwrap.dedent(text))
+    res = load_problem(path).run(out=tmp_path / name)
+    assert res.exit_code == 0
+    return res
+
+
+def block_text(cell: str, load: str) -> str:
+    return f"""
+[problem]
+name = "slide"
+[[bodies]]
+name = "low"
+formulation = "plane_strain"
+element = "{cell}"
+mesh = {{ generator = "rectangle", lx = 2.0, ly = 0.5, nx = 8, ny = 2, origin = [0.0, 0.0] }}
+material = {{ model = "neo-hooke", E = 1000.0, nu = 0.3 }}
+[[bodies]]
+name = "up"
+formulation = "plane_strain"
+element = "{cell}"
+mesh = {{ generator = "rectangle", lx = 0.5, ly = 0.25, nx = 3, ny = 2, origin = [0.75, 0.5] }}
+material = {{ model = "neo-hooke", E = 1000.0, nu = 0.3 }}
+[[dirichlet]]
+set = "low.ymin"
+components = "xy"
+value = 0.0
+[[pressure]]
+set = "up.ymax"
+value = 1.0
+[[contact]]
+name = "c"
+slave = "up.ymin"
+master = "low.ymax"
+penalty = 1e5
+weighting = "area"
+friction = {MU}
+[steps]
+factors = [0.25, 0.5, 0.75, 1.0]
+""" + load
+
+
+SLIDE = """
+[[dirichlet]]
+set = "up.ymax"
+components = "x"
+value = 0.02
+"""
+
+
+def push(F: float) -> str:
+    return f"""
+[[traction]]
+set = "up.xmin"
+value = [{F / 0.25}, 0.0, 0.0]
+"""
+
+
+def local_forces(res):
+    """Per active slave of the run's first pass: (normal, tangential) components of its contact force in the frame of
+    its master segment at its contact point (current configuration), and the friction states."""
+    st, p = res.state.contact.passes[0], res.model.contact.passes[0]
+    x = res.model.system.X + np.asarray(res.u).reshape(-1, 3)
+    on = np.flatnonzero(np.isfinite(st.gap) & (np.abs(st.force).sum(axis=1) > 0))
+    fn, ft = [], []
+    for s in on:
+        _, r, _ = segment_point(np.ascontiguousarray(x[p.curve.segments[st.facet[s]]]), float(st.xi[s, 0]))
+        t = r / np.linalg.norm(r)
+        fn.append(st.force[s, 0] * t[1] - st.force[s, 1] * t[0])
+        ft.append(st.force[s, :2] @ t)
+    # the slip: the reference distance between a slave and the master's material point under it
+    X = res.model.system.X
+    slip = [abs(segment_point(np.ascontiguousarray(X[p.curve.segments[st.facet[s]]]), float(st.xi[s, 0]))[0][0]
+                - X[p.slaves[s], 0]) for s in on]
+    return np.array(fn), np.array(ft), st.status[on], st.force[on], np.array(slip)
+
+
+@pytest.mark.parametrize("cell", ["quad4", "quad8"])
+def test_block_sliding_on_an_edge(tmp_path, cell):
+    """A block (0.5 x 0.25, plane strain) pressed onto a planar body's edge by a pressure (N = 0.5 per unit
+    thickness) and dragged along it by its top (0.02, far beyond the stick limit): every slave slips, its tangential
+    force mu times its normal force in the frame of its master segment (to round-off on linear segments, 2e-7 on
+    quadratic ones: the residual's O(g) terms, where a varies along the segment), the block's friction force
+    mu N to the tilt of the deformed master's segments (3e-4); pushed sideways by a traction F = 0.05 < mu N = 0.15
+    instead, the block rests (its slaves stick but those at its ends, where the pressure
+    falls off) and the friction force is F (non-matching edges: 3 cells on 8). ``force``: the
+    contact force on the slave."""
+    res = run(tmp_path, f"slide_{cell}", block_text(cell, SLIDE))
+    fn, ft, status, f, slip = local_forces(res)
+    N, Ft = f[:, 1].sum(), f[:, 0].sum()
+    assert slip.min() > 0.9 * 0.02
+    print(f"slide {cell}: N = {N:.6f}, Ft / (mu N) = {Ft / (MU * N):.8f}, states {np.bincount(status)}, "
+          f"local |ft| / (mu fn) - 1 <= {np.abs(np.abs(ft) / (MU * fn) - 1).max():.1e}")
+    assert N == pytest.approx(0.5, rel=1e-3)
+    assert np.all(status == SLIP)
+    np.testing.assert_allclose(np.abs(ft), MU * fn, rtol=1e-9 if cell == "quad4" else 1e-6)
+    assert np.all(np.sign(ft) == np.sign(ft[0]))
+    assert -Ft == pytest.approx(MU * N, rel=1e-3)  # against the block's motion (+x)
+    res = run(tmp_path, f"stick_{cell}", block_text(cell, push(0.05)))
+    fn, ft, status, f, slip = local_forces(res)
+    N, Ft = f[:, 1].sum(), f[:, 0].sum()
+    print(f"stick {cell}: N = {N:.6f}, Ft = {Ft:.8f}, states {np.bincount(status)}, "
+          f"|ft| / (mu fn) {np.round(np.abs(ft / (MU * fn)), 3)}, "
+          f"slip {slip.max():.1e}")
+    # the slaves inside the contact stick; the outer ones, where the pressure falls off, may slip a little: the block
+    # rests (the lateral expansions of the two bodies differ)
+    assert np.all(status[1:-1] == STICK) and np.all(np.abs(ft[1:-1]) < MU * fn[1:-1])
+    assert slip[1:-1].max() < 1e-3 * 0.02 and slip.max() < 5e-3 * 0.02
+    assert -Ft == pytest.approx(0.05, rel=1e-6)
+    assert N == pytest.approx(0.5, rel=1e-3)

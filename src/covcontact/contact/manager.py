@@ -166,7 +166,8 @@ class ContactManager:
             if p.tied:
                 self._tied_pass(p, xe, t, want_K, want_parts, ev)
             elif p.curve is not None:  # node-to-segment contact in the plane
-                segment_pass(self, p, xe, pcase, t, want_K, want_parts, ev)
+                segment_pass(self, p, xe, pcase, t, want_K, want_parts, ev, c, g0,
+                             self._x_start if committed.x is None else committed.x)
             elif p.surface is not None:
                 self._mesh_pass(k, p, xe, pcase, c, g0, t, committed.x, want_K, want_parts, ev)
             else:

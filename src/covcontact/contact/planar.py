@@ -239,12 +239,14 @@ class Curve:
 FACET, VERTEX = 1, 2
 
 
-def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float):
+def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, keep: np.ndarray | None = None,
+                   keep_band: float = 0.0):
     """Closest points of slaves xs (ns, 3) on the curve at positions xe: per slave (kind 0 none, FACET on a segment,
     VERTEX at a vertex; segment (the vertex's first segment for VERTEX); xi (the vertex's xi there); g; vertex node
     id (-1); sign). Candidates: the segments with a corner within ``reach`` (a segment length or more) of the slave;
     among the projections inside their segment the one of smallest |g|; none inside: the nearest corner shared by
-    two segments."""
+    two segments. ``keep`` (frictional passes): per slave the segment of the last iterate (-1 none), kept while the
+    projection on it lies within ``keep_band`` of it (xi not clipped)."""
     from scipy.spatial import cKDTree
 
     ns = len(xs)
@@ -261,6 +263,12 @@ def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float):
     for i in range(ns):
         if not near[i]:
             continue
+        if keep is not None and keep[i] >= 0:
+            xseg = np.ascontiguousarray(xe[curve.segments[keep[i]]])
+            z, gap, ok = project_on_segment(xseg, xs[i], 0.0)
+            if ok and abs(z) <= 1.0 + keep_band:
+                kind[i], seg[i], xi[i], g[i] = FACET, keep[i], z, gap
+                continue
         cand = sorted({s for k in near[i] for s in curve.vertex_segments[int(nodes[k])]})
         best = np.inf
         for s in cand:
@@ -363,9 +371,6 @@ def check_pair(pair, bodies, rigid) -> str | None:
         if rb.shape == "cylinder" and sb.formulation == "axisymmetric":
             return (f"{name}: a rigid circle in an axisymmetric model is a torus, not available; an axisymmetric "
                     f"pair takes a rigid line")
-    elif pair.friction:
-        return (f"{name}: friction against the edges of a planar body is not available yet (frictionless, or a rigid "
-                f"line or circle)")
     return None
 
 
@@ -428,16 +433,23 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
 
 
 # -- the pass -------------------------------------------------------------------------------------------------------
-def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_parts: bool, ev) -> None:
+def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_parts: bool, ev, c=None, g0=None,
+                 x_commit=None) -> None:
     """Evaluate the node-to-segment pass ``p`` (its ``curve``) at extended positions xe into ``ev`` (element blocks,
-    the parts) and the trial pass state ``t`` (facet: the segment, xi, gap, force)."""
+    the parts) and the trial pass state ``t`` (facet: the segment, xi, gap, force). A frictional pass (p.mu > 0)
+    reads the committed pass state ``c`` (its friction history, on the segments ``c.hist_facet``) and the
+    configuration ``x_commit`` of the last commit, keeps the segment of the last iterate ``g0`` up to KEEP_BAND
+    outside it, and writes the history to commit and the friction state into ``t`` (:mod:`.planar_friction`);
+    the committed state is only read."""
     from .laws import is_active, linear_equivalents
 
     curve: Curve = p.curve
     xs = xe[p.slaves]
     lengths = np.linalg.norm(xe[curve.segments[:, 1], :2] - xe[curve.segments[:, 0], :2], axis=1)
     reach = 1.5 * float(lengths.max()) if len(lengths) else 0.0
-    kind, seg, xi, g, vert, sign = closest_points(curve, xe, xs, reach)
+    friction = p.mu > 0.0 and c is not None
+    keep = g0.facet if friction and g0 is not None else None
+    kind, seg, xi, g, vert, sign = closest_points(curve, xe, xs, reach, keep, KEEP_BAND)
     ok = kind != 0
     t.facet = np.where(ok, seg, -1).astype(np.int64)
     t.xi = np.column_stack([np.where(ok, xi, 0.0), np.zeros(len(xi))])
@@ -457,9 +469,20 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
         K = np.zeros((idx.size, nd, nd))
         P = np.zeros((idx.size, 4, nd, nd)) if want_parts else np.zeros((1, 4, nd, nd))
         for j, s in enumerate(idx):
-            t.gap[s] = segment_core(np.ascontiguousarray(xe[conn[j, :nen]]), np.ascontiguousarray(xs[s]),
-                                    float(xi[s]), float(eps_s[s]), float(lam_s[s]), case, want_parts, R[j], K[j],
-                                    P[j] if want_parts else P[0])
+            xseg = np.ascontiguousarray(xe[conn[j, :nen]])
+            if friction:
+                from .planar_friction import segment_friction_core
+
+                hist = _segment_history(p, c, s, int(seg[s]), float(xi[s]), x_commit)
+                t.gap[s], t.status[s] = segment_friction_core(
+                    xseg, np.ascontiguousarray(xs[s]), float(xi[s]), float(eps_s[s]), float(p.eps_t[s]), float(p.mu),
+                    float(lam_s[s]), hist, R[j], K[j], t.hist[s])
+                if want_parts:
+                    segment_core(xseg, np.ascontiguousarray(xs[s]), float(xi[s]), float(eps_s[s]), float(lam_s[s]),
+                                 case, True, np.zeros(nd), np.zeros((nd, nd)), P[j])
+                continue
+            t.gap[s] = segment_core(xseg, np.ascontiguousarray(xs[s]), float(xi[s]), float(eps_s[s]),
+                                    float(lam_s[s]), case, want_parts, R[j], K[j], P[j] if want_parts else P[0])
         t.force[idx] = -R[:, -3:]
         manager._add(ev.blocks, conn, R, K if want_K else None, xe)
         if want_parts:
@@ -474,9 +497,42 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
             t.gap[s] = vertex_core(np.ascontiguousarray(xe[vert[s]]), np.ascontiguousarray(xs[s]), float(sign[s]),
                                    float(eps_s[s]), float(lam_s[s]), R[j], K[j])
         t.force[idx] = -R[:, -3:]
+        if friction:  # frictionless at a vertex; the committed history is carried through unchanged
+            t.hist[idx] = c.hist[idx]
+            t.hist_facet[idx] = c.hist_facet[idx]
+            t.status[idx] = SLIP_AT_VERTEX
         manager._add(ev.blocks, conn, R, K if want_K else None, xe)
         if want_parts:
             ev.parts[0].add(conn, np.zeros_like(R), K)
+
+
+#: frictional passes: how far outside its segment of the last Newton iterate (in xi) a slave keeps it (a slave
+#: resting on the node between two segments would otherwise cycle between them, its history moving each time)
+KEEP_BAND = 0.02
+#: the friction state of a slave at a vertex (frictionless there)
+SLIP_AT_VERTEX = 2
+
+
+def _segment_history(p, c, s: int, segment: int, xi: float, x_commit) -> np.ndarray:
+    """The committed friction history of slave ``s`` on ``segment``: moved there from its committed segment
+    (:func:`.planar_friction.transfer_history`), or started at its projection in the committed configuration for a
+    slave new to contact (:func:`.planar_friction.start_history`); none (frictionless: NEW) without a committed
+    configuration."""
+    from .planar_friction import start_history, transfer_history
+
+    hist = c.hist[s]
+    if x_commit is None:
+        return hist.copy() if hist[-1] > 0.0 and c.hist_facet[s] == segment else np.zeros_like(hist)
+    xseg = np.ascontiguousarray(x_commit[p.curve.segments[segment]])
+    eps_t = float(p.eps_t[s])
+    if hist[-1] == 0.0:
+        return start_history(xseg, x_commit[p.slaves[s]], xi, eps_t)
+    if c.hist_facet[s] == segment:
+        return hist.copy()
+    try:
+        return transfer_history(hist, xseg, xi, eps_t)
+    except ValueError:
+        return np.zeros_like(hist)
 
 
 __all__ = ["CASE_A", "CASE_B", "CASE_C", "CASE_D", "CASE_EXACT", "Curve", "closest_points", "project_on_segment",
