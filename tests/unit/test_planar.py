@@ -261,9 +261,9 @@ def _run(tmp_path, body: str, extra: str = "") -> subprocess.CompletedProcess:
     ('formulation = "plane_stress"\nelement = "quad4"\noptions = { integration = "reduced" }\n'
      'mesh = { generator = "rectangle", lx = 1, ly = 1, nx = 1, ny = 1 }', "", "reduced\" is for quad8"),
     ('formulation = "plane_strain"\nmesh = { generator = "rectangle", lx = 1, ly = 1, nx = 2, ny = 2 }',
-     '[[rigid]]\nname = "floor"\nshape = "plane"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 1.0, 0.0]\n'
-     '[[contact]]\nname = "c"\nslave = "disc.ymin"\nmaster = "floor"\npenalty = 1000.0',
-     "body 'disc' is a planar (plane_strain) body"),
+     '[[rigid]]\nname = "ball"\nshape = "sphere"\ncenter = [0.5, 2.0, 0.0]\nradius = 1.0\n'
+     '[[contact]]\nname = "c"\nslave = "disc.ymax"\nmaster = "ball"\npenalty = 1000.0',
+     "the rigid master 'ball' of a planar pair must be an analytic line"),
 ])
 def test_bad_input_one_line(tmp_path, body, extra, expect):
     proc = _run(tmp_path, body, extra)
