@@ -244,15 +244,10 @@ _TAIL = ("*MATERIAL, NAME=STEEL\n*ELASTIC\n210000., 0.3\n*SOLID SECTION, ELSET=E
      r"d\.inp:8: node 1 of the CAX4 elements has x = -0\.5: x is the radius"),
     ("*ELEMENT, TYPE=CPS4, ELSET=EALL\n1, 1, 2, 3, 4\n", "*NODE\n3, 1., 1., 0.25\n",
      r"d\.inp:8: node 3 of the CPS4 elements has z = 0\.25: .* lie in the x-y plane"),
-    ("*ELEMENT, TYPE=CPE4, ELSET=EALL\n1, 1, 2, 3, 4\n*ELEMENT, TYPE=CPE4, ELSET=E2\n2, 5, 6, 3, 2\n"
-     "*ELSET, ELSET=EALL\nE2\n*SURFACE, NAME=SA\n1, S2\n*SURFACE, NAME=SB\n2, S4\n*SURFACE INTERACTION, NAME=I\n"
-     "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=HARD\n*CONTACT PAIR, INTERACTION=I\nSA, SB\n", "",
-     r"d\.inp:\d+: a contact pair or \*TIE on CPE4 elements \(body \w+\): contact pairs of decks on planar "
-     r"elements are not mapped yet"),
 ])
 def test_planar_refusals_are_one_line(tmp_path, elements, tail, message):
-    """Two formulations in one body, a clockwise element, a negative radius, a node off the x-y plane, a contact pair
-    on planar elements: one line naming the deck line, exit 2."""
+    """Two formulations in one body, a clockwise element, a negative radius, a node off the x-y plane: one line naming
+    the deck line, exit 2 (contact pairs: test_deck_planar_contact.py)."""
     deck = tmp_path / "d.inp"
     nodes = _QUAD
     if tail:  # (a node moved: its line replaced)

@@ -22,7 +22,7 @@ from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 from .deck_coupling import DeckCouplings
-from .deck_planar import element_names, planar_body, planar_dof3, planar_pair
+from .deck_planar import element_names, planar_body, planar_contact, planar_dof3
 from .deck_rigid import DeckRigid
 from .deck_shells import DeckShells
 from .deck_springs import DeckSprings
@@ -624,6 +624,7 @@ class _Writer:
     # -- contact ------------------------------------------------------------------------------------
     def _contacts(self) -> str:
         text = ""
+        self._plane_pairs: set[str] = set()  # (pairs on planar elements: node-to-segment contact in the plane)
         pairs = list(self.m.pairs) + [("*TIE", "TIE", slave, master, where) for _, slave, master, _, where in self.m.ties]
         ties = {where: tol for _, _, _, tol, where in self.m.ties}
         for k, (inter, kind, slave, master, where) in enumerate(pairs):
@@ -657,8 +658,14 @@ class _Writer:
             else:
                 sb = self._surface_body(slave, sref, where)
                 sname = _name(slave)
-            planar_pair(self, (sb, mb), where)  # (contact in the plane: deck_planar)
             entry: dict = {"name": f"pair{k + 1}", "slave": self._ref(sb, sname), "master": self._ref(mb, _name(master))}
+            plane = planar_contact(self, sb, mb, kind, sk, it, where)  # (contact in the plane: deck_planar)
+            if plane is False:
+                continue
+            if plane is not None:  # (node-to-segment: the .dat tabulates its slave nodes)
+                text += _table("[[contact]]", entry | plane)
+                self._plane_pairs.add(entry["name"])
+                continue
             if sts:
                 entry["type"] = "sts"
             else:  # faces: per tributary area; a node surface: per the node's area over its body's boundary faces
@@ -930,7 +937,7 @@ class _Writer:
         out = {}
         for k, (_, kind, slave, _, _) in enumerate(self.m.pairs):
             sts = kind == "SURFACE TO SURFACE" and self.m.surfaces[slave][0] == "ELEMENT"
-            out[f"pair{k + 1}"] = slave if sts else "node"
+            out[f"pair{k + 1}"] = slave if sts and f"pair{k + 1}" not in getattr(self, "_plane_pairs", ()) else "node"
         return out
 
     def _surface_faces(self, section_prints: list) -> dict[str, list[list[int]]]:

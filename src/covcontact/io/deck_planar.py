@@ -149,15 +149,83 @@ def planar_dof3(w, body: int, where: str, value: float | None, load: bool = Fals
     return True
 
 
-def planar_pair(w, bodies, where: str) -> None:
-    """One line (DeckError) for a contact pair or tie on planar elements (a deck's pairs are not mapped onto contact in
-    the plane yet)."""
-    for body in bodies:
-        etype = _planar_bodies(w).get(int(body))
-        if etype is not None:
-            raise DeckError(f"{where}: a contact pair or *TIE on {etype} elements (body {w.body_names[int(body)]}): "
-                            f"contact pairs of decks on planar elements are not mapped yet (a problem file's [[contact]] "
-                           f"takes node-to-segment pairs on planar bodies: docs/input.md)")
+def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> dict | bool | None:
+    """A deck's contact pair (or *TIE, ``kind`` "TIE") between the bodies ``sb`` (slave; ``sk`` "ELEMENT" or "NODE"
+    its surface's kind) and ``mb`` as node-to-segment contact in the plane (docs/input.md, "Contact pairs on planar
+    bodies"): None when neither body is planar (the 3D mapping goes on), False when the pair is left out (listed as
+    unsupported), else the keys of the [[contact]] entry besides its name, slave and master.
+
+    The laws keep CalculiX's meaning. CalculiX expands a planar element into one layer of 3D elements (the section's
+    thickness; an axisymmetric one into a 2 degree segment), so a penalty K per area of an expanded face is K per unit
+    length of the edge times the thickness (2 pi R over the full circumference, of which the .dat prints 1/180): the
+    planar pair's ``weighting = "area"`` (eps = K int N_a t ds, t the thickness or 2 pi R) is that same law, the
+    forces totals as the body's. Mapped: PRESSURE-OVERCLOSURE=HARD on NODE TO SURFACE pairs of element surfaces
+    (augmented Lagrange with the automatic penalty 10 E / h per area, as the 3D import). Listed as unsupported
+    (CalculiX has them, contact in the plane does not): face-to-face contact (with --ignore-unsupported the pair is
+    node-to-segment with the same law: CalculiX integrates K g over the slave faces, here K g at the slave nodes over
+    their tributary edges; LINEAR there is the plain penalty K per area, HARD as above), the node-to-face LINEAR law
+    (arctan with its tension; with the flag the linear penalty K per area), a node surface (TYPE=NODE) as the slave,
+    EXPONENTIAL, TABULAR, TIED and *TIE, a pair between planar and 3D elements or between two planar
+    formulations (left out with the flag), friction on a body's edges and ADJUST (left out with the flag)."""
+    kinds = {b: _planar_bodies(w).get(int(b)) for b in (sb, mb)}
+    if kinds[sb] is None and kinds[mb] is None:
+        return None
+    name = {b: w.body_names[int(b)] for b in (sb, mb)}
+    types = [kinds[b] for b in (sb, mb)]
+    what = "*TIE" if kind == "TIE" else "*CONTACT PAIR"
+    flag = "with --ignore-unsupported the pair is left out"
+    if None in types:
+        solid = sb if kinds[sb] is None else mb
+        planar = mb if solid == sb else sb
+        w.unsupported.append(f"{where}: {what} between planar {kinds[planar]} elements (body {name[planar]}) and 3D "
+                             f"elements (body {name[solid]}): contact in the plane joins planar bodies only; {flag}")
+        return False
+    forms = [formulation_of(t) for t in types]
+    if forms[0] != forms[1]:
+        w.unsupported.append(f"{where}: {what} between {types[0]} ({forms[0]}, body {name[sb]}) and {types[1]} "
+                             f"({forms[1]}, body {name[mb]}) elements: contact in the plane joins bodies of one "
+                             f"formulation; {flag}")
+        return False
+    etype = types[0]
+    if kind == "TIE" or it.behavior == "tied":
+        w.unsupported.append(f"{where}: {what if kind == 'TIE' else 'PRESSURE-OVERCLOSURE=TIED'} on {etype} elements: "
+                             f"tied pairs are not available in the plane; {flag}")
+        return False
+    sts = kind == "SURFACE TO SURFACE" and sk == "ELEMENT"
+    if it.behavior in ("exponential", "tabular"):
+        w.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE={it.behavior.upper()} on {etype} elements ({where}): "
+                             f"contact in the plane has the linear penalty and hard (augmented) contact only; {flag}")
+        return False
+    if sk == "NODE":
+        w.unsupported.append(f"{where}: a node surface (TYPE=NODE) as the slave of a pair on {etype} elements: "
+                             f"CalculiX weights such nodes by their share of the body's boundary faces, which contact "
+                             f"in the plane does not have (its slaves are edge surfaces); {flag}")
+        return False
+    if sts:
+        w.unsupported.append(f"{where}: TYPE=SURFACE TO SURFACE on {etype} elements: contact in the plane is "
+                             f"node-to-segment; with --ignore-unsupported the pair is node-to-segment with the same "
+                             f"law (K g per area at the slave nodes over their tributary edges; CalculiX integrates it "
+                             f"over the slave faces)")
+    elif it.behavior == "linear":
+        w.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE=LINEAR on the NODE TO SURFACE pair {where} on {etype} "
+                             f"elements: CalculiX's node-to-face law (arctan, with its tension) is not available in "
+                             f"the plane; with --ignore-unsupported the linear penalty law with the same K per area")
+    if it.behavior == "linear":
+        K = it.values[0] if it.values and it.values[0] > 0.0 else 50.0 * w._first_modulus()
+        if not (it.values and it.values[0] > 0.0):
+            w.notes.append(f"{it.where}: *SURFACE BEHAVIOR, LINEAR without a slope K: CalculiX's default 50 E = {K:g} "
+                           f"is used")
+        entry: dict = {"penalty": K, "weighting": "area"}
+    else:
+        entry = {"penalty": "auto", "method": "augmented", "weighting": "area"}
+    if it.friction is not None and it.friction[0] > 0:
+        w.unsupported.append(f"{it.where}: *FRICTION on the {etype} elements of {where}: friction against the edges "
+                             f"of a planar body is not available yet; with --ignore-unsupported the pair is "
+                             f"frictionless")
+    if w.m.pair_adjust.get(where) is not None:
+        w.unsupported.append(f"{where}: ADJUST on {etype} elements: not available in the plane; with "
+                             f"--ignore-unsupported the slave nodes are not moved")
+    return entry
 
 
 def element_names(types) -> str:
