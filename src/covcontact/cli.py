@@ -485,7 +485,7 @@ def _ranks_info() -> str:
 
 
 def cmd_fit_material(args) -> int:
-    from .materials.fit import fit_material_command
+    from .io.fit_command import fit_material_command
 
     return fit_material_command(args.data, args.model, args.n, args.plot, args.error)
 

@@ -154,7 +154,7 @@ def test_shell_body_equals_the_generated_plate(tmp_path):
 
 
 @pytest.mark.parametrize("shell, message", [
-    ("shell = { thickness = -0.1 }", r"thickness: must be > 0"),
+    ("shell = { thickness = -0.1 }", r"thickness: must be a positive number"),
     ('shell = { thickness = 0.1, offset = "midle" }', "middle"),
     ('shell = { thickness = 0.1 }\nformulation = "solid"', "leave out formulation"),
 ])

@@ -56,7 +56,7 @@ from .friction_kernels import (
     new_friction_work,
 )
 from .laws import is_active
-from .planar import project_on_segment, segment_core, segment_point, segment_shapes
+from .planar_kernels import project_on_segment, segment_core, segment_point, segment_shapes
 
 #: how far beyond its ends (in xi) a history point may lie on the segment's continuation
 TRANSFER_BAND = 0.5

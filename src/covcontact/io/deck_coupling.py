@@ -222,7 +222,7 @@ def _faces(m, refs, surface: str = "", owner: str = "") -> list:
             if what is None:
                 raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: element {bad} is not "
                                 f"defined{owner}")
-            from .deck_model import ELEMENTS  # (deck_model reads *COUPLING through this module)
+            from .deck_elements import ELEMENTS
             from .deck_planar import element_names
             raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: element {bad} is {what}, a type "
                             f"covcontact does not read (it reads {element_names(ELEMENTS)}){owner}")
@@ -425,9 +425,7 @@ class DeckCouplings:
         return out
 
 
-def safe_name(text: str) -> str:
-    """As ``covcontact.io.deck_mesh.safe_name`` (which imports the deck model, which imports this module)."""
-    return re.sub(r"[^A-Za-z0-9_-]", "_", text)
+from .deck_elements import safe_name  # noqa: E402  (the names of the sets it makes)
 
 
 def coupling_names(m, names: list[str]) -> list[str]:

@@ -13,9 +13,7 @@ from .deck import DeckError
 from .deck_model import DeckModel
 
 
-def safe_name(text: str) -> str:
-    """A set or condition name covcontact's input takes (letters, digits, '_', '-')."""
-    return re.sub(r"[^A-Za-z0-9_-]", "_", text)
+from .deck_elements import safe_name  # noqa: E402,F401  (re-exported: the import names sets through it)
 
 
 class Parts:

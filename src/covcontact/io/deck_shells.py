@@ -532,7 +532,7 @@ class DeckShells:
     def sets(self, j: int, nsets: dict, elsets: dict, faces: dict):
         """Body j's node sets (surface node indices), element sets (element positions), face rows {name: [(element
         set, side)]} and the element sets those rows name, all from the deck's label sets."""
-        from .deck_mesh import safe_name
+        from .deck_elements import safe_name
 
         info = self.bodies[j]
         nodes, elements = info["nodes"], info["elements"]

@@ -7,22 +7,14 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ..words import suggest  # noqa: F401  (the input layer's messages name it from here)
+
 
 class InputError(ValueError):
     """Bad input. ``str(err)`` is the one-line message printed by the CLI (exit code 2)."""
 
 
 _REQUIRED = object()
-
-
-def suggest(word: str, candidates, fallback: str = "") -> str:
-    """``"; did you mean 'x'?"`` for the closest of ``candidates`` to ``word`` (difflib), else ``fallback``."""
-    names = [str(c) for c in candidates]
-    close = difflib.get_close_matches(str(word), names, n=1, cutoff=0.6)
-    if not close:
-        lower = {n.lower(): n for n in names}
-        close = [lower[str(word).lower()]] if str(word).lower() in lower else []
-    return f"; did you mean {close[0]!r}?" if close else fallback
 
 
 def _type_name(value: Any) -> str:

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from .common import check_density  # noqa: F401  (re-exported: the materials check their density through it)
 from .rubber import RUBBER, Rubber, rubber_energy, rubber_response
 
 #: kind codes understood by the kernels
@@ -60,12 +61,6 @@ class LameConstants:
     def mu(self) -> float:
         """Shear modulus mu."""
         return lame(self.E, self.nu)[1]
-
-
-def check_density(density) -> None:
-    """A mass density is None (a static analysis needs none) or finite and > 0."""
-    if density is not None and not (math.isfinite(float(density)) and float(density) > 0.0):
-        raise ValueError(f"density must be finite and > 0, got density={density}")
 
 
 @dataclass(frozen=True)

@@ -367,7 +367,7 @@ class J2Plasticity(LameConstants):
     density: float | None = None  # mass per unit reference volume (dynamics)
 
     def __post_init__(self) -> None:
-        from .hyperelastic import check_density
+        from .common import check_density
 
         check_density(self.density)
         E, nu = float(self.E), float(self.nu)

@@ -89,7 +89,7 @@ class Rubber:
     kind: int = field(init=False, default=RUBBER)
 
     def __post_init__(self) -> None:
-        from .hyperelastic import check_density
+        from .common import check_density
 
         _check(self)
         check_density(self.density)
@@ -271,7 +271,7 @@ def rubber_from_keys(model: str, keys: dict, density: float | None = None) -> Ru
         names = model_keys(model)
         for k in keys:
             if k not in names:
-                from ..io.validate import suggest
+                from ..words import suggest
 
                 raise RubberError(f"unknown key{suggest(k, names)} ({model}: {', '.join(names)})", k)
         for k in names:
@@ -311,7 +311,7 @@ def rubber_from_keys(model: str, keys: dict, density: float | None = None) -> Ru
                 raise RubberError(f"order N = {i} is above {NMAX}", k)
             d[i] = _number(k, v)
         else:
-            from ..io.validate import suggest
+            from ..words import suggest
 
             raise RubberError(f"unknown key{suggest(k, ['c10', 'c01', 'd1', 'n'])} ({model}: "
                               f"{', '.join(model_keys(model))})", k)
