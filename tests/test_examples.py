@@ -10,7 +10,8 @@ from covcontact.io.loader import load_problem
 
 ROOT = Path(__file__).resolve().parents[1]
 #: examples that take minutes; each is run at a CI size by its own test (same file, shorter loading)
-LONG = {"forming/uchannel": "tests/verification/test_uchannel.py"}
+LONG = {"forming/uchannel": "tests/verification/test_uchannel.py",
+        "contact/oring_groove": "tests/verification/test_oring.py"}  # (that test runs it whole)
 EXAMPLES = sorted(p for sub in ("solid", "contact", "verification", "plasticity", "forming", "dynamics")
                   for p in (ROOT / "examples" / sub).glob("*.toml") if f"{sub}/{p.stem}" not in LONG)
 
