@@ -711,3 +711,18 @@ def test_equation_remove_becomes_a_stage_removal(tmp_path):
     deck.write_text(deck.read_text().replace("*EQUATION, REMOVE ALL", "*EQUATION\n2\n1001, 1, 1.0, 1003, 1, -1.0"))
     with pytest.raises(DeckError, match="new equations belong to the model data, before the first"):
         import_deck(deck, tmp_path / "new" / "p.toml")
+
+
+@pytest.mark.parametrize("line, isotropic", [("*ELASTIC, TYPE = ISOTROPIC", True), ("*ELASTIC, TYPE=ISO", True),
+                                             ("*ELASTIC, TYPE=ORTHO", False)])
+def test_elastic_type_read_by_its_first_letters(tmp_path, line, isotropic):
+    """CalculiX reads *ELASTIC's TYPE by its first letters (elastics.f compares 'ISO'): Abaqus's TYPE=ISOTROPIC
+    (with blanks round '=', as CalculiX's thread.inp writes it) is isotropic elasticity; ORTHO stays unsupported."""
+    deck = two_block_deck(tmp_path / "tb.inp")
+    deck.write_text(deck.read_text().replace("*ELASTIC\n", line + "\n"))
+    if isotropic:
+        p = load_problem(import_deck(deck, tmp_path / "i" / "p.toml").problem)
+        assert p.bodies[0].material.E == 1000.0
+    else:
+        with pytest.raises(DeckError, match="TYPE=ORTHO is not supported"):
+            import_deck(deck, tmp_path / "i" / "p.toml")

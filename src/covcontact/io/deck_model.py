@@ -681,7 +681,8 @@ class _Reader(LoadCards):
         if not rows:
             raise c.fail("needs a data line")
         if c.name == "ELASTIC":
-            if c.param("TYPE", "ISO").upper() != "ISO":
+            # (CalculiX reads the type by its first letters: TYPE=ISO and Abaqus's TYPE=ISOTROPIC are both isotropic)
+            if not "".join(c.param("TYPE", "ISO").upper().split()).startswith("ISO"):
                 mat["unsupported"] = (f"{c.where()}: *ELASTIC, TYPE={c.params['TYPE']} is not supported (only "
                                       f"isotropic elasticity)")
                 return
