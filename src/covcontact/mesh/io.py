@@ -180,20 +180,25 @@ def read_mesh(path: str | os.PathLike[str], cell_type: str | None = None) -> Mes
     Raises:
         MeshError: the file does not parse or holds no (or an ambiguous) supported volume cell.
     """
-    import meshio
-
     p = Path(path)
     if not p.is_file():
         raise _fail(p, "no such file")
+    return mesh_from_meshio(read_meshio(p), p, cell_type)
+
+
+def read_meshio(p: Path) -> meshio.Mesh:
+    """meshio's mesh of the file ``p``, meshio's own output kept off the terminal; MeshError naming the file and
+    meshio's first line where it cannot read it."""
+    import meshio
+
     said = io.StringIO()
     try:
         with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
-            m = meshio.read(p)
+            return meshio.read(p)
     except (Exception, SystemExit) as exc:  # meshio raises many kinds, or exits, on bad input
         lines = [ln for ln in said.getvalue().splitlines() if ln.strip()]
         why = lines[0] if lines else f"{type(exc).__name__}: {exc}"
         raise _fail(p, f"cannot read mesh ({why})") from exc
-    return mesh_from_meshio(m, p, cell_type)
 
 
 def mesh_from_meshio(m: meshio.Mesh, p: Path, cell_type: str | None = None,

@@ -234,23 +234,17 @@ def read_surface(path) -> tuple[np.ndarray, str, np.ndarray, dict, dict]:
     sets). The surface cells must be of one type of SURFACE_CELLS; named groups (Gmsh physical groups, cell sets) of
     surface cells become element sets, those of lines and points node sets (a physical curve: the nodes of its
     lines). ShellMeshError where the file holds no surface cells, cells of several types, or volume cells."""
-    import contextlib
-    import io
     from pathlib import Path
 
-    import meshio
     from meshio._mesh import topological_dimension
 
-    from .io import _groups
+    from .io import MeshError, _groups, read_meshio
 
     p = Path(path)
-    said = io.StringIO()
     try:
-        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
-            m = meshio.read(p)
-    except (Exception, SystemExit) as exc:  # meshio raises many kinds, or exits, on bad input
-        lines = [ln for ln in said.getvalue().splitlines() if ln.strip()]
-        raise ShellMeshError(f"{p}: cannot read mesh ({lines[0] if lines else type(exc).__name__})") from exc
+        m = read_meshio(p)
+    except MeshError as exc:
+        raise ShellMeshError(str(exc)) from exc
     volume = sorted({b.type for b in m.cells if topological_dimension.get(b.type) == 3})
     if volume:
         raise ShellMeshError(f"{p}: holds volume cells ({', '.join(volume)}); a shell body's mesh is its surface")
