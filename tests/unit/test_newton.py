@@ -95,8 +95,9 @@ def test_energy_norm_and_residual_recorded(tmp_path):
 
 def test_extrapolating_predictor_same_answer_fewer_iterations(tmp_path):
     """[solver] predictor = "extrapolate": the previous step's increment, scaled, as the first iterate; the
-    same converged states as the tangent predictor, in fewer iterations on a friction problem (measured on
-    examples/friction/block_sliding.toml: 22 against 47)."""
+    same converged states as the tangent predictor, in no more iterations on a friction problem
+    (examples/friction/block_sliding.toml: 22 against 24; 22 against 47 while a trial traction on the Coulomb
+    cone stuck, see docs/performance.md "Predictors")."""
     import dataclasses
 
     from covcontact.io.loader import load_problem
@@ -109,7 +110,7 @@ def test_extrapolating_predictor_same_answer_fewer_iterations(tmp_path):
         runs[pred] = problem.run(out=tmp_path / pred, quiet=True)
         assert runs[pred].exit_code == 0
     a, b = runs["tangent"], runs["extrapolate"]
-    assert b.summary["total_iterations"] < 0.7 * a.summary["total_iterations"]
+    assert b.summary["total_iterations"] < a.summary["total_iterations"]
     assert np.allclose(a.u, b.u, atol=1e-8 * np.abs(a.u).max())
     for sa, sb in zip(a.summary["steps"], b.summary["steps"], strict=True):
         # components that vanish by symmetry are compared at the solver's tolerance of the force's size

@@ -7,7 +7,7 @@ With the committed stick point xi_n of the slave on its segment and the committe
     t'   = T_n rho(xi_n) / a(xi_n)               the old traction carried with the master (current configuration)
     T^tr = t' . rho - eps_T a (xi - xi_n)        the trial covariant traction
     ||T|| = |T| / sqrt(a),  kappa = mu p         (p = eps <-g_e> the normal pressure)
-    stick: ||T^tr|| <= kappa, T = T^tr;          slip: T = kappa sqrt(a) sign(T^tr)
+    stick: ||T^tr|| < kappa (1 - 1e-10), T = T^tr;   slip: T = kappa sqrt(a) sign(T^tr)   (on the cone: slip)
 
 and the residual is the variational one of the 3D element (section 7) with one index,
 

@@ -157,6 +157,12 @@ class Newton:
         codes = getattr(self.model, "contact_codes", None)
         return codes(trial) if codes is not None else np.zeros(0, np.int64)
 
+    def _changes(self, before: np.ndarray, after: np.ndarray) -> int:
+        """Slaves whose status code changed from ``before`` to ``after``, over all ranks of a distributed run."""
+        n = int(np.count_nonzero(before != after))
+        total = getattr(self.model, "sum_over_ranks", None)
+        return int(round(total(n))) if total is not None else n
+
     # checkpoints -------------------------------------------------------------------------------
     def checkpoint(self) -> tuple[dict, dict]:
         """Newton's part of a checkpoint: the largest force scale met, and the last step's increment where the
@@ -431,7 +437,7 @@ class Newton:
             out.records.append(IterationRecord(it, rn, energy, m.active_count(trial),
                                                "krylov" if inexact else "factor",
                                                self.stats["krylov_iterations"] - n_kry,
-                                               int(np.count_nonzero(codes != codes_prev))))
+                                               self._changes(codes_prev, codes)))
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
                 return out, trial
