@@ -318,6 +318,17 @@ def test_warmup_problems_are_quiet_and_converge(capsys):
     assert "warning" not in err and err.count("covcontact: compiled") == len(PROBLEMS)
 
 
+def test_parallel_warm_up_runs_every_problem():
+    """`covcontact compile` on several cores: worker processes share the warm-up problems by whole groups of kernels
+    (each problem in exactly one group), and every problem converges (a failing one raises in its worker)."""
+    from covcontact.warmup import GROUPS, PROBLEMS, warm_parallel
+
+    members = sorted(i for group, _ in GROUPS for i in group)
+    assert members == list(range(len(PROBLEMS)))
+    done = warm_parallel(2, quiet=True)
+    assert [label for label, _ in done] == [label for label, _ in PROBLEMS]
+
+
 RATTLE = """
 [problem]
 name = "rattle"

@@ -113,6 +113,8 @@ def _parser() -> argparse.ArgumentParser:
                        "upgrading numba.")
     w.add_argument("--only", default=None, metavar="TEXT",
                    help="only the warm-up problems whose label contains TEXT (default: all)")
+    w.add_argument("--jobs", default=None, type=int, metavar="N",
+                   help="compile in N worker processes (default: one per core, at most one per group of kernels)")
     f = sub.add_parser("fit-material", help="fit a rubber model to test data: constants, errors, stability, plot",
                        description="Fit the rubber models of the material tables with test_data (uniaxial, "
                        "equibiaxial, planar nominal stress against nominal strain; docs/input.md) by least squares, "
@@ -453,14 +455,17 @@ def cmd_check_tangent(args) -> int:
 def cmd_compile(args) -> int:
     import time
 
-    from .warmup import PROBLEMS, byte_compile, warm
+    from .warmup import PROBLEMS, byte_compile, warm, warm_parallel
 
     if args.only is not None and not any(args.only in label for label, _ in PROBLEMS):
         raise InputError(f"--only: no warm-up problem matches {args.only!r} (labels: "
                          f"{'; '.join(label for label, _ in PROBLEMS)})")
+    if args.jobs is not None and args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs}: the number of worker processes is 1 or more")
+    jobs = args.jobs if args.jobs is not None else (os.cpu_count() or 1)
     t0 = time.perf_counter()
     byte_compile()  # the modules' bytecode too, where the installation lacks it (PYTHONDONTWRITEBYTECODE)
-    done = warm(only=args.only)
+    done = warm(only=args.only) if args.only is not None or jobs == 1 else warm_parallel(jobs)
     print(f"covcontact: {len(done)} warm-up problems in {time.perf_counter() - t0:.1f} s; the kernels are in "
           f"numba's cache", file=sys.stderr)
     return 0
