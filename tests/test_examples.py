@@ -11,7 +11,9 @@ from covcontact.io.loader import load_problem
 ROOT = Path(__file__).resolve().parents[1]
 #: examples that take minutes; each is run at a CI size by its own test (same file, shorter loading)
 LONG = {"forming/uchannel": "tests/verification/test_uchannel.py",
-        "contact/oring_groove": "tests/verification/test_oring.py"}  # (that test runs it whole)
+        "contact/oring_groove": "tests/verification/test_oring.py",  # (these tests run them whole)
+        "contact/tube_crush": "tests/verification/test_tube_crush.py",
+        "contact/tube_crush_half": "tests/verification/test_tube_crush.py"}
 EXAMPLES = sorted(p for sub in ("solid", "contact", "verification", "plasticity", "forming", "dynamics")
                   for p in (ROOT / "examples" / sub).glob("*.toml") if f"{sub}/{p.stem}" not in LONG)
 

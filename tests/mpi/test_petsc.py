@@ -185,7 +185,7 @@ def test_ranks_stopped_by_sigterm(tmp_path):
     """SIGTERM to ``covcontact run --ranks 2``: the ranks stop together at their next Newton iteration, as a serial
     run does: exit code 143, summary "interrupted" with the converged steps, no process left; ``--resume`` then
     ends as the uninterrupted run (the same iterations, the displacements to 1e-12)."""
-    path = ROOT / "benchmarks" / "problems" / "two_blocks_30k.toml"
+    path = ROOT / "benchmarks" / "problems" / "two_blocks_5k.toml"
     out = tmp_path / "stopped"
     cmd = [sys.executable, "-m", "covcontact.cli", "run", str(path), "--ranks", "2", "--out", str(out)]
     proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
