@@ -270,3 +270,25 @@ def test_loads_on_elements_not_read_are_listed_with_their_type(tmp_path):
     deck.write_text(text.replace("*NODE PRINT", "*DLOAD\n9002, GRAV, 9.81, 0, 0, -1\n*NODE PRINT"))
     with pytest.raises(DeckError, match=r"m\.inp:\d+: \*DLOAD: element 9002 is not defined"):
         import_deck(deck, tmp_path / "x" / "p.toml")
+
+
+def test_surface_through_a_body_refused_in_one_line(tmp_path, capsys):
+    """A *SURFACE whose faces lie inside a body: named only by an unsupported *PRE-TENSION SECTION, the run lists
+    that keyword and stops (exit 2); used as a contact surface, one line names the deck, the body and the surface.
+    Neither is an internal error (exit 3, CalculiX's pret2.inp was)."""
+    from covcontact.cli import main
+
+    deck = two_block_deck(tmp_path / "cut.inp")
+    text = deck.read_text()
+    step = text.index("*STEP")
+    cut = "*SURFACE, NAME=CUT, TYPE=ELEMENT\n1, S4\n*PRE-TENSION SECTION, SURFACE=CUT, NODE=1\n"
+    deck.write_text(text[:step] + cut + text[step:])
+    assert main(["run", str(deck), "--out", str(tmp_path / "a"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "*PRE-TENSION SECTION is not supported" in err and "internal error" not in err
+    assert "BASETOP, S2" in text
+    deck.write_text(text.replace("BASETOP, S2", "1, S4"))
+    assert main(["run", str(deck), "--out", str(tmp_path / "b"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cut.inp: body" in err[0] and "*SURFACE SMAST: 1 of its faces are not on the boundary" \
+        in err[0]

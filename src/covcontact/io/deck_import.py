@@ -952,14 +952,14 @@ class _Writer:
         """One mesh file per body (its nodes, elements, sets and surfaces): bodies of cell types that do not mix
         (a hex20 part and a tet10 part) each read on their own. ``self.meshes``: each file's Mesh, built from the
         same content without reading the file back (``covcontact run DECK.inp`` hands them to the loader)."""
-        from ..mesh.io import mesh_from_meshio
+        from ..mesh.io import MeshError, mesh_from_meshio
 
         import dataclasses
 
         self.meshes = {}
         self.element_labels = {}  # body -> the deck's element labels in the mesh's element order
         # (a surface only *SECTION PRINT names may cut through a body: the .dat reads its faces from the labels file)
-        sections = {s[0] for st in self.m.steps for s in st.section_print}
+        sections = {s[0] for st in self.m.steps for s in st.section_print} | self.m.unsupported_surfaces
         used = {name for pair in self.m.pairs for name in pair[2:4]} | {name for tie in self.m.ties for name in tie[1:3]}
         model = dataclasses.replace(self.m, surfaces={name: v for name, v in self.m.surfaces.items()
                                                       if name in used or name not in sections})
@@ -968,7 +968,11 @@ class _Writer:
             content = body_content(model, self.b, k, self.extra_nsets, self.extra_elsets, self.extra_surfaces)
             self.element_labels[self.body_names[k]] = np.concatenate([lab for _, lab, _ in content["blocks"]]).tolist()
             path.write_text(body_text(content))
-            self.meshes[path] = mesh_from_meshio(body_meshio(content), path, surfaces=(surface_refs(content), {}))
+            try:
+                self.meshes[path] = mesh_from_meshio(body_meshio(content), path,
+                                                     surfaces=(surface_refs(content), {}))
+            except MeshError as exc:  # (named by the deck, not by the mesh file written from it)
+                raise DeckError(f"{self.deck}: body {self.body_names[k]}: {str(exc).split(': ', 1)[-1]}") from None
         start = max([int(e) for labs in self.element_labels.values() for e in labs]
                     + [int(e) for _, _, labs, _ in self.m.shell_blocks for e in labs] + [0]) + 1
         for j, info in enumerate(self.shells.bodies):  # shell bodies: their surface files, the solid-shells built

@@ -125,6 +125,8 @@ class DeckModel:
     couplings: list = field(default_factory=list)
     steps: list[Step] = field(default_factory=list)
     unsupported: list[str] = field(default_factory=list)
+    #: surfaces named by unsupported keywords (left out of the meshes unless a contact pair or tie uses them)
+    unsupported_surfaces: set[str] = field(default_factory=set)
     #: elements of types covcontact does not read (listed as unsupported): label -> type; and their nodes
     skipped_elements: dict[int, str] = field(default_factory=dict)
     skipped_nodes: set[int] = field(default_factory=set)
@@ -220,6 +222,8 @@ class _Reader(LoadCards):
                 continue
             if c.name not in SUPPORTED:
                 m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
+                if c.params.get("SURFACE"):  # (a *PRE-TENSION SECTION's surface cuts through its body)
+                    m.unsupported_surfaces.add(c.params["SURFACE"].upper())
                 continue
             if c.name in COUPLING_CARDS:  # (deck_coupling checks its own parameters)
                 read_coupling_card(self, c, cards[k] if k < len(cards) else None)
