@@ -292,3 +292,13 @@ def test_surface_through_a_body_refused_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cut.inp: body" in err[0] and "*SURFACE SMAST: 1 of its faces are not on the boundary" \
         in err[0]
+
+
+def test_node_line_without_coordinates_is_at_the_origin(tmp_path):
+    """A *NODE line of its label alone (CalculiX's planestress3.inp) or with fewer than three coordinates: the rest
+    are 0, as CalculiX's reader (nodes.f) sets them."""
+    deck = tmp_path / "n.inp"
+    deck.write_text("*NODE, NSET=NALL\n1\n2, 10.\n3 ,10,5\n4, 1, 2, 3\n")
+    m = read_model(deck)
+    assert m.node_labels.tolist() == [1, 2, 3, 4]
+    np.testing.assert_array_equal(m.X, [[0, 0, 0], [10, 0, 0], [10, 5, 0], [1, 2, 3]])

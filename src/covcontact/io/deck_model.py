@@ -557,7 +557,7 @@ class _Reader(LoadCards):
         if a is None or len(a) != len(c.data):
             a = np.zeros((len(c.data), 4))
             for k, row in enumerate(c.rows()):
-                if not 2 <= len(row) <= 4:
+                if not 1 <= len(row) <= 4:  # (coordinates left out are 0, as CalculiX reads them: nodes.f)
                     raise c.fail(f"a node line is 'label, x, y, z', got {len(row)} fields", k)
                 for j in range(len(row)):
                     a[k, j] = c.number(k, j, row, ("the node label", "x", "y", "z")[j], 0.0)
