@@ -23,4 +23,7 @@ def pytest_sessionstart(session):
     jobs = os.cpu_count() or 1
     print(f"\ncovcontact: numba's cache is cold: compiling the kernels in {jobs} processes first", file=sys.stderr,
           flush=True)
-    warmup.warm_parallel(jobs, quiet=True)
+    try:
+        warmup.warm_parallel(jobs, quiet=True)
+    except Exception as exc:  # (a warm-up problem that fails is test_cli's to report; the tests compile what they need)
+        print(f"covcontact: the compile before the tests failed ({exc}); the tests go on", file=sys.stderr, flush=True)
