@@ -169,3 +169,14 @@ def test_what_contact_in_the_plane_lacks_is_listed(tmp_path, kw, message):
     assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
     lines = [ln for ln in proc.stderr.splitlines() if re.search(message, ln)]
     assert len(lines) == 1 and lines[0].startswith("covcontact: unsupported: "), proc.stderr
+
+
+def test_contact_print_of_planar_pairs_is_said_not_left_empty(tmp_path):
+    """*CONTACT PRINT on a deck whose pairs lie on planar elements: the .dat has no table of them, and the run says so
+    in a note naming the card and the pairs (the VTU has their gap and pressure), instead of printing nothing."""
+    text = _deck("CPE4", kind="NODE TO SURFACE", law="HARD").replace(
+        "*END STEP\n", "*CONTACT PRINT\nCSTR, CDIS\n*END STEP\n")
+    dat, proc = _run(text, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert re.search(r"blocks\.inp:\d+: \*CONTACT PRINT: the pairs on planar elements \(pair1\) are not tabulated in "
+                     r"the \.dat", proc.stderr), proc.stderr

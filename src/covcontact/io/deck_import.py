@@ -879,6 +879,11 @@ class _Writer:
         el_prints = [[[elset, list(v), totals, order[w]] for elset, v, w, totals in self.m.steps[s].el_print]
                      for s, _ in self.stage_steps]
         contact_prints = [list(self.m.steps[s].contact_print) for s, _ in self.stage_steps]
+        planar = sorted(getattr(self, "_plane_pairs", ()))
+        printing = [self.m.steps[s].contact_card[0] for s, _ in self.stage_steps if self.m.steps[s].contact_print]
+        if planar and printing:  # (said, not left to an empty table)
+            self.notes.append(f"{printing[0]}: *CONTACT PRINT: the pairs on planar elements ({', '.join(planar)}) "
+                              f"are not tabulated in the .dat; their gap and contact pressure are in the VTU output")
         contact_cards = [[self.m.steps[s].contact_card[1], order.get(self.m.steps[s].contact_card[0], 0)]
                          for s, _ in self.stage_steps]
         section_prints = [[[surf, name, list(v), order[w]] for surf, name, v, w in self.m.steps[s].section_print
