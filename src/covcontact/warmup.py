@@ -323,8 +323,12 @@ def warm(stream=None, only: str | None = None, quiet: bool = False,
                 raise RuntimeError(f"warm-up problem {label!r} did not converge (exit {result.exit_code})")
             times.append((label, dt))
             if not quiet:
-                print(f"covcontact: compiled {label} ({dt:.1f} s)", file=stream or sys.stderr, flush=True)
+                _say(label, dt, stream)
     return times
+
+
+def _say(label: str, seconds: float, stream=None) -> None:
+    print(f"covcontact: compiled {label} ({seconds:.1f} s)", file=stream or sys.stderr, flush=True)
 
 
 def _warm_group(indices: tuple[int, ...]) -> list[tuple[str, float]]:
@@ -339,12 +343,10 @@ def warm_parallel(jobs: int, stream=None, quiet: bool = False) -> list[tuple[str
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    from . import kernel_cache
-
     jobs = max(1, min(int(jobs), len(GROUPS)))
     if jobs == 1:
         return warm(stream, quiet=quiet)
-    kernel_cache.check()  # once, before the workers (each would otherwise test the stamp at its import)
+    # (the stamp of the kernel sources was checked at the package's import, here and in each worker alike)
     loads = [0.0] * jobs
     shares: list[list[int]] = [[] for _ in range(jobs)]
     for members, seconds in sorted(GROUPS, key=lambda g: -g[1]):
@@ -357,14 +359,13 @@ def warm_parallel(jobs: int, stream=None, quiet: bool = False) -> list[tuple[str
             for label, seconds in result:
                 done[label] = seconds
                 if not quiet:
-                    print(f"covcontact: compiled {label} ({seconds:.1f} s)", file=stream or sys.stderr, flush=True)
+                    _say(label, seconds, stream)
     return [(label, done[label]) for label, _ in PROBLEMS if label in done]
 
 
 def cache_is_cold() -> bool:
     """Whether numba's cache lacks the compiled solid-element kernel that every 3D run loads (a new installation, a
-    cache cleared for changed kernel sources, or a NUMBA_CACHE_DIR not filled yet)."""
+    cache cleared for changed kernel sources at the package's import, or a NUMBA_CACHE_DIR not filled yet)."""
     from . import kernel_cache
 
-    kernel_cache.check()
     return not any(any(folder.glob("solid.solid_chunk-*.nbi")) for folder in kernel_cache.cache_dirs())
