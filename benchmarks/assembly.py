@@ -9,6 +9,7 @@ size and the resident peak memory of that process. Output: JSON on stdout or to 
     python benchmarks/assembly.py --out assembly.json --max-gib 12
     python benchmarks/assembly.py --cells hex8 --material j2 --formulation fbar   # plastic F-bar hex8
     python benchmarks/assembly.py --single hex8 40 --material j2 --formulation solid-shell  # plastic solid-shells
+    python benchmarks/assembly.py --cells hex8 --formulation incompatible   # incompatible modes (C3D8I)
 
 With ``--material j2`` the body is stretched 1 % (beyond yield) from the virgin state, so every Gauss point
 runs the return mapping; the time includes the copy of the history arrays that an evaluation makes.
@@ -82,6 +83,7 @@ def run_single(cell: str, n: int, repeats: int, material: str = "svk", formulati
     from covcontact.assembly import Pattern
     from covcontact.elements import SolidBody
     from covcontact.elements.fbar import FbarBody
+    from covcontact.elements.incompatible import IncompatibleBody
     from covcontact.elements.solidshell import SolidShellBody
     from covcontact.materials import J2Plasticity, SaintVenantKirchhoff
 
@@ -96,7 +98,8 @@ def run_single(cell: str, n: int, repeats: int, material: str = "svk", formulati
     if formulation == "solid-shell":  # the third element direction is the thickness; J2: 5 Gauss points
         body = SolidShellBody(cell, X, cells, mat)
     else:
-        body = (FbarBody if formulation == "fbar" else SolidBody)(cell, X, cells, mat)
+        kind = {"fbar": FbarBody, "incompatible": IncompatibleBody}.get(formulation, SolidBody)
+        body = kind(cell, X, cells, mat)
     state = body.new_state()
     t0 = time.perf_counter()
     body.ranks(P)
@@ -141,7 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--material", default="svk", choices=("svk", "j2"),
                     help="j2: J2 plasticity in a plastic state (return mapping included)")
-    ap.add_argument("--formulation", default="solid", choices=("solid", "fbar", "solid-shell"))
+    ap.add_argument("--formulation", default="solid",
+                    choices=("solid", "fbar", "solid-shell", "incompatible"))
     ap.add_argument("--single", nargs=2, metavar=("CELL", "N"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.single:

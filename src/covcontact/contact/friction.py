@@ -146,7 +146,7 @@ def _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, na, nb_,
 @njit(cache=True)
 def surface_derivs(kind, origin, frame, radius, sigma, prof, chart, xi, rho, rho1, rho2, rho3):
     """rho and its derivatives by xi up to third order, (3,), (2, 3), (2, 2, 3), (2, 2, 2, 3)."""
-    _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, 0, 0, rho)
+    _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, np.int64(0), np.int64(0), rho)
     for i in range(2):
         _surface_deriv(kind, origin, frame, radius, sigma, prof, chart, xi, 1 - i, i, rho1[i])
         for j in range(2):
@@ -226,7 +226,9 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, 
     """
     aw, fw, geo = work
     rho, rho1, rho2, rho3, a_cov, a_con, a_n, a_ni, ar, d1, d2, r, tvec, dtdx, xin, dxi, T, pt, dummy = geo
-    g, chart = analytic_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, CASE_EXACT, False, xi, R_out,
+    # np.int64 / np.bool_ constants are run-time values to numba: one compiled callee for every caller
+    exact, no = np.int64(CASE_EXACT), np.bool_(False)
+    g, chart = analytic_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, exact, no, xi, R_out,
                              K_out, dummy, aw, lam_k, band)
     nrm = aw[4]
     if kind == REVOLVED and chart == 1:
@@ -283,7 +285,8 @@ def analytic_friction_core(kind, origin, frame, radius, sigma, prof, xs, eps_n, 
     surface_coords(kind, origin, frame, radius, sigma, prof, chart, pt, xi, xin)
     dxi[0] = xi[0] - xin[0]
     dxi[1] = xi[1] - xin[1]
-    state = friction_generic(1, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, dxi, tvec, dtdx,
+    one = np.int64(1)
+    state = friction_generic(one, ar, d1, d2, r, nrm, g, rho1, rho2, rho3, a_cov, a_con, dxi, tvec, dtdx,
                              eps_n, eps_t, mu, R_out, K_out, T, fw, lam_k)
     hist_out[H_T] = T[0]
     hist_out[H_T + 1] = T[1]

@@ -332,7 +332,9 @@ def friction_core(xyz, xs, xi1, xi2, eps_n, eps_t, mu, hist, R_out, K_out, hist_
     ar, d1, d2, r, tvec, dtdx, dxi, T, dummy = geo[21:]
     nen = xyz.shape[0]
     nb = nen + 1
-    g = element_core(xyz, xs, xi1, xi2, eps_n, CASE_EXACT, False, R_out, K_out, dummy, ew, lam_k)
+    # np.int64 / np.bool_ constants are run-time values to numba: one compiled element_core for all callers
+    exact, no = np.int64(CASE_EXACT), np.bool_(False)
+    g = element_core(xyz, xs, xi1, xi2, eps_n, exact, no, R_out, K_out, dummy, ew, lam_k)
     for k in range(HIST_SIZE):
         hist_out[k] = hist[k]
     if g == np.inf:

@@ -61,6 +61,8 @@ def contact_batch(
     """
     npair, nen = facet_conn.shape
     nchunk = (npair + _CHUNK - 1) // _CHUNK
+    # np.bool_: run-time values to numba, so element_core is compiled once for every caller, not per constant
+    yes, no = np.bool_(True), np.bool_(False)
     for c in prange(nchunk):
         work = new_work()  # scratch per chunk of pairs, not per pair
         xyz = np.empty((nen, 3))
@@ -80,9 +82,9 @@ def contact_batch(
                 lk = lam_k[k]
             if want_parts:
                 g_out[k] = element_core(
-                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, True, R_out[k], K_out[k], P_out[k], work, lk
+                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, yes, R_out[k], K_out[k], P_out[k], work, lk
                 )
             else:
                 g_out[k] = element_core(
-                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, False, R_out[k], K_out[k], P_out[0], work, lk
+                    xyz, xs, xi[k, 0], xi[k, 1], eps[k], case, no, R_out[k], K_out[k], P_out[0], work, lk
                 )

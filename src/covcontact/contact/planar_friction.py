@@ -77,7 +77,7 @@ def segment_friction_core(xseg, xs, xi, eps_n, eps_t, mu, lam_k, hist, R, K, his
     nb = nen + 1
     m = 3 * nb
     dummy = np.zeros((1, 1, 1))
-    g = segment_core(xseg, xs, xi, eps_n, lam_k, CASE_EXACT, False, R, K, dummy)
+    g = segment_core(xseg, xs, xi, eps_n, lam_k, np.int64(CASE_EXACT), np.bool_(False), R, K, dummy)
     N = np.empty(3)
     dN = np.empty(3)
     ddN = np.empty(3)

@@ -257,9 +257,9 @@ def project_inline(xyz, xs, xi, c, G, max_iter, tol):
         t = 1.0
         accepted = False
         for k in range(_MAX_HALVINGS):
-            e0 = xs[0] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, 0)
-            e1 = xs[1] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, 1)
-            e2 = xs[2] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, 2)
+            e0 = xs[0] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, np.int64(0))
+            e1 = xs[1] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, np.int64(1))
+            e2 = xs[2] - _mono_point(c, xi[0] + t * dx0, xi[1] + t * dx1, np.int64(2))
             ft = 0.5 * (e0 * e0 + e1 * e1 + e2 * e2)
             if ft <= f0 + f_tol:
                 accepted = True

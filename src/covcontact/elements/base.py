@@ -198,7 +198,12 @@ class ElementBody(CellCounts):
         raise NotImplementedError
 
     def _gauss_fields(self, u: np.ndarray, mode: int, out: np.ndarray, state: dict[str, np.ndarray]) -> None:
-        """Per-element fields into out (nelem, ncol): mode 0 energy, 1 min det J0, 2 stress (18)."""
+        """Per-element fields into out (nelem, ncol): mode 0 energy, 1 min det J0, 2 stress (18).
+
+        The compiled field kernels of the element families are serial loops: they run once per output step
+        (or per step for the energy of a dynamic run), and a parallel kernel that calls the material library
+        costs numba about three times the compile time of a serial one (about a minute over the families on
+        a new installation's first run; docs/performance.md, "Cold start")."""
         raise NotImplementedError
 
     #: state keys that are only the starting point of a local iteration (read from the guess, e.g. the

@@ -346,9 +346,9 @@ def fbar_chunk(kind, params, form, volume, X, u, conn, e0, dNdxi, dNc, w, Pv, wa
                                      S, D, FS, T, A, Q, x, y, Jb, G0, Mw, Hw)
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def fbar_gauss_fields(kind, params, volume, X, u, conn, dNdxi, dNc, w, Pv, mode, out, nthreads, hist_n):
-    """Per-element Gauss-point quantities of F-bar hex8 (serial per block, parallel over blocks).
+    """Per-element Gauss-point quantities of F-bar hex8 (serial: see ``ElementBody._gauss_fields``).
 
     mode 0: out (ne, 1) strain energy int W(F_bar) dV (inf where det F or det F_c <= 0);
     mode 1: out (ne, 1) minimum det J0 over the Gauss points and the centre;
@@ -358,7 +358,7 @@ def fbar_gauss_fields(kind, params, volume, X, u, conn, dNdxi, dNc, w, Pv, mode,
     ne = conn.shape[0]
     nen = conn.shape[1]
     nblk = max(1, min(nthreads, ne))
-    for t in prange(nblk):
+    for t in range(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe = np.empty((nen, 3))
         ue = np.empty((nen, 3))

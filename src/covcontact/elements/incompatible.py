@@ -175,10 +175,12 @@ def _local_solve(kind, params, Ue, start, from_zero, Gt, wdv, want_K, hne, hist,
     (_Ue, _Gt, _wdv, _J0, _Ji, _Jc, F, H, S, D, T, A, Q, Kt, fa, Kaa, Kf, base, dal, _a0, piv, _X, _hne) = ws
     ng = wdv.size
     hyper = hne.shape[1] == 0
+    # np.bool_: run-time values to numba (a literal True or False compiles the callee once more per constant)
+    yes, no = np.bool_(True), np.bool_(False)
     for k in range(NMODE):
         for i in range(3):
             Ue[NEN + k, i] = 0.0 if from_zero else start[3 * k + i]
-    f, hmax, energy = _evaluate(kind, params, Ue, Gt, wdv, NEN, True, hne, hist, F, H, S, D, T, A, Q, Kt, fa)
+    f, hmax, energy = _evaluate(kind, params, Ue, Gt, wdv, NEN, yes, hne, hist, F, H, S, D, T, A, Q, Kt, fa)
     if f != 0:
         return f
     hn = 0.0
@@ -187,7 +189,7 @@ def _local_solve(kind, params, Ue, start, from_zero, Gt, wdv, want_K, hne, hist,
     for _it in range(LOCAL_MAXIT):
         _mode_block(Kt, Kaa)
         if hyper:
-            mode = _factor(Kaa, NALPHA, Kf, piv, False)
+            mode = _factor(Kaa, NALPHA, Kf, piv, no)
             dg = 0.0
             for m in range(NALPHA):
                 dg = max(dg, abs(Kaa[m, m]))
@@ -196,10 +198,10 @@ def _local_solve(kind, params, Ue, start, from_zero, Gt, wdv, want_K, hne, hist,
                 _mode_block(Kt, Kaa)
                 for m in range(NALPHA):
                     Kaa[m, m] += tau
-                mode = _factor(Kaa, NALPHA, Kf, piv, False)
+                mode = _factor(Kaa, NALPHA, Kf, piv, no)
                 tau *= 10.0
         else:
-            mode = _factor(Kaa, NALPHA, Kf, piv, True)
+            mode = _factor(Kaa, NALPHA, Kf, piv, yes)
         if mode == 0:
             return FLAG_LOCAL
         slope = 0.0
@@ -233,7 +235,8 @@ def _local_solve(kind, params, Ue, start, from_zero, Gt, wdv, want_K, hne, hist,
             for k in range(NMODE):
                 for i in range(3):
                     Ue[NEN + k, i] = base[3 * k + i] + step * dal[3 * k + i]
-            f, hmax, enew = _evaluate(kind, params, Ue, Gt, wdv, NEN, True, hne, hist, F, H, S, D, T, A, Q, Kt, fa)
+            f, hmax, enew = _evaluate(kind, params, Ue, Gt, wdv, NEN, yes, hne, hist, F, H, S, D, T, A, Q, Kt,
+                                      fa)
             if f == 0:
                 hnew = 0.0
                 for m in range(NALPHA):
@@ -288,9 +291,9 @@ def _element(kind, params, Xe, ue, alpha, dNdxi, dNc, pts, w, want_K, Ke, fe, hi
         for a in range(NEN):
             for i in range(3):
                 Ue[a, i] = ue[a, i]
-        flag = _local_solve(kind, params, Ue, a0, False, Gt, wdv, want_K, hne, hist, ws)
+        flag = _local_solve(kind, params, Ue, a0, np.bool_(False), Gt, wdv, want_K, hne, hist, ws)
         if flag != 0 and finite and nonzero:  # the start from the hint failed: once more from alpha = 0
-            flag = _local_solve(kind, params, Ue, a0, True, Gt, wdv, want_K, hne, hist, ws)
+            flag = _local_solve(kind, params, Ue, a0, np.bool_(True), Gt, wdv, want_K, hne, hist, ws)
     nd = 3 * NEN
     if flag != 0:
         for m in range(NALPHA):
@@ -314,7 +317,7 @@ def _element(kind, params, Xe, ue, alpha, dNdxi, dNc, pts, w, want_K, Ke, fe, hi
         return 0
     # condensation: Ke = K_uu - K_ua K_aa^-1 K_au
     _mode_block(Kt, Kaa)
-    mode = _factor(Kaa, NALPHA, Kf, piv, True)
+    mode = _factor(Kaa, NALPHA, Kf, piv, np.bool_(True))
     if mode == 0:
         for r in range(nd):
             fe[r] = 0.0
@@ -366,7 +369,7 @@ def incompatible_chunk(kind, params, X, u, conn, e0, alpha, dNdxi, dNc, pts, w, 
                                 hist[e], ws)
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mode, out, nthreads, hist_n):
     """Per-element quantities at the solved mode parameters (alpha (ne, 9): the start, overwritten with the
     solution; the caller passes a copy), hist_n (ne, 8, nh) the committed history (read only).
@@ -377,7 +380,7 @@ def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mod
     """
     ne = conn.shape[0]
     nblk = max(1, min(nthreads, ne))
-    for t in prange(nblk):
+    for t in range(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe = np.empty((NEN, 3))
         ue = np.empty((NEN, 3))
@@ -389,6 +392,7 @@ def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mod
         fe = np.empty(3 * NEN)
         Kdummy = np.empty((0, 0))
         row = np.empty(18)
+        no = np.bool_(False)  # run-time value: _element compiled once (a literal False adds a version)
         for e in range(lo, hi):
             gather(X, u, conn, e, Xe, ue)
             for r in range(out.shape[1]):
@@ -399,7 +403,7 @@ def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mod
                     dmin = min(dmin, _jacobian(Xe, dNdxi[g], J0, Ji))
                 out[e, 0] = dmin
                 continue
-            if _element(kind, params, Xe, ue, alpha[e], dNdxi, dNc, pts, w, False, Kdummy, fe, hist_n[e], htr,
+            if _element(kind, params, Xe, ue, alpha[e], dNdxi, dNc, pts, w, no, Kdummy, fe, hist_n[e], htr,
                         ws) != 0:
                 if mode == 0:
                     out[e, 0] = np.inf

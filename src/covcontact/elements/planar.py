@@ -295,14 +295,14 @@ def planar_chunk(kind, params, form, thick, X, u, conn, e0, N, dN, w, want_K, Ke
                                    hist_n[e0 + c], hist[e0 + c])
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def planar_gauss_fields(kind, params, form, thick, X, u, conn, N, dN, w, mode, out, hist_n):
     """Per-element quantities: mode 0 strain energy int W dV; 1 minimum det J0 (axisymmetric: min(det J0, R)); 2
     volume averages of Cauchy stress (with the out-of-plane or hoop component 33), S and Green-Lagrange E (Voigt); 3
     the Cauchy stress of every Gauss point g in out[e, 6 g: 6 g + 6]."""
     ne = conn.shape[0]
     nen = conn.shape[1]
-    for e in prange(ne):
+    for e in range(ne):
         Xe = np.empty((nen, 3))
         ue = np.empty((nen, 3))
         G = np.zeros((nen, 2))

@@ -314,7 +314,7 @@ def planar_fbar_chunk(kind, params, form, nexp, volume, thick, X, u, conn, e0, N
                                         want_K, Kc, fe[c], hist_n[e0 + c], hist[e0 + c])
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def planar_fbar_gauss_fields(kind, params, form, nexp, volume, thick, X, u, conn, N, dN, w, Nc, dNc, Pv, mode, out,
                              hist_n):
     """Per-element quantities with F_bar: mode 0 strain energy int W(F_bar) dV; 1 minimum det J0 (axisymmetric:
@@ -325,7 +325,7 @@ def planar_fbar_gauss_fields(kind, params, form, nexp, volume, thick, X, u, conn
     nd = 2 * nen
     ngp = w.size
     m = Pv.shape[1]
-    for e in prange(ne):
+    for e in range(ne):
         Xe = np.empty((nen, 3))
         ue = np.empty((nen, 3))
         G = np.zeros((nen, 2))

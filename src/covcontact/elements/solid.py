@@ -224,9 +224,9 @@ def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, n
                                 T, A, Q, Kt, hist_n[e0 + c], hist[e0 + c])
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, hist_n):
-    """Per-element Gauss-point quantities (serial per block, parallel over blocks).
+    """Per-element Gauss-point quantities (serial: see ``ElementBody._gauss_fields``).
 
     mode 0: out (ne, 1) strain energy int W dV; mode 1: out (ne, 1) minimum det J0;
     mode 2: out (ne, 18) volume averages of Cauchy stress, S and Green-Lagrange E (Voigt), with the
@@ -235,7 +235,7 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, 
     ne = conn.shape[0]
     nen = conn.shape[1]
     nblk = min(nthreads, ne)
-    for t in prange(nblk):
+    for t in range(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe, ue, G, J0, Ji, F, S, D = _work(nen)
         H = np.empty((3, 3))

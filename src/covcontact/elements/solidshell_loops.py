@@ -59,7 +59,7 @@ def solidshell_chunk(kind, params, X, u, conn, e0, alpha, dNp, dNc, w, tie_ptr, 
                                 eas_val, want_K, Kc, fe[c], ws3, ws4, ws2, wsg, wv, hist_n[e], hist[e], hne)
 
 
-@njit(parallel=True, cache=True)
+@njit(cache=True)
 def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
                       mode, out, nthreads, hist_n):
     """Per-element quantities at the solved EAS parameters, with hist_n (ne, ng, nh) as the committed
@@ -74,7 +74,7 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
     npt = dNp.shape[0]
     ng = w.size
     nblk = max(1, min(nthreads, ne))
-    for t in prange(nblk):
+    for t in range(nblk):
         lo, hi = block_range(t, ne, nblk)
         Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
         hne = np.empty((ng, hist_n.shape[2]))
