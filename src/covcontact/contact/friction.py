@@ -19,6 +19,7 @@ States: OPEN 0, STICK 1, SLIP 2 (also mu = 0), NEW 3.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -353,6 +354,20 @@ def make_history(xi_n, traction=(0.0, 0.0), rho_n=(0.0, 0.0, 0.0), rho_cov_n=Non
     return h
 
 
+def _history(xi, t, rho, rc) -> np.ndarray:
+    """``make_history`` of arrays of the right shapes (xi (2,), t (2,), rho (3,), rc (2, 3)), unchecked: the inner
+    loops of the friction history (every new contact point at every residual of a step) call it."""
+    h = np.zeros(HIST_SIZE)
+    h[H_XI:H_XI + 2] = xi
+    h[H_RHO:H_RHO + 3] = rho
+    h[H_RHO_COV:H_RHO_COV + 6] = rc.ravel()
+    h[H_T:H_T + 2] = t
+    h[H_FLAG] = 1.0
+    if not np.isfinite(h).all():
+        raise ValueError("friction history contains non-finite values")
+    return h
+
+
 def _check_friction(eps_t, mu, history):
     et = float(eps_t)
     if not np.isfinite(et) or et <= 0.0:
@@ -454,7 +469,7 @@ def _facet_frame(xyz, xi):
 def _regular_at(xyz, xi) -> bool:
     """Whether the facet's continuation is regular at ``xi``: within TRANSFER_BAND of the facet, its area element at
     least _TRANSFER_AREA of the centre's and its normal on the centre's side."""
-    if not (np.all(np.isfinite(xi)) and np.max(np.abs(xi)) <= 1.0 + TRANSFER_BAND):
+    if not (math.isfinite(xi[0]) and math.isfinite(xi[1]) and max(abs(xi[0]), abs(xi[1])) <= 1.0 + TRANSFER_BAND):
         return False
     try:
         _, _, n0, a0 = _facet_frame(xyz, np.zeros(2))
@@ -501,7 +516,7 @@ def _anchored(xyz, point, t_vec, eps_t, xi0) -> np.ndarray:
     if status == DEGENERATE or not (status == CONVERGED and _regular_at(xyz, xi)):
         xi = _closest_on_facet(xyz, point, np.clip(np.nan_to_num(np.asarray(xi0, dtype=np.float64)), -1.0, 1.0))
     rho, rc, _, _ = _facet_frame(xyz, xi)
-    return make_history(xi, rc @ (t_vec - eps_t * (rho - point)), rho, rc)
+    return _history(xi, rc @ (t_vec - eps_t * (rho - point)), rho, rc)
 
 
 def transfer_history(history, master_xyz, xi0=None, eps_t: float = 0.0) -> np.ndarray:
