@@ -294,6 +294,29 @@ def test_surface_through_a_body_refused_in_one_line(tmp_path, capsys):
         in err[0]
 
 
+def test_load_on_the_reference_node_of_an_unsupported_keyword_is_listed(tmp_path):
+    """A *CLOAD on the reference node of a *PRE-TENSION SECTION (CalculiX's pret1.inp: a node of no element) is listed
+    with the keyword it belongs to, among the unsupported features, not refused as a load on nothing; a *CLOAD on
+    another node of no element still is."""
+    deck = two_block_deck(tmp_path / "pret.inp")
+    text = deck.read_text()
+    step = text.index("*STEP")
+    cut = ("*NODE\n9999, 0., 0., 0.\n*SURFACE, NAME=CUT, TYPE=ELEMENT\n1, S4\n"
+           "*PRE-TENSION SECTION, SURFACE=CUT, NODE=9999\n1., 0., 0.\n")
+    assert "*NODE PRINT" in text
+    deck.write_text(text[:step] + cut + text[step:].replace("*NODE PRINT", "*CLOAD\n9999, 1, -10.\n*NODE PRINT"))
+    lines = deck.read_text().splitlines()
+    at, pre = lines.index("9999, 1, -10.") + 1, lines.index("*PRE-TENSION SECTION, SURFACE=CUT, NODE=9999") + 1
+    imp = import_deck(deck, tmp_path / "a" / "p.toml")
+    assert f"{deck}:{pre}: *PRE-TENSION SECTION is not supported" in imp.unsupported
+    assert imp.unsupported[-1] == (f"{deck}:{at}: *CLOAD on 9999, the reference node of {deck}:{pre}: *PRE-TENSION "
+                                   "SECTION; with --ignore-unsupported the load is left out")
+    deck.write_text(deck.read_text().replace("9999, 1, -10.", "9998, 1, -10.").replace("9999, 0., 0., 0.",
+                                                                                      "9999, 0., 0., 0.\n9998, 1., 0., 0."))
+    with pytest.raises(DeckError, match=r"pret\.inp:\d+: \*CLOAD on nodes of no element \(9998\)"):
+        import_deck(deck, tmp_path / "b" / "p.toml")
+
+
 def test_node_line_without_coordinates_is_at_the_origin(tmp_path):
     """A *NODE line of its label alone (CalculiX's planestress3.inp) or with fewer than three coordinates: the rest
     are 0, as CalculiX's reader (nodes.f) sets them."""

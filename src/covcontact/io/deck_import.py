@@ -569,6 +569,11 @@ class _Writer:
                 return  # (moments act on reference nodes alone; what they refuse is listed)
             targets = self._node_targets(ld.target, labels, ld.where)
             if not targets and not rigid:
+                owner = [self.m.unsupported_nodes[int(n)] for n in ld.nodes if int(n) in self.m.unsupported_nodes]
+                if owner and len(owner) == ld.nodes.size:  # (the reference node of a keyword listed as unsupported)
+                    self.unsupported.append(f"{ld.where}: *CLOAD on {ld.target}, the reference node of {owner[0]}; "
+                                            f"with --ignore-unsupported the load is left out")
+                    return
                 raise DeckError(f"{ld.where}: *CLOAD on nodes of no element ({ld.target})")
             for body, set_name in targets:
                 if ld.dof == 3 and planar_dof3(self, body, ld.where, None, load=True):

@@ -127,6 +127,8 @@ class DeckModel:
     unsupported: list[str] = field(default_factory=list)
     #: surfaces named by unsupported keywords (left out of the meshes unless a contact pair or tie uses them)
     unsupported_surfaces: set[str] = field(default_factory=set)
+    #: reference nodes named by unsupported keywords (a *PRE-TENSION SECTION's NODE=): label -> "file:line: *KEYWORD"
+    unsupported_nodes: dict[int, str] = field(default_factory=dict)
     #: elements of types covcontact does not read (listed as unsupported): label -> type; and their nodes
     skipped_elements: dict[int, str] = field(default_factory=dict)
     skipped_nodes: set[int] = field(default_factory=set)
@@ -224,6 +226,8 @@ class _Reader(LoadCards):
                 m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
                 if c.params.get("SURFACE"):  # (a *PRE-TENSION SECTION's surface cuts through its body)
                     m.unsupported_surfaces.add(c.params["SURFACE"].upper())
+                if str(c.params.get("NODE", "")).strip().isdigit():  # (its reference node: loads on it act on nothing)
+                    m.unsupported_nodes[int(c.params["NODE"])] = f"{c.where()}: *{c.name}"
                 continue
             if c.name in COUPLING_CARDS:  # (deck_coupling checks its own parameters)
                 read_coupling_card(self, c, cards[k] if k < len(cards) else None)
