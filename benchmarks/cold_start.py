@@ -16,6 +16,7 @@ compiles on the way). Writes JSON.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import subprocess
@@ -42,31 +43,15 @@ def timed_run(problem: Path | None, cache: str) -> tuple[float, int, str]:
 
 
 def kernel_times(problem: Path) -> list[dict]:
-    """Compile time per kernel of one in-process run with an empty cache (a child process)."""
-    code = f"""
-import json, os, sys, tempfile, time
-os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp()
-from numba.core import event
-open_ = {{}}
-spent = {{}}
-class Timer(event.Listener):
-    def on_start(self, e):
-        open_[id(e)] = time.perf_counter()
-    def on_end(self, e):
-        d = e.data["dispatcher"].py_func
-        name = d.__module__ + "." + d.__qualname__
-        spent[name] = spent.get(name, 0.0) + time.perf_counter() - open_.pop(id(e), time.perf_counter())
-event.register("numba:compile", Timer())
-from covcontact.io.loader import load_problem
-with tempfile.TemporaryDirectory() as out:
-    load_problem({str(problem)!r}).run(out=out, quiet=True)
-print(json.dumps(spent))
-"""
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    import json
-
-    spent = json.loads(proc.stdout.strip().splitlines()[-1])
-    return [{"kernel": k, "seconds": round(v, 2)} for k, v in sorted(spent.items(), key=lambda kv: -kv[1])]
+    """Compile time per kernel of one run with an empty cache (benchmarks/compile_profile.py, a child process):
+    seconds inclusive of the kernels first compiled inside it, exclusive_s without them."""
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "kernels.json"
+        subprocess.run([sys.executable, str(Path(__file__).with_name("compile_profile.py")), "--problem", str(problem),
+                        "--out", str(out), "--top", "0"], capture_output=True, text=True, check=True)
+        rows = json.loads(out.read_text())["kernels"]
+    return [{"kernel": r["kernel"], "seconds": round(r["inclusive_s"], 2), "exclusive_s": round(r["exclusive_s"], 2)}
+            for r in sorted(rows, key=lambda r: -r["inclusive_s"])]
 
 
 def main() -> None:
