@@ -14,12 +14,13 @@ caller's module and optimises it there again (docs/performance.md, "Less to comp
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import subprocess
 import sys
 import tempfile
 import time
+
+from _report import emit
 
 _CHILD = "COVCONTACT_COMPILE_PROFILE_CHILD"
 
@@ -74,18 +75,11 @@ def main() -> int:
             env = dict(os.environ, NUMBA_CACHE_DIR=cache, COVCONTACT_KEEP_KERNEL_CACHE="1", **{_CHILD: "1"})
             return subprocess.run([sys.executable, *sys.argv], env=env, check=False).returncode
     out = profile(args.only, args.problem)
-    print(f"total {out['total_s']:.1f} s, compiling {out['compile_s']:.1f} s; exclusive / inclusive s, versions:",
-          file=sys.stderr)
-    for r in out["kernels"][: args.top]:
-        print(f"{r['exclusive_s']:8.1f} {r['inclusive_s']:8.1f} {r['compiles']:3d}  {r['kernel']}", file=sys.stderr)
-    text = json.dumps(out, indent=1)
-    if args.out:
-        with open(args.out, "w") as fh:
-            fh.write(text + "\n")
-    else:
-        print(text)
+    lines = [f"total {out['total_s']:.1f} s, compiling {out['compile_s']:.1f} s; exclusive / inclusive s, versions:"]
+    lines += [f"{r['exclusive_s']:8.1f} {r['inclusive_s']:8.1f} {r['compiles']:3d}  {r['kernel']}"
+              for r in out["kernels"][: args.top]]
+    emit(out, args.out, "\n".join(lines))
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())
