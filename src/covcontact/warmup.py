@@ -278,8 +278,9 @@ value = [0.01, -0.01]
 )
 
 #: groups of warm-up problems that share their costly kernels (indices into PROBLEMS) with the seconds each group
-#: takes to compile from a cold cache in one process (2 cores, 2026-12-07): a parallel compile gives each worker
-#: whole groups, the costliest first, so that no two workers compile the same element family
+#: took to compile from a cold cache in one process (2 cores, 2026-12-07, before the output-field kernels became
+#: serial: weights, not today's times): a parallel compile gives each worker whole groups, the costliest first, so
+#: that no two workers compile the same element family
 GROUPS: tuple[tuple[tuple[int, ...], float], ...] = (
     ((0, 1, 2), 108.0),  # solid elements, analytic masters, friction
     ((3, 4), 92.0),      # facets of deformable bodies and rigid meshes

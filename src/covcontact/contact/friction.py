@@ -344,19 +344,17 @@ def new_history() -> np.ndarray:
 
 def make_history(xi_n, traction=(0.0, 0.0), rho_n=(0.0, 0.0, 0.0), rho_cov_n=None) -> np.ndarray:
     """A valid history from its parts (rho_cov_n (2, 3) defaults to the unit axes e1, e2)."""
-    h = np.zeros(HIST_SIZE)
-    h[H_XI:H_XI + 2] = _as_points(xi_n, lambda s: s == (2,), "xi_n (expected (2,))")
-    h[H_RHO:H_RHO + 3] = _as_points(rho_n, lambda s: s == (3,), "rho_n (expected (3,))")
+    xi = _as_points(xi_n, lambda s: s == (2,), "xi_n (expected (2,))")
+    rho = _as_points(rho_n, lambda s: s == (3,), "rho_n (expected (3,))")
     rc = np.eye(3)[:2] if rho_cov_n is None else rho_cov_n
-    h[H_RHO_COV:H_RHO_COV + 6] = _as_points(rc, lambda s: s == (2, 3), "rho_cov_n (expected (2, 3))").ravel()
-    h[H_T:H_T + 2] = _as_points(traction, lambda s: s == (2,), "traction (expected (2,))")
-    h[H_FLAG] = 1.0
-    return h
+    rc = _as_points(rc, lambda s: s == (2, 3), "rho_cov_n (expected (2, 3))")
+    return _history(xi, _as_points(traction, lambda s: s == (2,), "traction (expected (2,))"), rho, rc)
 
 
 def _history(xi, t, rho, rc) -> np.ndarray:
-    """``make_history`` of arrays of the right shapes (xi (2,), t (2,), rho (3,), rc (2, 3)), unchecked: the inner
-    loops of the friction history (every new contact point at every residual of a step) call it."""
+    """The history of arrays of the right shapes (xi (2,), t (2,), rho (3,), rc (2, 3)), only their finiteness
+    checked: the inner loops of the friction history (every new contact point at every residual of a step) call it,
+    ``make_history`` after checking each part."""
     h = np.zeros(HIST_SIZE)
     h[H_XI:H_XI + 2] = xi
     h[H_RHO:H_RHO + 3] = rho

@@ -45,7 +45,7 @@ committed values are copied to a scratch array before the trial overwrites them)
 from __future__ import annotations
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import njit, prange
 
 from ..fem import cells as other_cells
 from ..fem.quadrature import gauss_tensor
@@ -347,7 +347,7 @@ def fbar_chunk(kind, params, form, volume, X, u, conn, e0, dNdxi, dNc, w, Pv, wa
 
 
 @njit(cache=True)
-def fbar_gauss_fields(kind, params, volume, X, u, conn, dNdxi, dNc, w, Pv, mode, out, nthreads, hist_n):
+def fbar_gauss_fields(kind, params, volume, X, u, conn, dNdxi, dNc, w, Pv, mode, out, hist_n):
     """Per-element Gauss-point quantities of F-bar hex8 (serial: see ``ElementBody._gauss_fields``).
 
     mode 0: out (ne, 1) strain energy int W(F_bar) dV (inf where det F or det F_c <= 0);
@@ -357,62 +357,59 @@ def fbar_gauss_fields(kind, params, volume, X, u, conn, dNdxi, dNc, w, Pv, mode,
     """
     ne = conn.shape[0]
     nen = conn.shape[1]
-    nblk = max(1, min(nthreads, ne))
-    for t in range(nblk):
-        lo, hi = block_range(t, ne, nblk)
-        Xe = np.empty((nen, 3))
-        ue = np.empty((nen, 3))
-        hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D = _work(nen, hist_n.shape[2])
-        hscr = np.empty(hist_n.shape[2])
-        Jb, G0, Mw, Hw = _projection_work(w.size, nen, Pv.shape[1])
-        for e in range(lo, hi):
-            gather(X, u, conn, e, Xe, ue)
-            for r in range(out.shape[1]):
-                out[e, r] = 0.0
-            detc, Jc = _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0)
-            if mode == 1:
-                out[e, 0] = detc
-                for gp in range(w.size):
-                    out[e, 0] = min(out[e, 0], _jacobian(Xe, dNdxi[gp], J0, Ji))
-                continue
+    Xe = np.empty((nen, 3))
+    ue = np.empty((nen, 3))
+    hn, J0, Ji, Fi, G, Gc, g, g0, q, F, Fc, Fb, S, D = _work(nen, hist_n.shape[2])
+    hscr = np.empty(hist_n.shape[2])
+    Jb, G0, Mw, Hw = _projection_work(w.size, nen, Pv.shape[1])
+    for e in range(ne):
+        gather(X, u, conn, e, Xe, ue)
+        for r in range(out.shape[1]):
+            out[e, r] = 0.0
+        detc, Jc = _centre(Xe, ue, dNc, J0, Ji, Gc, Fc, Fi, g0)
+        if mode == 1:
+            out[e, 0] = detc
+            for gp in range(w.size):
+                out[e, 0] = min(out[e, 0], _jacobian(Xe, dNdxi[gp], J0, Ji))
+            continue
+        if not (detc > 0.0):
+            continue
+        if volume != 0:
+            detc, Jc = _projected_dilatation(Xe, ue, dNdxi, w, Pv, J0, Ji, G, F, Fi, g, Jb, G0, Mw, Hw)
             if not (detc > 0.0):
                 continue
-            if volume != 0:
-                detc, Jc = _projected_dilatation(Xe, ue, dNdxi, w, Pv, J0, Ji, G, F, Fi, g, Jb, G0, Mw, Hw)
-                if not (detc > 0.0):
-                    continue
-            vol = 0.0
-            for gp in range(w.size):
-                det = _jacobian(Xe, dNdxi[gp], J0, Ji)
-                if not (det > 0.0):
-                    continue
-                _kinematics(dNdxi[gp], Ji, ue, G, F)
-                wd = w[gp] * det
-                vol += wd
-                J = inverse3(F, Fi)
-                if not (J > 0.0 and Jc > 0.0):
-                    if mode == 0:
-                        out[e, 0] = np.inf
-                    continue
-                phi = ((Jc if volume == 0 else Jb[gp]) / J) ** (1.0 / 3.0)
-                for i in range(3):
-                    for j in range(3):
-                        Fb[i, j] = phi * F[i, j]
+        vol = 0.0
+        for gp in range(w.size):
+            det = _jacobian(Xe, dNdxi[gp], J0, Ji)
+            if not (det > 0.0):
+                continue
+            _kinematics(dNdxi[gp], Ji, ue, G, F)
+            wd = w[gp] * det
+            vol += wd
+            J = inverse3(F, Fi)
+            if not (J > 0.0 and Jc > 0.0):
                 if mode == 0:
-                    out[e, 0] += wd * material_energy(kind, params, Fb)
-                    continue
-                for k in range(hn.shape[0]):
-                    hn[k] = hist_n[e, gp, k]
-                material_update(kind, params, Fb, hn, hscr, S, D)
-                add_cauchy_pk2(Fb, S, wd, out[e])
-                for I in range(6):
-                    i = _PAIRS[I, 0]
-                    j = _PAIRS[I, 1]
-                    c = Fb[0, i] * Fb[0, j] + Fb[1, i] * Fb[1, j] + Fb[2, i] * Fb[2, j]
-                    out[e, 12 + I] += wd * 0.5 * (c - (1.0 if i == j else 0.0))
-            if mode == 2 and vol > 0.0:
-                for r in range(18):
-                    out[e, r] /= vol
+                    out[e, 0] = np.inf
+                continue
+            phi = ((Jc if volume == 0 else Jb[gp]) / J) ** (1.0 / 3.0)
+            for i in range(3):
+                for j in range(3):
+                    Fb[i, j] = phi * F[i, j]
+            if mode == 0:
+                out[e, 0] += wd * material_energy(kind, params, Fb)
+                continue
+            for k in range(hn.shape[0]):
+                hn[k] = hist_n[e, gp, k]
+            material_update(kind, params, Fb, hn, hscr, S, D)
+            add_cauchy_pk2(Fb, S, wd, out[e])
+            for I in range(6):
+                i = _PAIRS[I, 0]
+                j = _PAIRS[I, 1]
+                c = Fb[0, i] * Fb[0, j] + Fb[1, i] * Fb[1, j] + Fb[2, i] * Fb[2, j]
+                out[e, 12 + I] += wd * 0.5 * (c - (1.0 if i == j else 0.0))
+        if mode == 2 and vol > 0.0:
+            for r in range(18):
+                out[e, r] /= vol
 
 
 # ----------------------------------------------------------------------------- body
@@ -501,5 +498,5 @@ class FbarBody(ElementBody):
 
     def _gauss_fields(self, u, mode, out, state) -> None:
         fbar_gauss_fields(self.material.kind, self.material.params, self.volume, self.X, u, self.cells, self.dNdxi,
-                          self.dNc, self.weights, self.Pv, mode, out, get_num_threads(), state["hist"])
+                          self.dNc, self.weights, self.Pv, mode, out, state["hist"])
 

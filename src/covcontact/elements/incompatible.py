@@ -32,7 +32,7 @@ history. docs/theory.md, section "Hexahedra with incompatible modes".
 from __future__ import annotations
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import njit, prange
 
 from ..fem.quadrature import gauss_tensor
 from ..fem.shapes import shape_functions
@@ -370,7 +370,7 @@ def incompatible_chunk(kind, params, X, u, conn, e0, alpha, dNdxi, dNc, pts, w, 
 
 
 @njit(cache=True)
-def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mode, out, nthreads, hist_n):
+def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mode, out, hist_n):
     """Per-element quantities at the solved mode parameters (alpha (ne, 9): the start, overwritten with the
     solution; the caller passes a copy), hist_n (ne, 8, nh) the committed history (read only).
 
@@ -379,60 +379,57 @@ def incompatible_fields(kind, params, X, u, conn, alpha, dNdxi, dNc, pts, w, mod
     Green-Lagrange strain of the enhanced F (Voigt); mode 3: out (ne, 48) the Cauchy stress at each Gauss point.
     """
     ne = conn.shape[0]
-    nblk = max(1, min(nthreads, ne))
-    for t in range(nblk):
-        lo, hi = block_range(t, ne, nblk)
-        Xe = np.empty((NEN, 3))
-        ue = np.empty((NEN, 3))
-        nh = hist_n.shape[2]
-        ws = _work(nh)
-        (Ue, Gt, wdv, J0, Ji, Jc, F, H, S, D, _T, _A, _Q, _Kt, _fa, _Kaa, _Kf, _h, _dal, _a0, _piv, _Xm, _hne) = ws
-        htr = np.empty((w.size, nh))
-        hscr = np.empty(nh)
-        fe = np.empty(3 * NEN)
-        Kdummy = np.empty((0, 0))
-        row = np.empty(18)
-        no = np.bool_(False)  # run-time value: _element compiled once (a literal False adds a version)
-        for e in range(lo, hi):
-            gather(X, u, conn, e, Xe, ue)
-            for r in range(out.shape[1]):
-                out[e, r] = 0.0
-            if mode == 1:
-                dmin = _jacobian(Xe, dNc, J0, Ji)
-                for g in range(w.size):
-                    dmin = min(dmin, _jacobian(Xe, dNdxi[g], J0, Ji))
-                out[e, 0] = dmin
-                continue
-            if _element(kind, params, Xe, ue, alpha[e], dNdxi, dNc, pts, w, no, Kdummy, fe, hist_n[e], htr,
-                        ws) != 0:
-                if mode == 0:
-                    out[e, 0] = np.inf
-                continue
-            vol = 0.0
+    Xe = np.empty((NEN, 3))
+    ue = np.empty((NEN, 3))
+    nh = hist_n.shape[2]
+    ws = _work(nh)
+    (Ue, Gt, wdv, J0, Ji, Jc, F, H, S, D, _T, _A, _Q, _Kt, _fa, _Kaa, _Kf, _h, _dal, _a0, _piv, _Xm, _hne) = ws
+    htr = np.empty((w.size, nh))
+    hscr = np.empty(nh)
+    fe = np.empty(3 * NEN)
+    Kdummy = np.empty((0, 0))
+    row = np.empty(18)
+    no = np.bool_(False)  # run-time value: _element compiled once (a literal False adds a version)
+    for e in range(ne):
+        gather(X, u, conn, e, Xe, ue)
+        for r in range(out.shape[1]):
+            out[e, r] = 0.0
+        if mode == 1:
+            dmin = _jacobian(Xe, dNc, J0, Ji)
             for g in range(w.size):
-                _displacement_gradient(Ue, Gt[g], F, H, True)
-                wd = wdv[g]
-                vol += wd
-                if mode == 0:
-                    out[e, 0] += wd * material_energy(kind, params, F)
-                    continue
-                material_update_h(kind, params, F, H, hist_n[e, g], hscr, S, D)
-                if mode == 3:
-                    for r in range(18):
-                        row[r] = 0.0
-                    add_cauchy_pk2(F, S, 1.0, row)
-                    for r in range(6):
-                        out[e, 6 * g + r] = row[r]
-                    continue
-                add_cauchy_pk2(F, S, wd, out[e])
-                for I in range(6):
-                    i = VOIGT_PAIRS[I, 0]
-                    j = VOIGT_PAIRS[I, 1]
-                    cm = H[i, j] + H[j, i] + H[0, i] * H[0, j] + H[1, i] * H[1, j] + H[2, i] * H[2, j]
-                    out[e, 12 + I] += wd * 0.5 * cm
-            if mode == 2 and vol > 0.0:
+                dmin = min(dmin, _jacobian(Xe, dNdxi[g], J0, Ji))
+            out[e, 0] = dmin
+            continue
+        if _element(kind, params, Xe, ue, alpha[e], dNdxi, dNc, pts, w, no, Kdummy, fe, hist_n[e], htr,
+                    ws) != 0:
+            if mode == 0:
+                out[e, 0] = np.inf
+            continue
+        vol = 0.0
+        for g in range(w.size):
+            _displacement_gradient(Ue, Gt[g], F, H, True)
+            wd = wdv[g]
+            vol += wd
+            if mode == 0:
+                out[e, 0] += wd * material_energy(kind, params, F)
+                continue
+            material_update_h(kind, params, F, H, hist_n[e, g], hscr, S, D)
+            if mode == 3:
                 for r in range(18):
-                    out[e, r] /= vol
+                    row[r] = 0.0
+                add_cauchy_pk2(F, S, 1.0, row)
+                for r in range(6):
+                    out[e, 6 * g + r] = row[r]
+                continue
+            add_cauchy_pk2(F, S, wd, out[e])
+            for I in range(6):
+                i = VOIGT_PAIRS[I, 0]
+                j = VOIGT_PAIRS[I, 1]
+                cm = H[i, j] + H[j, i] + H[0, i] * H[0, j] + H[1, i] * H[1, j] + H[2, i] * H[2, j]
+                out[e, 12 + I] += wd * 0.5 * cm
+        if mode == 2 and vol > 0.0:
+            for r in range(18):
+                out[e, r] /= vol
 
 
 # ----------------------------------------------------------------------------- body
@@ -510,7 +507,7 @@ class IncompatibleBody(ElementBody):
             hist_n = np.zeros((self.n_elements, self.weights.size, self.n_hist))
         alpha = state["alpha"].copy() if "alpha" in state else np.zeros((self.n_elements, NALPHA))
         incompatible_fields(self.material.kind, self.material.params, self.X, u, self.cells, alpha, self.dNdxi,
-                            self.dNc, self.points, self.weights, mode, out, get_num_threads(), hist_n)
+                            self.dNc, self.points, self.weights, mode, out, hist_n)
 
     def point_stresses(self, u: np.ndarray, state: dict | None = None) -> np.ndarray:
         """(nelem, 8, 6) Cauchy stress (Voigt 11, 22, 33, 12, 23, 13) at the Gauss points (the first direction of

@@ -5,7 +5,6 @@ decks"), from the same kernel that averages it over the element: called once per
 from __future__ import annotations
 
 import numpy as np
-from numba import get_num_threads
 
 from .composite import CompositeBody
 from .solid import SolidBody, solid_gauss_fields
@@ -35,7 +34,7 @@ def point_stresses(solid, u: np.ndarray, state: dict | None = None) -> np.ndarra
         if solid.n_elements:
             solid_gauss_fields(solid.material.kind, solid.material.params, solid.X, u, solid.cells,
                                np.ascontiguousarray(solid.dNdxi[g: g + 1]), np.ascontiguousarray(solid.weights[g: g + 1]),
-                               2, buf, get_num_threads(), np.ascontiguousarray(hist[:, g: g + 1]))
+                               2, buf, np.ascontiguousarray(hist[:, g: g + 1]))
         out[:, g] = buf[:, :6]
     return out
 

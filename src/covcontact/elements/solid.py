@@ -12,7 +12,7 @@ them to the CSR data array through the node-pair ranks of :class:`covcontact.ass
 from __future__ import annotations
 
 import numpy as np
-from numba import get_num_threads, njit, prange
+from numba import njit, prange
 
 from ..fem import cells as other_cells
 from ..fem.quadrature import DEFAULT_RULE, gauss_tensor
@@ -225,7 +225,7 @@ def solid_chunk(kind, params, X, u, conn, e0, dNdxi, w, want_K, Ke, fe, flags, n
 
 
 @njit(cache=True)
-def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, hist_n):
+def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, hist_n):
     """Per-element Gauss-point quantities (serial: see ``ElementBody._gauss_fields``).
 
     mode 0: out (ne, 1) strain energy int W dV; mode 1: out (ne, 1) minimum det J0;
@@ -234,43 +234,40 @@ def solid_gauss_fields(kind, params, X, u, conn, dNdxi, w, mode, out, nthreads, 
     """
     ne = conn.shape[0]
     nen = conn.shape[1]
-    nblk = min(nthreads, ne)
-    for t in range(nblk):
-        lo, hi = block_range(t, ne, nblk)
-        Xe, ue, G, J0, Ji, F, S, D = _work(nen)
-        H = np.empty((3, 3))
-        hscr = np.empty(hist_n.shape[2])
-        for e in range(lo, hi):
-            gather(X, u, conn, e, Xe, ue)
-            for r in range(out.shape[1]):
-                out[e, r] = 0.0
+    Xe, ue, G, J0, Ji, F, S, D = _work(nen)
+    H = np.empty((3, 3))
+    hscr = np.empty(hist_n.shape[2])
+    for e in range(ne):
+        gather(X, u, conn, e, Xe, ue)
+        for r in range(out.shape[1]):
+            out[e, r] = 0.0
+        if mode == 1:
+            out[e, 0] = np.inf
+        vol = 0.0
+        for g in range(w.size):
+            det = _jacobian(Xe, dNdxi[g], J0, Ji)
             if mode == 1:
-                out[e, 0] = np.inf
-            vol = 0.0
-            for g in range(w.size):
-                det = _jacobian(Xe, dNdxi[g], J0, Ji)
-                if mode == 1:
-                    out[e, 0] = min(out[e, 0], det)
-                    continue
-                if det <= 0.0:
-                    continue
-                _kinematics(dNdxi[g], Ji, ue, G, F)
-                wd = w[g] * det
-                vol += wd
-                if mode == 0:
-                    out[e, 0] += wd * material_energy(kind, params, F)
-                    continue
-                _displacement_gradient(ue, G, F, H, False)
-                material_update_h(kind, params, F, H, hist_n[e, g], hscr, S, D)
-                add_cauchy_pk2(F, S, wd, out[e])
-                for I in range(6):
-                    i = _PAIRS[I, 0]
-                    j = _PAIRS[I, 1]
-                    cm = H[i, j] + H[j, i] + H[0, i] * H[0, j] + H[1, i] * H[1, j] + H[2, i] * H[2, j]
-                    out[e, 12 + I] += wd * 0.5 * cm
-            if mode == 2 and vol > 0.0:
-                for r in range(18):
-                    out[e, r] /= vol
+                out[e, 0] = min(out[e, 0], det)
+                continue
+            if det <= 0.0:
+                continue
+            _kinematics(dNdxi[g], Ji, ue, G, F)
+            wd = w[g] * det
+            vol += wd
+            if mode == 0:
+                out[e, 0] += wd * material_energy(kind, params, F)
+                continue
+            _displacement_gradient(ue, G, F, H, False)
+            material_update_h(kind, params, F, H, hist_n[e, g], hscr, S, D)
+            add_cauchy_pk2(F, S, wd, out[e])
+            for I in range(6):
+                i = _PAIRS[I, 0]
+                j = _PAIRS[I, 1]
+                cm = H[i, j] + H[j, i] + H[0, i] * H[0, j] + H[1, i] * H[1, j] + H[2, i] * H[2, j]
+                out[e, 12 + I] += wd * 0.5 * cm
+        if mode == 2 and vol > 0.0:
+            for r in range(18):
+                out[e, r] /= vol
 
 
 def _rule(cell_type: str, rule) -> tuple[np.ndarray, np.ndarray]:
@@ -327,4 +324,4 @@ class SolidBody(ElementBody):
 
     def _gauss_fields(self, u, mode, out, state) -> None:
         solid_gauss_fields(self.material.kind, self.material.params, self.X, u, self.cells, self.dNdxi,
-                           self.weights, mode, out, get_num_threads(), state["hist"])
+                           self.weights, mode, out, state["hist"])

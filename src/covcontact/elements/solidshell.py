@@ -36,7 +36,6 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import get_num_threads
 
 from ..fem.quadrature import DEFAULT_RULE, gauss_1d, gauss_tensor
 from ..fem.shapes import NODES, shape_functions
@@ -422,4 +421,4 @@ class SolidShellBody(ElementBody):
         alpha = state["alpha"].copy()  # the local EAS solve writes its result: not into the caller's state
         solidshell_fields(self.material.kind, self.material.params, self.X, u, self.cells, alpha, self.dNp,
                           self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
-                          mode, out, get_num_threads(), hist_n)
+                          mode, out, hist_n)

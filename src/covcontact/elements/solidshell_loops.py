@@ -61,7 +61,7 @@ def solidshell_chunk(kind, params, X, u, conn, e0, alpha, dNp, dNc, w, tie_ptr, 
 
 @njit(cache=True)
 def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val,
-                      mode, out, nthreads, hist_n):
+                      mode, out, hist_n):
     """Per-element quantities at the solved EAS parameters, with hist_n (ne, ng, nh) as the committed
     material history (read only; the trial goes to scratch).
 
@@ -73,59 +73,56 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
     nen = conn.shape[1]
     npt = dNp.shape[0]
     ng = w.size
-    nblk = max(1, min(nthreads, ne))
-    for t in range(nblk):
-        lo, hi = block_range(t, ne, nblk)
-        Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
-        hne = np.empty((ng, hist_n.shape[2]))
-        htr = np.empty((ng, hist_n.shape[2]))
-        Gx = np.empty((nen, 3))
-        Fc = np.empty((3, 3))
-        Gp, gp, _sig = ws3
-        Tg, D = ws4
-        Ep, S, Et, Ec = ws2
-        Gam, detg = wsg
-        J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua, piv = wv
-        for e in range(lo, hi):
-            gather(X, u, conn, e, Xe, ue)
-            for r in range(out.shape[1]):
-                out[e, r] = 0.0
-            if mode == 1:
-                dmin = _jacobian(Xe, dNc, J0, Ji)
-                for p in range(npt):
-                    dmin = min(dmin, _jacobian(Xe, dNp[p], J0, Ji))
-                out[e, 0] = dmin
-                continue
-            flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
-                            Gam, detg, J0, Ji, T0, En, F)
-            for g in range(ng):
-                for k in range(hne.shape[1]):
-                    hne[g, k] = hist_n[e, g, k]
-            if flag != FLAG_REFERENCE:
-                f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F,
-                                  hne, htr, piv)
-                if f2 != 0:
-                    flag = f2
-            if flag != 0 and (mode == 0 or flag != FLAG_INVERTED):
-                if mode == 0:
+    Xe, ue, ws3, ws4, ws2, wsg, wv = _scratch(conn, dNp, w, eas_comp)
+    hne = np.empty((ng, hist_n.shape[2]))
+    htr = np.empty((ng, hist_n.shape[2]))
+    Gx = np.empty((nen, 3))
+    Fc = np.empty((3, 3))
+    Gp, gp, _sig = ws3
+    Tg, D = ws4
+    Ep, S, Et, Ec = ws2
+    Gam, detg = wsg
+    J0, Ji, T0, F, En, h, H, Hf, dal, _a0, _x, _Bn, _Bc, _DB, _DG, _Kua, piv = wv
+    for e in range(ne):
+        gather(X, u, conn, e, Xe, ue)
+        for r in range(out.shape[1]):
+            out[e, r] = 0.0
+        if mode == 1:
+            dmin = _jacobian(Xe, dNc, J0, Ji)
+            for p in range(npt):
+                dmin = min(dmin, _jacobian(Xe, dNp[p], J0, Ji))
+            out[e, 0] = dmin
+            continue
+        flag = _prepare(Xe, ue, dNp, dNc, w, tie_ptr, tie_pt, tie_w, eas_comp, eas_val, Gp, gp, Ep, Tg, Ec,
+                        Gam, detg, J0, Ji, T0, En, F)
+        for g in range(ng):
+            for k in range(hne.shape[1]):
+                hne[g, k] = hist_n[e, g, k]
+        if flag != FLAG_REFERENCE:
+            f2 = _local_solve(kind, params, w, Ec, Gam, detg, alpha[e], S, D, h, H, Hf, dal, Et, F,
+                              hne, htr, piv)
+            if f2 != 0:
+                flag = f2
+        if flag != 0 and (mode == 0 or flag != FLAG_INVERTED):
+            if mode == 0:
+                out[e, 0] = np.inf
+            continue
+        vol = 0.0
+        for g in range(ng):
+            wd = w[g] * detg[g]
+            vol += wd
+            if mode == 0:
+                if _stretch(Et[g], F):
+                    out[e, 0] += wd * material_energy(kind, params, F)
+                else:
                     out[e, 0] = np.inf
                 continue
-            vol = 0.0
-            for g in range(ng):
-                wd = w[g] * detg[g]
-                vol += wd
-                if mode == 0:
-                    if _stretch(Et[g], F):
-                        out[e, 0] += wd * material_energy(kind, params, F)
-                    else:
-                        out[e, 0] = np.inf
-                    continue
-                # Cauchy stress with the compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
-                _jacobian(Xe, dNp[g], J0, Ji)
-                _kinematics(dNp[g], Ji, ue, Gx, Fc)
-                add_cauchy_pk2(Fc, S[g], wd, out[e])
-                for I in range(6):
-                    out[e, 12 + I] += wd * (Et[g, I] if I < 3 else 0.5 * Et[g, I])
-            if mode == 2 and vol > 0.0:
-                for r in range(18):
-                    out[e, r] /= vol
+            # Cauchy stress with the compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
+            _jacobian(Xe, dNp[g], J0, Ji)
+            _kinematics(dNp[g], Ji, ue, Gx, Fc)
+            add_cauchy_pk2(Fc, S[g], wd, out[e])
+            for I in range(6):
+                out[e, 12 + I] += wd * (Et[g, I] if I < 3 else 0.5 * Et[g, I])
+        if mode == 2 and vol > 0.0:
+            for r in range(18):
+                out[e, r] /= vol
