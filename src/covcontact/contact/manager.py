@@ -71,6 +71,9 @@ class ContactManager:
         self.symmetric = not any(p.mu > 0.0 for p in self.passes)
         self.timing = {"search": 0.0, "projection": 0.0}
         self._cache: list[_SearchCache | None] = [None] * len(self.passes)
+        # per pass: the friction histories moved onto new facets (``_facet_history``) for the committed state they
+        # came from, so that the residuals of a step compute each once
+        self._moved: list[tuple | None] = [None] * len(self.passes)
         self._rigid: tuple[float, np.ndarray] | None = None
         self.enabled = [True] * len(self.passes)  # pairs switched on (stages may switch them)
         # rigid bodies with a reference node: their nodes' rows and columns are mapped onto the node pair
@@ -242,7 +245,7 @@ class ContactManager:
             facet_conn = np.ascontiguousarray(conn[:, :nen])
             slaves = np.ascontiguousarray(conn[:, nen])
             if p.mu > 0.0:
-                hist = self._facet_history(p, c, idx, t.facet[idx], xi,
+                hist = self._facet_history(k, p, c, idx, t.facet[idx], xi,
                                            self._x_start if x_commit is None else x_commit)
                 hist_out = np.zeros_like(hist)
                 state = np.zeros(idx.size, dtype=np.int64)
@@ -374,27 +377,46 @@ class ContactManager:
         for c, r, k in map_rigid_nodes(conn, R, K, self.owner, self.reference, self._poses, xe):
             blocks.add(c, r, k)
 
-    @staticmethod
-    def _facet_history(p: Pass, c: PassState, idx, facets, xi, x_commit) -> np.ndarray:
+    def _facet_history(self, k: int, p: Pass, c: PassState, idx, facets, xi, x_commit) -> np.ndarray:
         """Committed friction history of slaves ``idx`` moved onto their current facets; a slave new to contact (no
         history) sticks from where the step found it: its projection on its facet in the committed configuration,
-        zero traction (so a contact that closes in a step carries friction in that step already)."""
+        zero traction (so a contact that closes in a step carries friction in that step already).
+
+        What a slave's history becomes on a facet depends on the committed state only (``xi``, the current contact
+        point, is where the projections start), so each (slave, facet) is worked out once per committed state and
+        reused by the step's later residuals."""
         hist = c.hist[idx].copy()
-        if x_commit is not None:
-            for j in np.flatnonzero(hist[:, -1] == 0.0):
-                hist[j] = start_history(x_commit[p.surface.faces[facets[j]]], x_commit[p.slaves[idx[j]]], xi[j],
-                                        float(p.eps_t[idx[j]]))
-        moved = np.flatnonzero((hist[:, -1] > 0.0) & (c.hist_facet[idx] != facets))
-        for j in moved:
-            if x_commit is None:
-                hist[j] = 0.0
-                continue
-            try:  # (the slave's tangential penalty: an old point far off the new facet is anchored on it)
-                hist[j] = transfer_history(hist[j], x_commit[p.surface.faces[facets[j]]], xi[j],
-                                           float(p.eps_t[idx[j]]))
-            except ValueError:
-                hist[j] = 0.0
+        moved = c.hist_facet[idx] != facets
+        if x_commit is None:
+            hist[moved & (hist[:, -1] > 0.0)] = 0.0
+            return hist
+        memo = self._moved[k]
+        if memo is None or memo[0] is not c or memo[1] is not x_commit or memo[2] is not p.eps_t:
+            memo = self._moved[k] = (c, x_commit, p.eps_t, {})
+        done = memo[3]
+        for j in np.flatnonzero(moved | (hist[:, -1] == 0.0)):
+            key = (int(idx[j]), int(facets[j]))
+            h = done.get(key)
+            if h is None:
+                h = done[key] = self._moved_history(p, hist[j], bool(moved[j]), int(idx[j]), int(facets[j]), xi[j],
+                                                    x_commit)
+            hist[j] = h
         return hist
+
+    @staticmethod
+    def _moved_history(p: Pass, h, moved: bool, i: int, facet: int, xi, x_commit) -> np.ndarray:
+        """The history ``h`` of slave ``i`` on ``facet``: started where it has none, transferred where it was kept on
+        another facet."""
+        xyz = x_commit[p.surface.faces[facet]]
+        eps_t = float(p.eps_t[i])
+        if h[-1] == 0.0:
+            h = start_history(xyz, x_commit[p.slaves[i]], xi, eps_t)
+        if h[-1] > 0.0 and moved:
+            try:  # (the slave's tangential penalty: an old point far off the new facet is anchored on it)
+                h = transfer_history(h, xyz, xi, eps_t)
+            except ValueError:
+                h = np.zeros_like(h)
+        return h
 
     def _analytic_pass(self, p: Pass, xe, lam, case, c: PassState, t: PassState, want_K, want_parts,
                        ev: ContactEvaluation) -> None:
