@@ -257,23 +257,3 @@ def test_fit_material_command(tmp_path, capsys):
     assert "c11 = " in cap.out and "warning:" in cap.err and "uniaxial tension from nominal strain" in cap.err
     with pytest.raises(FitError):
         fit("ogden", _treloar(), 0)
-
-
-def test_deck_test_data_input_is_refused_in_one_line(tmp_path):
-    """*HYPERELASTIC, ..., TEST DATA INPUT (with *UNIAXIAL TEST DATA below it) is refused at the card in one line."""
-    from covcontact.io.deck import DeckError
-    from covcontact.io.deck_import import import_deck
-
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("rubber_decks", Path(__file__).with_name("test_rubber_decks.py"))
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    DECK = mod.CUBE
-    deck = tmp_path / "cube.inp"
-    deck.write_text(DECK.replace("HYPERCARD", "*HYPERELASTIC, OGDEN, N=3, TEST DATA INPUT\n*UNIAXIAL TEST DATA\n"
-                                 "0.14, 0.12\n0.23, 0.24\n0.32, 0.39"))
-    with pytest.raises(DeckError) as err:
-        import_deck(deck, tmp_path / "p.toml")
-    msg = str(err.value)
-    assert "\n" not in msg and "cube.inp:" in msg and "TEST DATA INPUT" in msg and "fit-material" in msg

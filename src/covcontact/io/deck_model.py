@@ -21,6 +21,8 @@ from .deck_planar import element_names
 from .deck_shells import (SHELL_CARDS, SHELL_ELEMENTS, read_shell_card, read_shell_elements, refuse_shell_type,
                           shell_surface_row)
 from .deck_springs import BEAMS, SPRING_CARDS, SPRING_ELEMENTS, read_spring_card, read_spring_elements
+from .deck_testdata import (TEST_DATA_CARDS, finish_test_data, is_test_data_input, read_test_data_card,
+                            start_test_data)
 
 # the element types read and their cells (deck_elements: the deck modules share them without an import cycle)
 
@@ -31,7 +33,7 @@ SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY",
-             "TIME POINTS", "SECTION PRINT") + COUPLING_CARDS + SHELL_CARDS
+             "TIME POINTS", "SECTION PRINT") + COUPLING_CARDS + SHELL_CARDS + TEST_DATA_CARDS
 #: keywords only Abaqus reads: a deck with one of them is read in Abaqus' dialect (import_deck's "auto")
 _ABAQUS_ONLY = ("PART", "END PART", "ASSEMBLY", "END ASSEMBLY", "INSTANCE", "END INSTANCE")
 #: output requests: accepted; the .dat tabulates what _print lists for *NODE PRINT, *EL PRINT, *CONTACT PRINT and
@@ -235,6 +237,9 @@ class _Reader(LoadCards):
             if c.name in SHELL_CARDS:  # (*SHELL SECTION, *NODAL THICKNESS: deck_shells)
                 read_shell_card(self, c)
                 continue
+            if c.name in TEST_DATA_CARDS:  # (*UNIAXIAL TEST DATA, ...: deck_testdata)
+                read_test_data_card(self, c)
+                continue
             self._check_params(c)
             if c.name == "HEADING":
                 m.heading = " ".join(c.data)[:200]
@@ -390,6 +395,7 @@ class _Reader(LoadCards):
                 self._print(c)
         if self.step is not None:
             raise DeckError(f"{self.step.where}: *STEP without its *END STEP")
+        finish_test_data(m)
         self._nodes_ready(nodes, coords)
 
     # -- helpers ---------------------------------------------------------------------------------
@@ -404,7 +410,7 @@ class _Reader(LoadCards):
                     c.name == "EQUATION" and p in ("REMOVE", "REMOVE ALL")) or (
                     c.name == "SOLID SECTION" and p == "OFFSET") or (
                     c.name == "PLASTIC" and p == "HARDENING") or (c.name == "SECTION PRINT" and p == "SURFACE") or (
-                    c.name == "HYPERELASTIC" and (p == "N" or _rubber_option(p) is not None)):
+                    c.name == "HYPERELASTIC" and (p in ("N", "POISSON", "TEST DATA INPUT") or _rubber_option(p))):
                 continue
             self.m.unsupported.append(f"{c.where()}: *{c.name}, {p}{'=' + c.params[p] if c.params[p] else ''} is not "
                                       f"supported")
@@ -738,10 +744,6 @@ class _Reader(LoadCards):
         if self.material is None:
             raise c.fail("comes before any *MATERIAL")
         mat = self.m.materials[self.material]
-        if any(" ".join(p.upper().split()) == "TEST DATA INPUT" for p in c.params):
-            raise c.fail("TEST DATA INPUT: constants fitted from *UNIAXIAL, *BIAXIAL and *PLANAR TEST DATA are not "
-                         "read from decks; fit them with `covcontact fit-material` (test_data, docs/input.md) and give "
-                         "them on the data line")
         models = [m for m in (_rubber_option(p) for p in c.params) if m is not None]
         if len(models) > 1:
             raise c.fail(f"names {len(models)} models; give one of ARRUDA-BOYCE, MOONEY-RIVLIN, NEO HOOKE, OGDEN, "
@@ -758,6 +760,12 @@ class _Reader(LoadCards):
             raise c.fail(f"N={N} is for OGDEN, POLYNOMIAL and REDUCED POLYNOMIAL")
         if N > 6:
             raise c.fail(f"N={N}: the order is at most 6")
+        if is_test_data_input(c):  # (constants fitted to *UNIAXIAL, *BIAXIAL, *PLANAR TEST DATA: deck_testdata)
+            start_test_data(self, c, mat, model, N)
+            return
+        if "POISSON" in c.params:
+            raise c.fail("POISSON= sets the compressibility of constants fitted to test data (TEST DATA INPUT); with "
+                         "the constants on the data line give D1 there")
         rows = c.rows()
         if not rows:
             raise c.fail("needs a data line")

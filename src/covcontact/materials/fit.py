@@ -641,7 +641,8 @@ def _d_keys(model: str) -> tuple:
 
 def fitted_material(model: str, keys: dict, base: Path, density: float | None = None, name: str = ""):
     """A Rubber fitted to the test data of a problem file's material table (``keys``: everything but ``model`` and
-    ``density``: test_data, n, error and the compressibilities d1.. (d for Ogden and Arruda-Boyce)). The Rubber's
+    ``density``: test_data, n, error and the compressibilities d1.. (d for Ogden and Arruda-Boyce), or ``poisson``, the
+    initial Poisson's ratio they follow from with the fitted mu0, as Abaqus's POISSON=). The Rubber's
     ``fitted`` holds the report lines (the constants, the errors, the stability verdict; lines that begin with
     'warning: ' are warnings). Raises FitError or RubberError naming the key."""
     keys = dict(keys)
@@ -653,6 +654,7 @@ def fitted_material(model: str, keys: dict, base: Path, density: float | None = 
     if not isinstance(error, str):
         raise FitError("must be \"relative\" or \"absolute\"", "error")
     dk = _d_keys(model)
+    poisson = keys.pop("poisson", None)
     d = {}
     for k in list(keys):
         if k in dk:
@@ -660,15 +662,30 @@ def fitted_material(model: str, keys: dict, base: Path, density: float | None = 
     if keys:
         k = sorted(keys)[0]
         raise FitError(f"with test_data the constants are fitted: give test_data, n, error and {', '.join(dk[:2])}"
-                       f"{', ...' if len(dk) > 2 else ''} (the compressibility) only", k)
-    if not d:
+                       f"{', ...' if len(dk) > 2 else ''} or poisson (the compressibility) only", k)
+    if poisson is not None:
+        if d:
+            raise FitError(f"give the compressibility once: poisson or {dk[0]}", "poisson")
+        if isinstance(poisson, bool) or not isinstance(poisson, (int, float)) or not -1.0 < poisson < 0.5:
+            raise FitError(f"must be a number in (-1, 0.5) (0.5, incompressible, needs a mixed formulation covcontact "
+                           f"does not have: e.g. 0.495), got {poisson!r}", "poisson")
+    elif not d:
         raise FitError(f"missing required key: the fit is incompressible; give the compressibility ({dk[0]} > 0, e.g. "
-                       f"{dk[0]} = 2 / (1000 mu0) for K0 = 1000 mu0)", dk[0])
+                       f"{dk[0]} = 2 / (1000 mu0) for K0 = 1000 mu0, or poisson = 0.4995)", dk[0])
     f = fit(model, tests, n, error)
+    notes = list(f.notes)
+    if poisson is not None:  # (as Abaqus's POISSON=: D1 = 2 / K0 from the fitted mu0, the higher D_i zero)
+        if not f.mu0 > 0.0:
+            raise FitError(f"the fitted initial shear modulus mu0 = {f.mu0:.6g} is not positive: no compressibility "
+                           f"follows from poisson (fit another model or order to these data)", "test_data")
+        d1 = 3.0 * (1.0 - 2.0 * poisson) / (f.mu0 * (1.0 + poisson))
+        d = {"d": [d1] if model == "ogden" else d1} if dk == ("d",) else {"d1": d1}
+        notes.append(f"compressibility from Poisson's ratio {poisson:g}: D1 = 3 (1 - 2 nu) / (mu0 (1 + nu)) = "
+                     f"{d1:.6g} (K0 = {2.0 / d1:.6g})")
     m = f.rubber(d, density)
     lines = [f"{name + ': ' if name else ''}{f.lines()[0]}", *f.lines()[1:]]
     lines += [f"warning: {name + ': ' if name else ''}{w}" for w in f.warnings]
-    lines += [f"  {x}" for x in f.notes]
+    lines += [f"  {x}" for x in notes]
     object.__setattr__(m, "fitted", tuple(lines))
     object.__setattr__(m, "fit", f)
     return m
