@@ -195,3 +195,18 @@ def test_a_cycling_iteration_is_recognised():
     assert _cycle([1.0, 2.0, 1.5] * 2) == 0  # two periods are not enough
     assert _cycle([2.0 * 0.9 ** k for k in range(20)]) == 0  # falling
     assert _cycle([1.0, 2.0, 1.5, 2.0, 1.5 * (1 + 1e-5), 2.0, 1.5, 2.0]) == 0  # a period differs beyond 1e-6
+
+
+def test_a_diverging_iteration_is_recognised():
+    """Residual norms that grew in three iterations in a row to above the step's reference, from the fourth iteration
+    on, lead away (an extrapolated start of a plastic wire bent round a tool, measured: 411, 140, 79, 139, 130, 187,
+    234, 370, 706, ... for 24 iterations); a contact step that rises twice and then converges (10.7, 19.1, 1.2e-2,
+    0.14, 60, 1.4e-2, 1.4e-7, measured on two blocks) and a rise that stays below the reference do not."""
+    from covcontact.solvers.newton import _diverging
+
+    wire = [411.1, 139.6, 78.8, 138.9, 129.9, 187.1, 233.9, 370.2, 706.1]
+    assert [_diverging(wire[:k], 411.1) for k in range(5, 10)] == [False, False, False, False, True]
+    blocks = [10.7, 19.1, 1.16e-2, 0.139, 60.0, 1.36e-2, 1.37e-7]
+    assert not any(_diverging(blocks[:k], 19.1) for k in range(2, 8))
+    assert not _diverging([1.0, 0.5, 0.1, 0.2, 0.3, 0.4], 1.0)  # three rises, below the reference
+    assert _diverging([1.0, 0.5, 0.1, 0.2, 0.3, 1.4], 1.0)

@@ -48,8 +48,18 @@ from .linear import LinearSolverError, SingularMatrixError, gmres_right, make_so
 #: from this iteration on, a step whose residuals repeat with a period of up to CYCLE_PERIOD iterations three
 #: times over (to CYCLE_RTOL) is given up as cycling instead of iterating on to max_iterations
 CYCLE_FROM = 10
+#: from this iteration on (CalculiX's I_0), a residual that grew in three iterations in a row to above the step's
+#: reference max(||R_0||, ||R_1||) ends the attempt as diverging
+DIVERGING_FROM = 4
 CYCLE_PERIOD = 4
 CYCLE_RTOL = 1e-6
+
+
+def _diverging(rs: list, ref: float) -> bool:
+    """Whether residual norms ``rs`` (R_0, R_1, ...) lead away: from iteration DIVERGING_FROM on, the last one is above
+    ``ref`` and grew in three iterations in a row. (CalculiX and Abaqus cut back after two rises in a row; a contact
+    step can rise twice, far above its start, and then converge quadratically.)"""
+    return len(rs) > DIVERGING_FROM and rs[-1] > ref and rs[-1] > rs[-2] > rs[-3] > rs[-4]
 
 
 def _cycle(rs: list) -> int:
@@ -440,6 +450,10 @@ class Newton:
                                                self._changes(codes_prev, codes)))
             if not np.isfinite(rn) or (it >= 3 and rn > opt.divergence_factor * max(r0, opt.atol * scale)):
                 out.reason = f"diverged (residual {rn:.3e} against {r0:.3e})"
+                return out, trial
+            if _diverging(out.residual_norms, max(r_ref, opt.atol * scale)):  # (retried or cut back)
+                out.reason = (f"diverging (the residual grew in three iterations in a row, to {rn:.3e}, above the "
+                              f"step's {r_ref:.3e})")
                 return out, trial
             period = _cycle(out.residual_norms) if it >= CYCLE_FROM else 0
             if period:  # the iteration goes round in a circle (an active set that cycles): cut back now
