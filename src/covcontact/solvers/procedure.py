@@ -46,7 +46,8 @@ class AutomaticIncrements:
     """Increments of the load factor chosen as the steps go (``[steps] initial, min, max``), in the manner of
     Abaqus/Standard: start with ``initial``; after ``EASY_STEPS`` steps in a row that converged without a
     cutback in at most ``EASY_ITERATIONS`` iterations, grow by ``GROW``; after a step that needed more than
-    ``HARD_ITERATIONS``, or more than ``EASY_ITERATIONS`` while more than ``SET_CHANGE`` of the active slave
+    ``HARD_ITERATIONS`` (counting every attempt at the increment: a failed extrapolated start retried from the tangent
+    made the step hard, however quickly the retry converged), or more than ``EASY_ITERATIONS`` while more than ``SET_CHANGE`` of the active slave
     nodes (and more than ``SET_CHANGE_MIN``) opened or closed, or more than ``ZONE_CHANGE`` of the yielding
     Gauss points started or stopped yielding, shrink by ``SHRINK``; after a step that needed cutbacks, go on
     with the increment that finally converged; never below ``min`` (Newton's cutbacks stop there) nor above ``max``; the last step
@@ -92,7 +93,7 @@ class AutomaticIncrements:
         cutbacks the last one is the size that worked)."""
         if self._settled(inc, converged):
             return
-        its = inc.outcomes[-1].iterations
+        its = inc.iterations  # (every attempt: a failed extrapolated start retried from the tangent counts)
         moved = (inc.opened_closed > max(self.SET_CHANGE_MIN, self.SET_CHANGE * inc.active)
                  or inc.plastic_changed > max(self.SET_CHANGE_MIN, self.ZONE_CHANGE * inc.yielding))
         if its > self.EASY_ITERATIONS and moved:
