@@ -89,7 +89,8 @@ class ContactPair:
     master: (body name, face set name) of a deformable or rigid meshed body, or (rigid body name, "")
     for an analytic surface.
     penalty: eps_N, or "auto" (``auto_factor`` times Young's modulus over the facet size of the master
-    body, or of the slave body against a rigid master; times the tributary area for "nodal" weighting).
+    body, or of the slave body against a rigid master; times the tributary area for "nodal" weighting; a tied
+    pair: 100 times the larger modulus over the smaller mean shortest facet edge of its two surfaces).
     method: "penalty", or "augmented" (Uzawa updates of per-node multipliers after each converged step
     until the largest penetration is below ``gap_tolerance``, absolute, or ``gap_tolerance_relative``
     times the mean master facet size; at most ``max_augmentations`` updates per step).
@@ -109,7 +110,7 @@ class ContactPair:
     gap_tolerance: float | None = None
     gap_tolerance_relative: float | None = None
     max_augmentations: int = 20
-    auto_factor: float = 10.0
+    auto_factor: float | None = None   # None: 10, or 100 for law "tied" (penalty "auto")
     enabled: bool = True               # off: the pair does nothing until a stage switches it on
     smoothing: float = 0.0             # width of the band of gaps over which the normal law is rounded (C1)
     law: str = "penalty"               # normal law: "penalty" (with ``smoothing``), "exponential", "arctan", "table"
@@ -124,6 +125,13 @@ class ContactPair:
     self_surfaces: tuple | None = None  # self-contact: the (body, face set) surfaces merged into one
     tie_tolerance: float | None = None  # law "tied": largest distance of a tied point (None: 5 % facet size)
     adjust: float | str | None = None  # slave nodes moved onto the master before the first step: below this gap, or a node set
+
+    def penalty_factor(self) -> float:
+        """The factor of ``penalty = "auto"``: ``auto_factor``, else 10 (100 for a tied pair: a tie has no active set
+        to chatter, only the conditioning to mind, and stands for CalculiX's exact equations)."""
+        if self.auto_factor is not None:
+            return float(self.auto_factor)
+        return 100.0 if self.law == "tied" else 10.0
 
 
 @dataclass

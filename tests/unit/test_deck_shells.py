@@ -294,3 +294,96 @@ def test_symmetry_plane_maps_onto_both_layers(tmp_path):
                       tmp_path / "r" / "r.toml")
     toml = imp.problem.read_text()
     assert toml.count("[[equation]]") == 2 * 2 and "[[dirichlet]]" not in toml
+
+
+TIED_EDGE = """*NODE, NSET=NALL
+1, 0.0, 0.0, 0.0
+2, 1.0, 0.0, 0.0
+3, 1.0, 1.0, 0.0
+4, 0.0, 1.0, 0.0
+5, 0.0, 0.0, 1.0
+6, 1.0, 0.0, 1.0
+7, 1.0, 1.0, 1.0
+8, 0.0, 1.0, 1.0
+11, 1.0, 0.0, 0.5
+12, 2.0, 0.0, 0.5
+13, 2.0, 1.0, 0.5
+14, 1.0, 1.0, 0.5
+15, 3.0, 0.0, 0.5
+16, 3.0, 1.0, 0.5
+*ELEMENT, TYPE=C3D8, ELSET=SOLID
+1, 1, 2, 3, 4, 5, 6, 7, 8
+*ELEMENT, TYPE=S4, ELSET=SHELL
+2, 11, 12, 13, 14
+3, 12, 15, 16, 13
+*NSET, NSET=FIX
+1, 2, 3, 4, 5, 6, 7, 8
+*NSET, NSET=TIP
+15, 16
+*SURFACE, NAME=SOLIDFACE
+SOLID, S4
+*SURFACE, NAME=SHELLEDGE
+2, S6
+*MATERIAL, NAME=STEEL
+*ELASTIC
+210000, 0.3
+*SOLID SECTION, ELSET=SOLID, MATERIAL=STEEL
+*SHELL SECTION, ELSET=SHELL, MATERIAL=STEEL
+0.1
+*TIE, NAME=T1, POSITION TOLERANCE=0.1
+SHELLEDGE, SOLIDFACE
+*BOUNDARY
+FIX, 1, 3
+*STEP, NLGEOM
+*STATIC
+1.0, 1.0
+*CLOAD
+TIP, 3, -1.0
+*NODE PRINT, NSET=TIP
+U
+*END STEP
+"""
+
+
+def test_shell_edge_tied_to_a_solid_is_a_clamp(tmp_path):
+    """An S4 strip whose edge (S6: from its node 4 to node 1) is tied (*TIE) to the face of a C3D8 block held in
+    place: the edge is clamped, so the tip deflects as the same strip clamped at that edge (its edge nodes held in
+    dofs 1-6) to 0.5 % (measured 0.17 %: the tie is a penalty, 100 E / h with h the shell's thickness, the smaller
+    facet dimension; with the contact pairs' 10 E / h of the block's face it was 17 % softer)."""
+    dat, proc = _run_deck(tmp_path, TIED_EDGE, "tied")
+    assert proc.returncode == 0, proc.stderr
+    tied = _dat(dat)["U"][15][2]
+    clamp = TIED_EDGE.replace("*TIE, NAME=T1, POSITION TOLERANCE=0.1\nSHELLEDGE, SOLIDFACE\n", "").replace(
+        "FIX, 1, 3", "FIX, 1, 3\n11, 1, 5\n14, 1, 5")
+    dat, proc = _run_deck(tmp_path, clamp, "clamped")
+    assert proc.returncode == 0, proc.stderr
+    clamped = _dat(dat)["U"][15][2]
+    assert clamped < -0.2 and tied == pytest.approx(clamped, rel=5e-3)
+
+
+def test_shell_edge_faces():
+    """extrude_surface's edge face sets: the lateral face along edge k of a quad4 cell (its corners k, k + 1 as
+    given, both layers), outward; an edge shared by two cells has none (one line), nor have triangles."""
+    from covcontact.mesh.shell import ShellMeshError, extrude_surface
+
+    pts = np.array([[1, 0, .5], [2, 0, .5], [2, 1, .5], [1, 1, .5], [3, 0, .5], [3, 1, .5]], float)
+    cells = np.array([[0, 1, 2, 3], [1, 4, 5, 2]])
+    m = extrude_surface(pts, "quad4", cells, 0.1, face_sets={"E": [(np.array([0]), "edge4")],
+                                                              "F": [(np.array([1]), "edge2")]})
+    for name, normal in (("E", (-1.0, 0.0, 0.0)), ("F", (1.0, 0.0, 0.0))):
+        (face,) = m.face_sets[name]
+        x = m.points[face]
+        n = np.cross(x[1] - x[0], x[3] - x[0])
+        np.testing.assert_allclose(n / np.linalg.norm(n), normal, atol=1e-12)
+        assert set(np.round(x[:, 2], 12)) == {0.45, 0.55}
+    with pytest.raises(ShellMeshError, match="shared with another cell"):
+        extrude_surface(pts, "quad4", cells, 0.1, face_sets={"E": [(np.array([0]), "edge2")]})
+    with pytest.raises(ShellMeshError, match="these cells are tri3"):
+        extrude_surface(pts, "tri3", np.array([[0, 1, 2]]), 0.1, face_sets={"E": [(np.array([0]), "edge1")]})
+
+
+def test_edges_of_other_shells_are_refused(tmp_path):
+    text = TIED_EDGE.replace("*ELEMENT, TYPE=S4, ELSET=SHELL\n2, 11, 12, 13, 14\n3, 12, 15, 16, 13",
+                             "*ELEMENT, TYPE=S3, ELSET=SHELL\n2, 11, 12, 14\n3, 12, 15, 16")
+    with pytest.raises(DeckError, match="S6 of an S3 element is an edge: covcontact reads the edges of S4 and S4R"):
+        import_deck(_write(tmp_path / "s3.inp", text), tmp_path / "i" / "s3.toml")

@@ -232,7 +232,7 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
     h = float(np.mean(np.linalg.norm(X[ref[:, 1]] - X[ref[:, 0]], axis=1))) if ref is not None else 1.0
     if pair.penalty == "auto":
         body = mb if mb is not None else sb
-        penalty = pair.auto_factor * float(body.material.params[0]) / h
+        penalty = pair.penalty_factor() * float(body.material.params[0]) / h
     else:
         penalty = float(pair.penalty)
     if pair.weighting == "area" or pair.penalty == "auto":

@@ -143,16 +143,36 @@ class Numbering:
         return None
 
 
+def _shortest_edges(X, faces: np.ndarray) -> np.ndarray:
+    """Per facet, its shortest corner-to-corner edge."""
+    nc = 3 if faces.shape[1] in (3, 6) else 4
+    c = X[faces[:, :nc]]
+    return np.linalg.norm(c - np.roll(c, -1, axis=1), axis=2).min(axis=1)
+
+
 def _auto_penalty(num: Numbering, pair, slave, master) -> float:
-    """eps_N per unit area: auto_factor * E / h of the master body (the slave body's if rigid)."""
+    """eps_N per unit area: auto_factor * E / h of the master body (the slave body's if rigid). A tied pair takes the
+    stiffer of its bodies and h the smaller of its surfaces' mean shortest facet edges: a tie is a constraint
+    (CalculiX writes equations), and across a thin layer (a shell's edge face, whose short side is the thickness)
+    the mean facet size would leave it soft in bending."""
     X = num.reference()
+    if pair.law == "tied":
+        found = []
+        for body, sset in (master, slave):
+            E = num.material_E(body)
+            mesh, off = num.mesh_of(body)
+            if mesh is not None and sset in mesh.face_sets and len(mesh.face_sets[sset]):
+                found.append((E, float(np.mean(_shortest_edges(X, mesh.face_sets[sset] + off)))))
+        moduli = [E for E, _ in found if E is not None]
+        if moduli:
+            return pair.penalty_factor() * max(moduli) / min(h for _, h in found)
     for body, sset in (master, slave):
         E = num.material_E(body)
         mesh, off = num.mesh_of(body)
         if E is None or mesh is None or sset not in mesh.face_sets:
             continue
         h = float(np.mean(facet_sizes(X, mesh.face_sets[sset] + off))) / np.sqrt(2.0)
-        return pair.auto_factor * E / h
+        return pair.penalty_factor() * E / h
     raise ValueError(f"contact {pair.name}: penalty = \"auto\" needs a deformable body with a face set "
                      f"named like its contact set")
 

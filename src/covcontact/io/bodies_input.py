@@ -66,7 +66,7 @@ def _read_once(path: Path, element: str | None = None):
 def build_shell(shell: Section, sec: Section, base: Path):
     """The solid-shell mesh of a body with ``shell = { thickness, offset }`` and ``mesh = { file = "SURFACE" }``, a
     mid-surface mesh (mesh/shell.py ``extrude_surface``)."""
-    from ..mesh.shell import OFFSETS, ShellMeshError, extrude_surface, read_surface
+    from ..mesh.shell import EDGE_SIDES, OFFSETS, ShellMeshError, extrude_surface, read_surface
 
     thickness = shell.get("thickness", "any")
     per_node = isinstance(thickness, list)
@@ -89,8 +89,9 @@ def build_shell(shell: Section, sec: Section, base: Path):
         for name in list(faces.data):
             rows = faces.get(name, "any")
             if not (isinstance(rows, list) and rows and all(isinstance(r, list) and len(r) == 2 and isinstance(r[0], str)
-                                                            and r[1] in ("top", "bottom") for r in rows)):
-                faces.fail("must be an array of [\"ELEMENT SET\", \"top\" or \"bottom\"] pairs", name)
+                                                            and r[1] in ("top", "bottom", *EDGE_SIDES) for r in rows)):
+                faces.fail("must be an array of [\"ELEMENT SET\", \"top\", \"bottom\" or \"edge1\"..\"edge4\"] "
+                           "pairs", name)
             face_rows[name] = rows
         faces.done()
     shell.done()

@@ -161,7 +161,7 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         if law == "arctan" and penalty == "auto":
             c.fail("law = \"arctan\" takes its slope K as a number (its tension sigma_inf is relative to it)",
                    "penalty")
-        auto_factor = c.get("auto_factor", "float", 10.0, positive=True)
+        auto_factor = c.get("auto_factor", "float", None, positive=True)
         method = c.get("method", "str", "penalty", choices=("penalty", "augmented"))
         gap_tol = c.get("gap_tolerance", "float", None, positive=True)
         gap_rel = c.get("gap_tolerance_relative", "float", None, positive=True)

@@ -140,9 +140,18 @@ def shell_surface_row(reader, c: Card, k: int, row: list[str], name: str) -> boo
         return False
     if any(int(e) not in shells for e in els):
         raise c.fail(f"{face} names shell and solid elements at once ({row[0]}): give them on separate lines", k)
+    if face in ("S3", "S4", "S5", "S6"):  # (an edge: the solid-shell's lateral face along it, of 4-node shells)
+        types = {t for t, _, labs, _ in m.shell_blocks if np.intersect1d(labs, np.asarray(els, dtype=np.int64)).size}
+        other = sorted(types - {"S4", "S4R"})
+        if other:
+            raise c.fail(f"{face} of an {other[0]} element is an edge: covcontact reads the edges of "
+                         f"S4 and S4R elements (their solid-shells' side faces), not of {other[0]}", k)
+        m.shell_surfaces.setdefault(name, []).append((np.asarray(els, dtype=np.int64), f"EDGE{int(face[1:]) - 2}",
+                                                      c.where(k)))
+        return True
     if face not in ("S1", "S2"):
-        raise c.fail(f"{face} of a shell element is an edge (S1 and S2 are its negative and positive faces): shell "
-                     f"edges are not contact surfaces here", k)
+        raise c.fail(f"{face} is no face of a shell element (S1 and S2 its negative and positive faces, S3..S6 its "
+                     f"edges)", k)
     m.shell_surfaces.setdefault(name, []).append((np.asarray(els, dtype=np.int64), "SNEG" if face == "S1" else "SPOS",
                                                   c.where(k)))
     return True
@@ -555,7 +564,8 @@ class DeckShells:
                     es_name = f"__{safe_name(name)}_{r + 1}"
                     es[es_name] = np.sort(order[np.searchsorted(elements[order], labs)])
                     es_lab[es_name] = labs
-                    mine.append([es_name, "top" if side == "SPOS" else "bottom"])
+                    mine.append([es_name, side.lower() if side.startswith("EDGE") else
+                                 "top" if side == "SPOS" else "bottom"])
             if mine:
                 rows[safe_name(name)] = mine
         return ns, es, rows, ns_lab, es_lab

@@ -163,6 +163,7 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     if o is None or not -0.5 <= o <= 0.5:
         raise ShellMeshError(f"offset must be 'middle', 'top', 'bottom' or a number in [-0.5, 0.5], got {offset!r}")
     cell_of = np.arange(cells.shape[0])  # the surface cell each new cell comes from
+    surface_type = cell_type
     if cell_type == "quad8":
         points, t, cells = _quad8_to_quad9(points, t, cells)
         cell_type = "quad9"
@@ -206,11 +207,16 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             mesh.add_face_set(name, f)
     for name, ids in (element_sets or {}).items():
         mesh.element_sets[name] = np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64)))
+    lateral_of = {frozenset(f.tolist()): f for f in lateral}
     for name, rows in (face_sets or {}).items():
         chosen = []
         for ids, side in rows:
+            if side in EDGE_SIDES:
+                chosen.append(_edge_faces(name, side, given, surface_type, cell_of, ids, n, lateral_of))
+                continue
             if side not in ("top", "bottom"):
-                raise ShellMeshError(f"face set {name!r}: side must be 'top' or 'bottom', got {side!r}")
+                raise ShellMeshError(f"face set {name!r}: side must be 'top', 'bottom' or 'edge1'..'edge4', got "
+                                     f"{side!r}")
             sel = np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64)))
             up = turned[sel] != (side == "top")  # (the mesh's top face)
             if np.any(up):
@@ -223,6 +229,29 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             if name not in mesh.node_sets:
                 mesh.add_node_set(name, np.unique(f))
     return mesh
+
+
+#: the sides of a face set row that name a quad4 cell's edge k (from its corner k to corner k + 1, in the cell's node
+#: order as given): the lateral face of the solid-shell along it (a deck's S3..S6 of an S4 element)
+EDGE_SIDES = ("edge1", "edge2", "edge3", "edge4")
+
+
+def _edge_faces(name, side, given, surface_type, cell_of, ids, n, lateral_of) -> np.ndarray:
+    """The lateral faces (outward, as the mesh's boundary has them) along edge ``side`` of the surface cells ``ids``;
+    ShellMeshError where the cells are no quad4 or the edge is not on the surface's boundary."""
+    if surface_type != "quad4":
+        raise ShellMeshError(f"face set {name!r}: {side} names an edge of a quadrilateral shell cell (quad4: a deck's "
+                             f"S4, S4R); these cells are {surface_type}")
+    k = EDGE_SIDES.index(side)
+    out = []
+    for c in np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64))):
+        a, b = int(given[c, k]), int(given[c, (k + 1) % 4])
+        face = lateral_of.get(frozenset((a, b, a + n, b + n)))
+        if face is None:
+            raise ShellMeshError(f"face set {name!r}: {side} of surface cell {c} (0-based) is shared with another cell, "
+                                 f"not an edge of the shell: it has no lateral face")
+        out.append(face)
+    return np.array(out, dtype=np.int64).reshape(-1, 4)
 
 
 #: meshio's surface cell types and ours
