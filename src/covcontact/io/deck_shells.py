@@ -144,8 +144,10 @@ def shell_surface_row(reader, c: Card, k: int, row: list[str], name: str) -> boo
         types = {t for t, _, labs, _ in m.shell_blocks if np.intersect1d(labs, np.asarray(els, dtype=np.int64)).size}
         other = sorted(types - {"S4", "S4R"})
         if other:
+            why = (" (the side faces of their 18-node solid-shells have six nodes, a facet type covcontact does not "
+                   "have)" if other[0] in ("S8", "S8R") else "")
             raise c.fail(f"{face} of an {other[0]} element is an edge: covcontact reads the edges of "
-                         f"S4 and S4R elements (their solid-shells' side faces), not of {other[0]}", k)
+                         f"S4 and S4R elements (their solid-shells' side faces), not of {other[0]}{why}", k)
         m.shell_surfaces.setdefault(name, []).append((np.asarray(els, dtype=np.int64), f"EDGE{int(face[1:]) - 2}",
                                                       c.where(k)))
         return True

@@ -207,12 +207,11 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             mesh.add_face_set(name, f)
     for name, ids in (element_sets or {}).items():
         mesh.element_sets[name] = np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64)))
-    lateral_of = {frozenset(f.tolist()): f for f in lateral}
     for name, rows in (face_sets or {}).items():
         chosen = []
         for ids, side in rows:
             if side in EDGE_SIDES:
-                chosen.append(_edge_faces(name, side, given, surface_type, cell_of, ids, n, lateral_of))
+                chosen.append(_edge_faces(name, side, given, surface_type, cell_of, ids, mesh.points))
                 continue
             if side not in ("top", "bottom"):
                 raise ShellMeshError(f"face set {name!r}: side must be 'top', 'bottom' or 'edge1'..'edge4', got "
@@ -236,20 +235,32 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
 EDGE_SIDES = ("edge1", "edge2", "edge3", "edge4")
 
 
-def _edge_faces(name, side, given, surface_type, cell_of, ids, n, lateral_of) -> np.ndarray:
-    """The lateral faces (outward, as the mesh's boundary has them) along edge ``side`` of the surface cells ``ids``;
-    ShellMeshError where the cells are no quad4 or the edge is not on the surface's boundary."""
+def _edge_faces(name, side, given, surface_type, cell_of, ids, points) -> np.ndarray:
+    """The side faces (outward) along edge ``side`` of the quad4 surface cells ``ids``: (bottom a, bottom b, top b,
+    top a) of the cell's edge from corner a to corner b. ShellMeshError for other cells (the side faces of hex18
+    solid-shells have six nodes, no facet type) or an edge of two cells."""
     if surface_type != "quad4":
-        raise ShellMeshError(f"face set {name!r}: {side} names an edge of a quadrilateral shell cell (quad4: a deck's "
-                             f"S4, S4R); these cells are {surface_type}")
+        raise ShellMeshError(f"face set {name!r}: {side} names an edge of a quad4 shell cell (a deck's S4, S4R); these "
+                             f"cells are {surface_type}")
+    n = points.shape[0] // 2
     k = EDGE_SIDES.index(side)
+    corners = given[:, :4]
+    count: dict = {}
+    for c in corners:
+        for e in range(4):
+            key = frozenset((int(c[e]), int(c[(e + 1) % 4])))
+            count[key] = count.get(key, 0) + 1
     out = []
     for c in np.flatnonzero(np.isin(cell_of, np.asarray(ids, dtype=np.int64))):
         a, b = int(given[c, k]), int(given[c, (k + 1) % 4])
-        face = lateral_of.get(frozenset((a, b, a + n, b + n)))
-        if face is None:
+        if count[frozenset((a, b))] > 1:
             raise ShellMeshError(f"face set {name!r}: {side} of surface cell {c} (0-based) is shared with another cell, "
-                                 f"not an edge of the shell: it has no lateral face")
+                                 f"not an edge of the shell: it has no side face")
+        centre = points[np.concatenate([given[c], given[c] + n])].mean(axis=0)
+        face = np.array([a, b, b + n, a + n], dtype=np.int64)
+        x = points[face]
+        if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
+            face = face[::-1]
         out.append(face)
     return np.array(out, dtype=np.int64).reshape(-1, 4)
 
