@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
+import time
 from pathlib import Path
 
 
@@ -34,3 +36,21 @@ def runs_table(rows: list[dict], key: str) -> str:
     lines += [f"| {r['problem']} | {cell(r[key])} | {r['status']} | {r['steps']} | {r['iterations']} | {r['cutbacks']} | "
               f"{r['wall_s']} |" for r in rows]
     return "\n".join(lines)
+
+
+def run_variant(problem: Path, replacements: list[tuple[str, str]], work: Path, name: str) -> tuple[dict, float, int]:
+    """``covcontact run`` (a whole process) of ``problem`` with the text ``replacements`` (old, new) made, in ``work``:
+    (its summary.json, the wall seconds, the exit code). A replacement whose old text is missing stops the script."""
+    text = problem.read_text()
+    for old, new in replacements:
+        if old not in text:
+            raise SystemExit(f"{Path(sys.argv[0]).name}: the variant {name!r} expects {old!r} in {problem}")
+        text = text.replace(old, new)
+    path = work / f"{name}.toml"
+    path.write_text(text)
+    out = work / name
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(path), "--out", str(out), "--quiet"],
+                          capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    return json.loads((out / "summary.json").read_text()), wall, proc.returncode

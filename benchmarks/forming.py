@@ -12,15 +12,12 @@ from __future__ import annotations
 
 import argparse
 import csv
-import json
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _report import emit  # noqa: E402
+from _report import emit, run_variant  # noqa: E402
 
 PROBLEM = Path(__file__).resolve().parent / "problems" / "vbend.toml"
 
@@ -51,23 +48,11 @@ def attempts(path: Path) -> tuple[int, int]:
 
 
 def run(name: str, work: Path) -> dict:
-    text = PROBLEM.read_text()
-    for old, new in VARIANTS[name]:
-        if old not in text:
-            raise SystemExit(f"forming.py: the variant {name!r} expects {old!r} in {PROBLEM}")
-        text = text.replace(old, new)
-    path = work / f"{name}.toml"
-    path.write_text(text)
-    out = work / name
-    t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "covcontact.cli", "run", str(path), "--out", str(out), "--quiet"],
-                          capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    summary = json.loads((out / "summary.json").read_text())
+    summary, wall, code = run_variant(PROBLEM, VARIANTS[name], work, name)
     steps = summary["steps"]
-    wasted, retried = attempts(out / "convergence.csv")
+    wasted, retried = attempts(work / name / "convergence.csv")
     n, its = len(steps), sum(s["iterations"] for s in steps)
-    return {"variant": name, "exit_code": proc.returncode, "status": summary["status"], "increments": n,
+    return {"variant": name, "exit_code": code, "status": summary["status"], "increments": n,
             "iterations": its, "per_increment": round(its / max(n, 1), 2), "given_up": wasted,
             "steps_retried": retried, "cutbacks": sum(s.get("cutbacks", 0) for s in steps), "wall_s": round(wall, 2)}
 
