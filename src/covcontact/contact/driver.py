@@ -533,7 +533,9 @@ def project_slaves(
     if gmax is None:
         gm = 0.5 * facet_sizes(x, surface.faces)
     else:
-        gm = np.ascontiguousarray(np.broadcast_to(np.asarray(gmax, np.float64), (nf,)))
+        # (a copy: a broadcast view of one facet is contiguous but read-only, a kernel signature of its own that
+        # numba would compile again, 30 s)
+        gm = np.array(np.broadcast_to(np.asarray(gmax, np.float64), (nf,)))
     lo, hi = facet_boxes(x, surface.faces) if boxes is None else boxes
     out = ProjectionResult(
         facet=np.empty(ns, np.int64),
