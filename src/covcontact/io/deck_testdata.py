@@ -38,7 +38,7 @@ def start_test_data(reader, c: Card, mat: dict, model: str, n: int) -> None:
     out: dict = {"model": model, "test_data": []}
     if model in ("polynomial", "reduced-polynomial", "ogden"):
         out["n"] = n
-    poisson = next((v for p, v in c.params.items() if p == "POISSON"), None)
+    poisson = c.params.get("POISSON")
     if poisson is not None:
         try:
             nu = float(poisson)

@@ -46,12 +46,13 @@ class AutomaticIncrements:
     """Increments of the load factor chosen as the steps go (``[steps] initial, min, max``), in the manner of
     Abaqus/Standard: start with ``initial``; after ``EASY_STEPS`` steps in a row that converged without a
     cutback in at most ``EASY_ITERATIONS`` iterations, grow by ``GROW``; after a step that needed more than
-    ``HARD_ITERATIONS`` (counting every attempt at the increment: a failed extrapolated start retried from the tangent
-    made the step hard, however quickly the retry converged), or more than ``EASY_ITERATIONS`` while more than ``SET_CHANGE`` of the active slave
-    nodes (and more than ``SET_CHANGE_MIN``) opened or closed, or more than ``ZONE_CHANGE`` of the yielding
-    Gauss points started or stopped yielding, shrink by ``SHRINK``; after a step that needed cutbacks, go on
-    with the increment that finally converged; never below ``min`` (Newton's cutbacks stop there) nor above ``max``; the last step
-    ends exactly at the stage's end (a remainder below ``min`` is taken with the step before it)."""
+    ``HARD_ITERATIONS`` (counting every attempt at the increment: a failed extrapolated start retried from the
+    tangent made the step hard, however quickly the retry converged), or more than ``EASY_ITERATIONS`` while
+    more than ``SET_CHANGE`` of the active slave nodes (and more than ``SET_CHANGE_MIN``) opened or closed, or
+    more than ``ZONE_CHANGE`` of the yielding Gauss points started or stopped yielding, shrink by ``SHRINK``;
+    after a step that needed cutbacks, go on with the increment that finally converged; never below ``min``
+    (Newton's cutbacks stop there) nor above ``max``; the last step ends exactly at the stage's end (a
+    remainder below ``min`` is taken with the step before it)."""
 
     EASY_ITERATIONS = 5
     EASY_STEPS = 2
