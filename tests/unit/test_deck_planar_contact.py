@@ -136,15 +136,12 @@ _HEX = ("*NODE\n101, 5., 0., 0.\n102, 6., 0., 0.\n103, 6., 1., 0.\n104, 5., 1., 
 
 
 @pytest.mark.parametrize("kw, message", [
-    ({"pair": "*TIE, NAME=T\nSLAVE, MASTER\n"},
-     r"\*TIE on CPE4 elements: tied pairs are not available in the plane; with --ignore-unsupported the pair is left "
-     r"out"),
+    ({"pair": "*SURFACE, NAME=NS, TYPE=NODE\n11\n12\n13\n*TIE, NAME=T\nNS, MASTER\n"},
+     r"\*TIE with a node surface \(TYPE=NODE\) as the slave on CPE4 elements: a tie in the plane weights its slave "
+     r"nodes by their edges"),
     ({"law": "EXPONENTIAL\n0.01, 10."},
      r"PRESSURE-OVERCLOSURE=EXPONENTIAL on CPE4 elements \(\S*blocks\.inp:\d+\): contact in the plane has the linear "
      r"penalty and hard \(augmented\) contact only"),
-    ({"law": "HARD", "kind": "NODE TO SURFACE", "extra": "*FRICTION\n0.2, 1.e6\n"},
-     r"\*FRICTION on the CPE4 elements of \S*blocks\.inp:\d+: friction against the edges of a planar body is not "
-     r"available yet; with --ignore-unsupported the pair is frictionless"),
     ({"law": f"LINEAR\n{K}, 3., 0.001", "kind": "NODE TO SURFACE"},
      r"PRESSURE-OVERCLOSURE=LINEAR on the NODE TO SURFACE pair \S*blocks\.inp:\d+ on CPE4 elements: CalculiX's "
      r"node-to-face law \(arctan, with its tension\) is not available in the plane"),
@@ -162,13 +159,49 @@ _HEX = ("*NODE\n101, 5., 0., 0.\n102, 6., 0., 0.\n103, 6., 1., 0.\n104, 5., 1., 
      r"ADJUST on CPE4 elements: not available in the plane"),
 ])
 def test_what_contact_in_the_plane_lacks_is_listed(tmp_path, kw, message):
-    """Tied pairs, the exponential law, friction on a body's edges, the node-to-face linear (arctan) law, node
+    """A tie of a node surface, the exponential law, the node-to-face linear (arctan) law, node
     surfaces as slaves, two formulations, planar with 3D elements, ADJUST: one line each, listed as unsupported
     (exit 2 without --ignore-unsupported)."""
     _, proc = _run(_deck(**kw), tmp_path)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
     lines = [ln for ln in proc.stderr.splitlines() if re.search(message, ln)]
     assert len(lines) == 1 and lines[0].startswith("covcontact: unsupported: "), proc.stderr
+
+
+def test_friction_on_a_body_s_edges(tmp_path):
+    """*FRICTION on a NODE TO SURFACE pair of CPE4 blocks: Coulomb friction along the master edges (mu and the stick
+    slope as the tangential penalty per area, as in 3D). Pressed along y with nu = 0 nothing slides: the blocks take
+    the uniaxial closed form, as without friction."""
+    dat, proc = _run(_deck("CPE4", kind="NODE TO SURFACE", law="HARD", extra="*FRICTION\n0.2, 1.e6\n"), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    entry = tomllib.loads((tmp_path / "o" / "deck" / "blocks.toml").read_text())["contact"][0]
+    assert (entry["friction"], entry["tangential_penalty"], entry["method"]) == (0.2, 1.0e6, "augmented")
+    U = _last(dat, "displacements")
+    d = (_stretch() - 1.0) * H
+    for n in (4, 5, 6):
+        assert U[n][1] == pytest.approx(d, abs=1e-10)
+        assert U[n + 10][1] - U[n + 7][1] == pytest.approx(d, abs=2e-10)
+        assert abs(U[n + 7][0] - U[n][0]) < 1e-12
+
+
+@pytest.mark.parametrize("etype, x0", [("CPE4", 0.0), ("CAX4", 1.0)])
+def test_tie_is_a_tied_pair_in_the_plane(tmp_path, etype, x0):
+    """*TIE of the upper block's bottom to the lower block's top, the top pulled (P3 = -P): a tied pair in the plane
+    with the automatic tie penalty 100 E / h per area (h = 0.5, the edges' length); CalculiX writes equations (no
+    opening), here the tie opens by P h / (100 E) and carries the tension; the blocks stretch as the uniaxial closed
+    form (nu = 0) says, each by d."""
+    text = _deck(etype, x0=x0, pair="*TIE, NAME=T\nSLAVE, MASTER\n").replace(f"UP, P3, {P}", f"UP, P3, {-P}")
+    dat, proc = _run(text, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    entry = tomllib.loads((tmp_path / "o" / "deck" / "blocks.toml").read_text())["contact"][0]
+    assert (entry["law"], entry["penalty"], entry["weighting"]) == ("tied", "auto", "area")
+    U = _last(dat, "displacements")
+    lam = brentq(lambda s: s * E * (s * s - 1.0) / 2.0 - P, 0.5, 1.5, xtol=1e-15)
+    d, opening = (lam - 1.0) * H, P * 0.5 / (100.0 * E)
+    for n in (4, 5, 6):
+        assert U[n][1] == pytest.approx(d, abs=1e-10)
+        assert U[n + 7][1] - U[n][1] == pytest.approx(opening, abs=2e-10)
+        assert U[n + 10][1] - U[n + 7][1] == pytest.approx(d, abs=2e-10)
 
 
 def test_contact_print_of_planar_pairs_is_said_not_left_empty(tmp_path):

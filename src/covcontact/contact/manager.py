@@ -335,7 +335,7 @@ class ContactManager:
     def _tied_pass(self, p: Pass, xe, t: PassState, want_K, want_parts, ev: ContactEvaluation) -> None:
         """Tied slaves: a vector penalty to their fixed tie points (:mod:`.tied`); gap: the points' distance."""
         idx = np.flatnonzero(p.tie_facet >= 0)
-        faces = p.surface.faces[p.tie_facet[idx]]
+        faces = (p.curve.segments if p.curve is not None else p.surface.faces)[p.tie_facet[idx]]
         R, K, d = tied_blocks(xe, faces, p.tie_N[idx], xe[p.slaves[idx]], p.eps[idx], want_K or want_parts)
         conn = np.hstack([faces, p.slaves[idx][:, None]])
         t.facet[idx] = p.tie_facet[idx]

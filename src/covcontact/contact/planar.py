@@ -174,14 +174,17 @@ def check_pair(pair, bodies, rigid) -> str | None:
         return f"{name}: the bodies have different formulations ({' and '.join(sorted(planar))})"
     if pair.type != "nts":
         return f"{name}: planar bodies take node-to-segment contact only (type = \"nts\")"
-    if pair.law not in ("penalty",):
-        return f"{name}: law = \"{pair.law}\" is not available on planar bodies (penalty, smoothing, augmented)"
+    if pair.law not in ("penalty", "tied"):
+        return (f"{name}: law = \"{pair.law}\" is not available on planar bodies (penalty, smoothing, augmented, "
+                f"tied)")
     if pair.adjust is not None:
         return f"{name}: adjust is not available on planar bodies"
     if pair.weighting == "boundary":
         return f"{name}: weighting = \"boundary\" is not available on planar bodies (use \"area\" or \"nodal\")"
     if sb is None:
         return f"{name}: the slave of a planar pair is the edge set of a planar body, not the rigid body {pair.slave[0]!r}"
+    if mb is None and pair.law == "tied":
+        return f"{name}: a tied planar pair bonds to the edges of a planar body, not to the rigid body {pair.master[0]!r}"
     if mb is None:
         rb = next((r for r in rigid if r.name == pair.master[0]), None)
         if rb is None or rb.mesh is not None or rb.shape not in ("plane", "cylinder"):
@@ -229,8 +232,12 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
             raise ValueError(f"contact {pair.name}: no edge set {master[1]!r} on body {master[0]!r}")
         segments = mmesh.face_sets[master[1]] + moff
     ref = segments if segments is not None else faces
-    h = float(np.mean(np.linalg.norm(X[ref[:, 1]] - X[ref[:, 0]], axis=1))) if ref is not None else 1.0
-    if pair.penalty == "auto":
+    h = float(np.mean(_chords(X, ref))) if ref is not None else 1.0
+    if pair.penalty == "auto" and pair.law == "tied":  # the stiffer body over the shorter of both sides' segments
+        sides = [e for e in (faces, segments) if e is not None and len(e)]
+        penalty = (pair.penalty_factor() * max(float(b.material.params[0]) for b in (sb, mb))
+                   / min(float(np.mean(_chords(X, e))) for e in sides))
+    elif pair.penalty == "auto":
         body = mb if mb is not None else sb
         penalty = pair.penalty_factor() * float(body.material.params[0]) / h
     else:
@@ -252,9 +259,36 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
     else:
         rb = next(r for r in num.problem.rigid if r.name == master[0])
         p = Pass(name, nodes, eps, weight, analytic=analytic_surface(rb), rigid=rb.name, **kw)
+    if pair.law == "tied":
+        p.tie_facet, p.tie_N = tie(p.curve, X, X[nodes], pair.tie_tolerance)
+        if not (p.tie_facet >= 0).any():
+            raise ValueError(f"contact {pair.name}: no slave node lies within the tie tolerance of the master edges; "
+                             f"the edges do not meet: check the geometry or raise tie_tolerance")
     if p.augmented:
         p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
     return p
+
+
+def _chords(X: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Per edge (nf, 2 or 3), its corner-to-corner length."""
+    return np.linalg.norm(X[edges[:, 1], :2] - X[edges[:, 0], :2], axis=1)
+
+
+def tie(curve: Curve, X: np.ndarray, xs: np.ndarray, tolerance: float | None):
+    """Tie slave nodes at reference positions xs (ns, 3) to the master ``curve`` at reference nodes X (a tied pair,
+    docs/theory.md section 14, in the plane): each to its closest point on the curve (a vertex between two segments
+    included), if that lies within the tolerance (None: 5 % of the mean segment length). Returns (segment (ns,), -1
+    where none lies within it; N (ns, nen) the segment's shape values at the tie point)."""
+    lengths = _chords(X, curve.segments)
+    tol = 0.05 * float(lengths.mean()) if tolerance is None else float(tolerance)
+    kind, seg, xi, g, _, _ = closest_points(curve, X, xs, 1.5 * float(lengths.max()))
+    ok = (kind != 0) & (np.abs(g) <= tol)
+    N = np.zeros((len(xs), curve.nen))
+    n3, d3, dd3 = np.empty(3), np.empty(3), np.empty(3)
+    for i in np.flatnonzero(ok):
+        segment_shapes(curve.nen, float(xi[i]), n3, d3, dd3)
+        N[i] = n3[:curve.nen]
+    return np.where(ok, seg, -1).astype(np.int64), N
 
 
 # -- the pass -------------------------------------------------------------------------------------------------------
@@ -361,4 +395,4 @@ def _segment_history(p, c, s: int, segment: int, xi: float, x_commit) -> np.ndar
 
 
 __all__ = ["CASE_A", "CASE_B", "CASE_C", "CASE_D", "CASE_EXACT", "Curve", "closest_points", "project_on_segment",
-           "segment_core", "segment_pass", "slave_weights", "vertex_core", "check_pair", "make_pass"]
+           "segment_core", "segment_pass", "slave_weights", "vertex_core", "check_pair", "make_pass", "tie"]

@@ -165,8 +165,11 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
     node-to-segment with the same law: CalculiX integrates K g over the slave faces, here K g at the slave nodes over
     their tributary edges; LINEAR there is the plain penalty K per area, HARD as above), the node-to-face LINEAR law
     (arctan with its tension; with the flag the linear penalty K per area), a node surface (TYPE=NODE) as the slave,
-    EXPONENTIAL, TABULAR, TIED and *TIE, a pair between planar and 3D elements or between two planar
-    formulations (left out with the flag), friction on a body's edges and ADJUST (left out with the flag)."""
+    EXPONENTIAL, TABULAR, a pair between planar and 3D elements or between two planar formulations (left out with the
+    flag) and ADJUST (left out with the flag). *FRICTION is Coulomb friction along the master edges (mu, and the
+    stick slope as the tangential penalty per area, as in 3D). *TIE and PRESSURE-OVERCLOSURE=TIED
+    become tied pairs in the plane (``law = "tied"``): *TIE with the automatic tie penalty (CalculiX writes equations),
+    TIED with its slope K per area."""
     kinds = {b: _planar_bodies(w).get(int(b)) for b in (sb, mb)}
     if kinds[sb] is None and kinds[mb] is None:
         return None
@@ -187,11 +190,21 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
                              f"formulation; {flag}")
         return False
     etype = types[0]
-    if kind == "TIE" or it.behavior == "tied":
-        w.unsupported.append(f"{where}: {what if kind == 'TIE' else 'PRESSURE-OVERCLOSURE=TIED'} on {etype} elements: "
-                             f"tied pairs are not available in the plane; {flag}")
-        return False
     sts = kind == "SURFACE TO SURFACE" and sk == "ELEMENT"
+    if (kind == "TIE" or it.behavior == "tied") and sk == "NODE":
+        w.unsupported.append(f"{where}: {what if kind == 'TIE' else 'PRESSURE-OVERCLOSURE=TIED'} with a node surface "
+                             f"(TYPE=NODE) as the slave on {etype} elements: a tie in the plane weights its slave "
+                             f"nodes by their edges; {flag}")
+        return False
+    if kind == "TIE":  # CalculiX's equations; here a stiff penalty tie (100 E / h per area), as in 3D
+        entry = {"law": "tied", "penalty": "auto", "weighting": "area"}
+        tol = next((t for _, _, _, t, at in w.m.ties if at == where), None)
+        if tol:
+            entry["tie_tolerance"] = tol
+        return entry
+    if it.behavior == "tied":  # face-to-face: the slope K per area (the stick slope checked as in 3D)
+        entry = {"weighting": "area"}
+        return entry if w._tied_pair(entry, it, True, where) else False
     if it.behavior in ("exponential", "tabular"):
         w.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE={it.behavior.upper()} on {etype} elements ({where}): "
                              f"contact in the plane has the linear penalty and hard (augmented) contact only; {flag}")
@@ -218,10 +231,10 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
         entry: dict = {"penalty": K, "weighting": "area"}
     else:
         entry = {"penalty": "auto", "method": "augmented", "weighting": "area"}
-    if it.friction is not None and it.friction[0] > 0:
-        w.unsupported.append(f"{it.where}: *FRICTION on the {etype} elements of {where}: friction against the edges "
-                             f"of a planar body is not available yet; with --ignore-unsupported the pair is "
-                             f"frictionless")
+    if it.friction is not None and it.friction[0] > 0:  # covariant Coulomb friction along the master edges
+        entry["friction"] = it.friction[0]
+        if it.friction[1] is not None and it.friction[1] > 0:  # the stick slope, per area as K
+            entry["tangential_penalty"] = it.friction[1]
     if w.m.pair_adjust.get(where) is not None:
         w.unsupported.append(f"{where}: ADJUST on {etype} elements: not available in the plane; with "
                              f"--ignore-unsupported the slave nodes are not moved")
