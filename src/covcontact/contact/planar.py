@@ -235,11 +235,10 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
     h = float(np.mean(_chords(X, ref))) if ref is not None else 1.0
     if pair.penalty == "auto" and pair.law == "tied":  # the stiffer body over the shorter of both sides' segments
         sides = [e for e in (faces, segments) if e is not None and len(e)]
-        penalty = (pair.penalty_factor() * max(float(b.material.params[0]) for b in (sb, mb))
+        penalty = (pair.penalty_factor() * max(num.material_E(b.name) for b in (sb, mb))
                    / min(float(np.mean(_chords(X, e))) for e in sides))
     elif pair.penalty == "auto":
-        body = mb if mb is not None else sb
-        penalty = pair.penalty_factor() * float(body.material.params[0]) / h
+        penalty = pair.penalty_factor() * num.material_E((mb if mb is not None else sb).name) / h
     else:
         penalty = float(pair.penalty)
     if pair.weighting == "area" or pair.penalty == "auto":
