@@ -39,6 +39,18 @@ class Equation:
 
 
 @dataclass
+class MPC:
+    """A nonlinear multi-point constraint (docs/theory.md, "Nonlinear multi-point constraints"): ``kind`` "plane"
+    (the nodes after the first three stay in the plane of those three), "straight" (the nodes after the first two
+    stay on their line) or "beam" (two nodes keep their distance); ``nodes`` (body, node set): the defining nodes'
+    sets of one node each first, then sets of any number of constrained nodes (a beam: the two nodes' sets)."""
+
+    kind: str
+    nodes: list[tuple[str, str]]
+    name: str = ""
+
+
+@dataclass
 class NodalForce:
     """Force ``lam * value`` on every node of a node set (``per_node``) or spread evenly (``total``)."""
 

@@ -39,6 +39,8 @@ class Problem:
     dirichlet: list[Dirichlet] = field(default_factory=list)
     #: linear multi-point constraints (``covcontact.loads.Equation``)
     equations: list = field(default_factory=list)
+    #: nonlinear multi-point constraints (``covcontact.loads.MPC``)
+    mpcs: list = field(default_factory=list)
     forces: list[NodalForce] = field(default_factory=list)
     pressures: list[Pressure] = field(default_factory=list)
     tractions: list[Traction] = field(default_factory=list)

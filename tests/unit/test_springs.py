@@ -730,16 +730,16 @@ def test_spring_input_errors(tmp_path):
 def test_deck_spring_errors_and_unsupported(tmp_path):
     """Deck mistakes (one line naming the line, exit 2) and what covcontact does not read (listed, exit 2): a *SPRING
     over a solid element, a spring element without its constant, a dofs line on a SPRINGA, a spring to a free node of
-    no solid element, *MPC PLANE and BEAM, a B32R beam element."""
+    no solid element, *MPC MEANROT and DIST, a B32R beam element."""
     good = DASH_DECK
     cases = {
         good.replace("*SPRING, ELSET=ESPRING", "*SPRING, ELSET=MASS"): ("element 1 is no spring or dashpot element",),
         good.replace("*SPRING, ELSET=ESPRING\n\n9.869604401089358\n", ""): ("SPRINGA element 21 has no *SPRING",),
         good.replace("*SPRING, ELSET=ESPRING\n\n", "*SPRING, ELSET=ESPRING\n3\n"): ("a dofs line for the SPRINGA",),
         good.replace("GROUND, 1, 3", "GROUND, 1, 2"): ("its node 11 belongs to no solid element and is not held",),
-        good.replace("*STEP, NLGEOM", "*MPC\nPLANE, 1, 2, 3, 5\nBEAM, 6, 7\n*STEP, NLGEOM"):
-            ("*MPC PLANE (the nodes after the first three kept in the plane", "*MPC BEAM (two nodes kept at their "
-             "distance"),
+        good.replace("*STEP, NLGEOM", "*MPC\nMEANROT, 1, 1, 1, 2, 2, 2, 5\n*MPC\nDIST, 6, 6, 6, 7, 7, 7, 5\n"
+                                      "*STEP, NLGEOM"):
+            ("*MPC MEANROT (a mean rotation", "*MPC DIST (a maximum distance"),
         good.replace("*NSET, NSET=BLOCK", "*ELEMENT, TYPE=B32R, ELSET=BEAM\n40, 1, 2, 3\n*NSET, NSET=BLOCK"):
             ("*ELEMENT, TYPE=B32R is not supported (3-node beam): CalculiX expands it into C3D20R bricks, covcontact "
              "does not",),

@@ -25,6 +25,7 @@ from .deck_coupling import DeckCouplings
 from .deck_planar import element_names, planar_body, planar_contact, planar_dof3
 from .deck_rigid import DeckRigid
 from .deck_shells import DeckShells
+from .deck_mpc import DeckMPCs
 from .deck_springs import DeckSprings
 
 _COMP = "xyz"
@@ -856,6 +857,7 @@ class _Writer:
         bodies += self._shell_bodies_toml()
         rigid = "".join(_table("[[rigid]]", e) for e in self.rigid.entries(self.extra_nsets, self._ref))
         springs = "".join(_table(kind, e) for kind, e in DeckSprings(self).entries())  # (SPRINGA, ..., DASHPOTA)
+        springs += "".join(_table("[[mpc]]", e) for e in DeckMPCs(self).entries())  # (*MPC: deck_mpc)
         conds += "".join(_table("[[force]]", e) for e in self.couplings.entries(self.extra_nsets, self._ref))
         self.unsupported += self.rigid.unsupported
         first = self.m.steps[0]

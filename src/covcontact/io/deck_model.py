@@ -20,6 +20,7 @@ from .deck_elements import ELEMENTS, NFACES, NNODE
 from .deck_planar import element_names
 from .deck_shells import (SHELL_CARDS, SHELL_ELEMENTS, read_shell_card, read_shell_elements, refuse_shell_type,
                           shell_surface_row)
+from .deck_mpc import read_mpc_card
 from .deck_springs import BEAMS, SPRING_CARDS, SPRING_ELEMENTS, read_spring_card, read_spring_elements
 from .deck_testdata import (TEST_DATA_CARDS, finish_test_data, is_test_data_input, read_test_data_card,
                             start_test_data)
@@ -101,6 +102,8 @@ class DeckModel:
     #: where each block's *ELEMENT line is
     block_where: list[str] = field(default_factory=list)
     nsets: dict[str, np.ndarray] = field(default_factory=dict)
+    #: each *NSET's labels in the order written (``nsets`` sorts them; an *MPC's defining nodes come first)
+    nset_order: dict[str, list] = field(default_factory=dict)
     elsets: dict[str, np.ndarray] = field(default_factory=dict)
     #: name -> ("ELEMENT", [(element labels, face 1..6)]) or ("NODE", node labels)
     surfaces: dict[str, tuple[str, object]] = field(default_factory=dict)
@@ -221,8 +224,11 @@ class _Reader(LoadCards):
             k += 1
             if c.name in _ABAQUS_ONLY:
                 m.dialect = "abaqus"
-            if c.name in SPRING_CARDS:  # (*SPRING, *DASHPOT, *MPC: deck_springs checks its own parameters)
+            if c.name in SPRING_CARDS:  # (*SPRING, *DASHPOT: deck_springs checks its own parameters)
                 read_spring_card(self, c)
+                continue
+            if c.name == "MPC":  # (deck_mpc)
+                read_mpc_card(self, c)
                 continue
             if c.name not in SUPPORTED:
                 m.unsupported.append(f"{c.where()}: *{c.name} is not supported")
@@ -648,13 +654,19 @@ class _Reader(LoadCards):
                     if f.lstrip("-").isdigit():
                         ids.append(int(f))
                     elif f.upper() in sets:
-                        labels.append(sets[f.upper()])
+                        labels.append(np.asarray(ids, dtype=np.int64))
+                        ids = []
+                        labels.append(np.asarray(self.m.nset_order.get(f.upper(), sets[f.upper()])
+                                                 if key == "NSET" else sets[f.upper()], dtype=np.int64))
                     elif key == "ELSET" and f.upper() in self.m.skipped_elsets:  # (of elements not read)
                         labels.append(self.m.element_set(f))
                     else:
                         raise c.fail(f"{f!r} is neither a label nor a {key} defined above", k)
                 labels.append(np.asarray(ids, dtype=np.int64))
-        self._add(sets, name, np.concatenate(labels) if labels else np.zeros(0, np.int64))
+        new = np.concatenate(labels) if labels else np.zeros(0, np.int64)
+        if key == "NSET":
+            self.m.nset_order.setdefault(name, []).extend(int(v) for v in new)
+        self._add(sets, name, new)
 
     def _surface(self, c: Card) -> None:
         name = c.param("NAME", required=True).upper()

@@ -1,6 +1,6 @@
 """A deck's springs and dashpots: *ELEMENT, TYPE=SPRINGA, SPRING1, SPRING2, DASHPOTA with *SPRING and *DASHPOT, mapped
 to ``[[spring]]`` and ``[[dashpot]]`` (docs/input.md, "Abaqus and CalculiX decks"; ``covcontact.elements.springs``);
-*MPC and beam elements, which covcontact does not read, each listed with one line saying why.
+beam elements, which covcontact does not read, each listed with one line saying why.
 
 Spring elements are no solids: they make no body (the importer's parts are the solid elements joined through shared
 nodes) and join nodes of the bodies. An end on a node of no solid element is ground where *BOUNDARY holds it (in the
@@ -23,18 +23,11 @@ from .deck import Card, DeckError, numbers
 #: the element types read here, with their node count and whether they are dashpots
 SPRING_ELEMENTS = {"SPRINGA": 2, "SPRING1": 1, "SPRING2": 2, "DASHPOTA": 2}
 #: the cards read here (deck_model dispatches them)
-SPRING_CARDS = ("SPRING", "DASHPOT", "MPC")
+SPRING_CARDS = ("SPRING", "DASHPOT")
 #: beam elements: why they are refused (CalculiX expands them into bricks; covcontact does not)
 BEAMS = {etype: f"({nodes}-node beam): CalculiX expands it into {brick} bricks, covcontact does not: mesh the beam "
                 f"with {brick} solid elements" for etype, nodes, brick in
          (("B31", 2, "C3D8I"), ("B31R", 2, "C3D8R"), ("B32", 3, "C3D20"), ("B32R", 3, "C3D20R"))}
-#: *MPC types: what they are, for the line that refuses them
-_MPC = {"PLANE": "the nodes after the first three kept in the plane of those three",
-        "STRAIGHT": "the nodes after the first two kept on the line through those two",
-        "BEAM": "two nodes kept at their distance",
-        "MEANROT": "a mean rotation"}
-
-
 @dataclass
 class SpringElements:
     """One *ELEMENT block of springs or dashpots: labels (n,), nodes (n, 1 or 2) as labels, each element's line."""
@@ -83,20 +76,10 @@ def _integers(row: list[str]) -> bool:
 
 
 def read_spring_card(reader, c: Card) -> None:
-    """*SPRING, *DASHPOT (model data) and *MPC (each MPC listed as unsupported)."""
+    """*SPRING, *DASHPOT (model data)."""
     m = reader.m
     if reader.step is not None:
         raise c.fail("is model data: it belongs before the first *STEP")
-    if c.name == "MPC":
-        for k, row in enumerate(c.rows()):
-            if row and row[0] and not row[0].lstrip("+-").isdigit():
-                name = row[0].upper()
-                what = _MPC.get(name, "a user MPC")
-                m.unsupported.append(f"{c.where(k)}: *MPC {name} ({what}, a nonlinear constraint) is not supported: "
-                                     f"covcontact eliminates linear *EQUATIONs and rigid links (*RIGID BODY, "
-                                     f"*KINEMATIC) only" + ("; a stiff SPRINGA between the two nodes approximates it"
-                                                            if name == "BEAM" else ""))
-        return
     for p, v in c.params.items():
         if p == "ELSET" or (p == "NONLINEAR" and c.name == "SPRING"):
             continue

@@ -18,6 +18,7 @@ from .conditions_input import SetRefs, read_body_forces, read_dirichlet, read_eq
 from .contact_input import read_contacts
 from .dynamics_input import check_densities, read_dynamics, read_initial_velocities
 from .fields import read_steps
+from .mpc_input import read_mpcs
 from .options_input import read_output, read_solver
 from .rigid_input import check_attached, read_rigid
 from .springs_input import read_springs
@@ -40,7 +41,7 @@ def load_problem(path: str | Path) -> Problem:
 
 
 _TOP_LEVEL = ("problem", "bodies", "rigid", "dirichlet", "force", "pressure", "traction", "body_force", "contact",
-              "equation", "spring", "dashpot", "steps", "stages", "initial_velocity", "solver", "output")
+              "equation", "mpc", "spring", "dashpot", "steps", "stages", "initial_velocity", "solver", "output")
 
 
 def problem_from_dict(raw: dict, path: Path) -> Problem:
@@ -77,6 +78,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                 top.fail(why, f"contact[{i}]")
     equations = read_equations(top, sets, dirichlet)
     springs, dashpots = read_springs(top, sets)
+    mpcs = read_mpcs(top, sets, bodies, dirichlet, equations, rigid)
 
     for i, r in enumerate(rigid):
         if r.free and not r.attach and not any(r.name in (c.slave[0], c.master[0]) for c in contacts):
@@ -126,4 +128,4 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
                    pressures=pressures, tractions=tractions, rigid=rigid, contacts=contacts, steps=steps, solver=solver,
                    output=output, source=path, stages=stages, stage_name=stage_name,
                    units=units, dynamics=dynamics, initial_velocity=velocities, gravity=gravity, equations=equations,
-                   body_forces=body_forces, ramp=ramp, springs=springs, dashpots=dashpots)
+                   body_forces=body_forces, ramp=ramp, springs=springs, dashpots=dashpots, mpcs=mpcs)

@@ -39,6 +39,7 @@ def auto_amg(problem) -> bool:
         return False
     if any(c.friction for c in problem.contacts) or any(rb.free or rb.attach for rb in problem.rigid) or _dynamic(problem) \
             or getattr(problem, "gravity", None) is not None or getattr(problem, "equations", None) \
+            or getattr(problem, "mpcs", None) \
             or getattr(problem, "springs", None) or getattr(problem, "dashpots", None):
         return False
     on_boundary = sum(np.unique(boundary_faces(b.mesh)[0]).size for b in problem.bodies)
@@ -149,8 +150,8 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if distributes(linear) and any(rb.free or rb.attach for rb in problem.rigid):
         raise InputError(f"{where}: rigid bodies with free components or attached nodes (reference nodes) are not available with "
                          f"the distributed solver {linear!r} yet; use a serial solver")
-    if distributes(linear) and getattr(problem, "equations", None):
-        raise InputError(f"{where}: multi-point constraints ([[equation]]) are not available with the distributed "
+    if distributes(linear) and (getattr(problem, "equations", None) or getattr(problem, "mpcs", None)):
+        raise InputError(f"{where}: multi-point constraints ([[equation]], [[mpc]]) are not available with the distributed "
                          f"solver {linear!r} yet; use a serial solver (--solver pardiso or superlu)")
     if distributes(linear) and (getattr(problem, "springs", None) or getattr(problem, "dashpots", None)):
         raise InputError(f"{where}: springs and dashpots ([[spring]], [[dashpot]]) are not available with the "

@@ -197,24 +197,30 @@ def _with_diagonal(K, dofs: np.ndarray):
 
 
 class ChainedConstraints:
-    """Linear equations and rigid links together: u = T g(w) (the equations' dependent dofs are set from the
-    attached nodes after those are set from their bodies), so the residual is P^T T^T R."""
+    """Several kinds of constraints together, ``layers`` in the order their dependent dofs are set (rigid links,
+    then nonlinear MPCs, then linear equations: each may read the dofs the ones before set): u = T(m(g(w))), so the
+    residual is P_g^T P_m^T T^T R and every layer's second-order part takes the forces handed to it."""
 
-    symmetric = False
-
-    def __init__(self, linear: LinearConstraints, rigid: RigidLinks):
-        self.linear, self.rigid = linear, rigid
-        self.mask = linear.mask | rigid.mask
+    def __init__(self, *layers):
+        self.layers = layers
+        self.mask = np.logical_or.reduce([c.mask for c in layers])
+        self.symmetric = all(c.symmetric for c in layers)
 
     def complete(self, u: np.ndarray) -> None:
-        self.rigid.complete(u)
-        self.linear.complete(u)
+        for c in self.layers:
+            c.complete(u)
 
     def transform(self, R: np.ndarray, K):
-        return self.rigid.transform(*self.linear.transform(R, K))
+        for c in reversed(self.layers):
+            R, K = c.transform(R, K)
+        return R, K
 
     def mass(self, M):
-        return self.rigid.mass(self.linear.mass(M))
+        for c in reversed(self.layers):
+            M = c.mass(M)
+        return M
 
     def lift(self, a: np.ndarray) -> np.ndarray:
-        return self.linear.lift(self.rigid.lift(a))
+        for c in self.layers:
+            a = c.lift(a)
+        return a

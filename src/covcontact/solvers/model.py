@@ -47,6 +47,7 @@ class Model:
         self.system = System(problem.bodies, problem.rigid, problem.loads, problem.dirichlet)
         self._constraint_sets: dict = {}
         self._rigid_links = None
+        self._mpcs = None
         self.tangent = tangent
         self.contact = ContactManager(problem, self.system, tangent)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
@@ -68,19 +69,23 @@ class Model:
         self.set_stage(State([], None))
 
     def _constraints(self, problem, stage: int = 0):
-        """The multi-point constraints of a stage: linear equations (those no stage up to it removed), nodes attached
-        to rigid bodies, both or None; built once per set of equations."""
+        """The multi-point constraints of a stage: nodes attached to rigid bodies, nonlinear MPCs and linear
+        equations (those no stage up to it removed), chained in that order where there are several, or None; built
+        once per set of equations."""
         from .constraints import ChainedConstraints, LinearConstraints, RigidLinks
+        from .mpc import NonlinearMPCs
 
         if self._rigid_links is None and any(r.attached.size for r in self.system.reference):
             self._rigid_links = RigidLinks(self.system)
+        if self._mpcs is None and getattr(problem, "mpcs", None):
+            self._mpcs = NonlinearMPCs(problem.mpcs, self.system)
         removed = frozenset(n for st in list(getattr(problem, "stages", []))[:stage] for n in st.remove)
         if removed not in self._constraint_sets:
             eqs = [e for e in getattr(problem, "equations", None) or [] if not (e.name and e.name in removed)]
             linear = LinearConstraints(eqs, self.system) if eqs else None
-            rigid = self._rigid_links
-            both = ChainedConstraints(linear, rigid) if linear is not None and rigid is not None else None
-            self._constraint_sets[removed] = both or (linear if linear is not None else rigid)
+            layers = [c for c in (self._rigid_links, self._mpcs, linear) if c is not None]
+            self._constraint_sets[removed] = (ChainedConstraints(*layers) if len(layers) > 1
+                                              else layers[0] if layers else None)
         return self._constraint_sets[removed]
 
     # stages -----------------------------------------------------------------------------------
