@@ -174,9 +174,7 @@ def check_pair(pair, bodies, rigid) -> str | None:
         return f"{name}: the bodies have different formulations ({' and '.join(sorted(planar))})"
     if pair.type != "nts":
         return f"{name}: planar bodies take node-to-segment contact only (type = \"nts\")"
-    if pair.law not in ("penalty", "tied"):
-        return (f"{name}: law = \"{pair.law}\" is not available on planar bodies (penalty, smoothing, augmented, "
-                f"tied)")
+
     if pair.adjust is not None:
         return f"{name}: adjust is not available on planar bodies"
     if pair.weighting == "boundary":
@@ -208,7 +206,7 @@ def planar_body(num, name):
     return b if b is not None and b.formulation in PLANAR_FORMULATIONS else None
 
 
-def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, analytic_surface):
+def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, analytic_surface, law_terms):
     """The node-to-segment pass of ``slave`` (body, edge set) against ``master`` (a planar body's edge set, or a
     rigid line or circle) of ``pair``: weights from :func:`slave_weights` (reference configuration), eps = penalty
     times the weight with weighting "area" or penalty "auto" (eps per unit length per thickness or circumference),
@@ -247,11 +245,11 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
         eps = penalty * weight
     else:
         eps = np.full(len(nodes), penalty)
-    ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
-    kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
+    eps, eps_t, band, law = law_terms(pair, eps, penalty)   # (the pressure-overclosure laws as in 3D)
+    kw = {"eps_t": eps_t, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
-          "slave_body": slave[0], "master_body": master[0], "band": float(pair.smoothing), "kind": "nts",
-          "slave_faces": faces}
+          "slave_body": slave[0], "master_body": master[0], "band": band, "kind": "nts", "slave_faces": faces,
+          "law": law}
     if segments is not None:
         p = Pass(name, nodes, eps, weight, **kw)
         p.curve = Curve(segments)
@@ -313,11 +311,17 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
     t.xi = np.column_stack([np.where(ok, xi, 0.0), np.zeros(len(xi))])
     t.gap = np.where(ok, g, np.inf)
     t.hist_facet = t.facet.copy()
-    if p.band != 0.0:
-        eps_s, lam_s = linear_equivalents(t.gap, t.multiplier, p.eps, p.band)
+    pull = np.zeros(len(ok), dtype=bool)
+    if p.law is not None:  # a pressure-overclosure curve: the linear law with its traction and slope at each gap
+        on, eps_s, lam_s = p.law.equivalents(t.gap, p.area)
+        active = ok & on
+        pull = active & (lam_s + eps_s * np.where(ok, g, 0.0) > 0.0)   # (a tension at a clearance: split below)
     else:
-        eps_s, lam_s = p.eps, t.multiplier
-    active = ok & is_active(t.gap, t.multiplier, p.eps, p.band)
+        if p.band != 0.0:
+            eps_s, lam_s = linear_equivalents(t.gap, t.multiplier, p.eps, p.band)
+        else:
+            eps_s, lam_s = p.eps, t.multiplier
+        active = ok & is_active(t.gap, t.multiplier, p.eps, p.band)
     nen = curve.nen
     nd = 3 * (nen + 1)
     idx = np.flatnonzero(active & (kind == FACET))
@@ -328,7 +332,10 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
         P = np.zeros((idx.size, 4, nd, nd)) if want_parts else np.zeros((1, 4, nd, nd))
         for j, s in enumerate(idx):
             xseg = np.ascontiguousarray(xe[conn[j, :nen]])
-            if friction:
+            if friction and pull[s]:  # (a pull carries no friction: the history is dropped, as in 3D)
+                t.hist[s] = 0.0
+                t.status[s] = 0
+            elif friction:
                 from .planar_friction import segment_friction_core
 
                 hist = _segment_history(p, c, s, int(seg[s]), float(xi[s]), x_commit)
@@ -339,8 +346,14 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
                     segment_core(xseg, np.ascontiguousarray(xs[s]), float(xi[s]), float(eps_s[s]), float(lam_s[s]),
                                  case, True, np.zeros(nd), np.zeros((nd, nd)), P[j])
                 continue
-            t.gap[s] = segment_core(xseg, np.ascontiguousarray(xs[s]), float(xi[s]), float(eps_s[s]),
-                                    float(lam_s[s]), case, want_parts, R[j], K[j], P[j] if want_parts else P[0])
+            for e_j, l_j in _laws(float(eps_s[s]), float(lam_s[s]), float(g[s]), bool(pull[s])):
+                Rj, Kj, Pj = np.zeros(nd), np.zeros((nd, nd)), np.zeros((4, nd, nd))
+                t.gap[s] = segment_core(xseg, np.ascontiguousarray(xs[s]), float(xi[s]), e_j, l_j, case, want_parts,
+                                        Rj, Kj, Pj)
+                R[j] += Rj
+                K[j] += Kj
+                if want_parts:
+                    P[j] += Pj
         t.force[idx] = -R[:, -3:]
         manager._add(ev.blocks, conn, R, K if want_K else None, xe)
         if want_parts:
@@ -352,8 +365,12 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
         R = np.zeros((idx.size, 6))
         K = np.zeros((idx.size, 6, 6))
         for j, s in enumerate(idx):
-            t.gap[s] = vertex_core(np.ascontiguousarray(xe[vert[s]]), np.ascontiguousarray(xs[s]), float(sign[s]),
-                                   float(eps_s[s]), float(lam_s[s]), R[j], K[j])
+            for e_j, l_j in _laws(float(eps_s[s]), float(lam_s[s]), float(g[s]), bool(pull[s])):
+                Rj, Kj = np.zeros(6), np.zeros((6, 6))
+                t.gap[s] = vertex_core(np.ascontiguousarray(xe[vert[s]]), np.ascontiguousarray(xs[s]),
+                                       float(sign[s]), e_j, l_j, Rj, Kj)
+                R[j] += Rj
+                K[j] += Kj
         t.force[idx] = -R[:, -3:]
         if friction:  # frictionless at a vertex; the committed history is carried through unchanged
             t.hist[idx] = c.hist[idx]
@@ -362,6 +379,17 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
         manager._add(ev.blocks, conn, R, K if want_K else None, xe)
         if want_parts:
             ev.parts[0].add(conn, np.zeros_like(R), K)
+
+
+def _laws(eps: float, lam: float, g: float, pull: bool) -> tuple:
+    """The linear laws (eps', lam') the kernels evaluate for one slave: its own, or where a curve pulls (lam + eps g >
+    0: a tension at a clearance, where the kernels, written for a pushing law, act not at all) two pushing laws with
+    the same g whose sum is it, (2 eps, -2 eps g - c) and (-eps, lam + 2 eps g + c) with c = eps |g| + |lam| > 0
+    (the kernels' residual and every tangent part are linear in (eps', lam'))."""
+    if not pull:
+        return ((eps, lam),)
+    c = eps * abs(g) + abs(lam) + 1e-300
+    return ((2.0 * eps, -2.0 * eps * g - c), (-eps, lam + 2.0 * eps * g + c))
 
 
 #: frictional passes: how far outside its segment of the last Newton iterate (in xi) a slave keeps it (a slave

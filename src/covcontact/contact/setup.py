@@ -212,11 +212,33 @@ def _pressure_law(pair) -> PressureLaw | None:
     return None
 
 
+def law_terms(pair, eps: np.ndarray, penalty: float) -> tuple[np.ndarray, np.ndarray, float, PressureLaw | None]:
+    """(eps, eps_t, band, law) of a pass whose slaves have the normal stiffness ``eps`` (``penalty`` times each
+    slave's weight): a pressure-overclosure curve evaluated in the Python layer (``law``) makes eps its reference
+    stiffness per slave (the scale of the tangential penalty); Abaqus' exponential law is the kernels' own, eps the
+    nodal force at zero gap and band = -c0; the tangential penalty ``eps_t`` is the pair's (per the same weight), or
+    by default eps (p0 / c0 per weight for the exponential laws)."""
+    law = _pressure_law(pair)
+    if law is not None:
+        w = eps / penalty
+        penalty = law.stiffness
+        eps = penalty * w
+    ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
+    band = float(pair.smoothing)
+    if pair.law == "exponential" and law is None:
+        band = -float(pair.clearance)
+        if not pair.tangential_penalty:
+            ratio = 1.0 / float(pair.clearance)  # the tangential stiffness p0 / c0 (per area)
+    elif law is not None and law.kind == "calculix_exponential" and not pair.tangential_penalty:
+        ratio = float(pair.pressure) / float(pair.clearance) / penalty  # p0 / c0 as for Abaqus' curve
+    return eps, eps * ratio, band, law
+
+
 def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | None, surfaces=None) -> Pass:
     """The pass of ``slave`` against ``master`` of ``pair``; ``tangent`` overrides the pair's case. ``surfaces``:
     the (body, face set) list of a self-contact, merged into one surface that is both slave and master."""
     if surfaces is None and planar.planar_body(num, slave[0]) is not None:  # contact in the plane (.planar)
-        return planar.make_pass(num, name, slave, master, pair, tangent, Pass, analytic_surface)
+        return planar.make_pass(num, name, slave, master, pair, tangent, Pass, analytic_surface, law_terms)
     X = num.reference()
     if surfaces is not None:
         slave_faces = np.vstack([num.mesh_of(b)[0].face_sets[f] + num.mesh_of(b)[1] for b, f in surfaces])
@@ -242,20 +264,8 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         eps = penalty * area
     else:
         eps = np.full(len(slaves), float(penalty))
-    law = _pressure_law(pair)
-    if law is not None:  # eps: the law's reference stiffness per slave (the scale of the tangential penalty)
-        w = eps / penalty
-        penalty = law.stiffness
-        eps = penalty * w
-    ratio = (pair.tangential_penalty / penalty) if pair.tangential_penalty else 1.0
-    band = float(pair.smoothing)
-    if pair.law == "exponential" and law is None:  # eps: the nodal force at zero gap; the kernels' law: band = -c0
-        band = -float(pair.clearance)
-        if not pair.tangential_penalty:
-            ratio = 1.0 / float(pair.clearance)  # the tangential stiffness p0 / c0 (per area)
-    elif law is not None and law.kind == "calculix_exponential" and not pair.tangential_penalty:
-        ratio = float(pair.pressure) / float(pair.clearance) / penalty  # p0 / c0 as for Abaqus' curve
-    kw = {"eps_t": eps * ratio, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
+    eps, eps_t, band, law = law_terms(pair, eps, penalty)
+    kw = {"eps_t": eps_t, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
           "slave_body": slave[0] if surfaces is None else "", "master_body": master[0] if surfaces is None else "",
           "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own, "law": law}

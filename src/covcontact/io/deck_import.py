@@ -687,14 +687,8 @@ class _Writer:
                     continue
             elif it.behavior == "linear":
                 self._linear(entry, it, sts, where)
-            elif it.behavior == "exponential":
-                entry.update({"law": "exponential", "clearance": it.values[0], "pressure": it.values[1],
-                              "form": self.dialect})
-            elif it.behavior == "tabular":
-                pts = it.values
-                entry.update({"law": "table", "table": [[pts[j], pts[j + 1]] for j in range(0, len(pts), 2)]})
-                if len(pts) == 2:  # (one point: constant pressure; a second point with the same makes a table)
-                    entry["table"].append([pts[0] + 1.0, pts[1]])
+            elif it.behavior in ("exponential", "tabular"):
+                entry.update(it.curve(self.dialect))
             elif sk == "NODE":  # hard contact, node slaves: augmented Lagrange with 10 E h per node
                 entry.update({"penalty": self._hard_penalty(mb), "method": "augmented", "weighting": "nodal"})
             else:

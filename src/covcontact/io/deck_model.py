@@ -89,6 +89,17 @@ class Interaction:
     friction: tuple[float, float | None] | None = None   # (mu, stick slope)
     where: str = ""
 
+    def curve(self, dialect: str) -> dict:
+        """The [[contact]] keys of an EXPONENTIAL (c0, p0; in the deck's dialect) or TABULAR (pressure, overclosure
+        lines, here [overclosure, pressure] pairs; one point: a constant pressure) curve."""
+        if self.behavior == "exponential":
+            return {"law": "exponential", "clearance": self.values[0], "pressure": self.values[1], "form": dialect}
+        pts = self.values
+        table = [[pts[j], pts[j + 1]] for j in range(0, len(pts), 2)]
+        if len(pts) == 2:  # (a second point with the same pressure makes a table)
+            table.append([pts[0] + 1.0, pts[1]])
+        return {"law": "table", "table": table}
+
 
 @dataclass
 class DeckModel:

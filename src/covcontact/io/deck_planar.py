@@ -160,16 +160,16 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
     length of the edge times the thickness (2 pi R over the full circumference, of which the .dat prints 1/180): the
     planar pair's ``weighting = "area"`` (eps = K int N_a t ds, t the thickness or 2 pi R) is that same law, the
     forces totals as the body's. Mapped: PRESSURE-OVERCLOSURE=HARD on NODE TO SURFACE pairs of element surfaces
-    (augmented Lagrange with the automatic penalty 10 E / h per area, as the 3D import). Listed as unsupported
-    (CalculiX has them, contact in the plane does not): face-to-face contact (with --ignore-unsupported the pair is
-    node-to-segment with the same law: CalculiX integrates K g over the slave faces, here K g at the slave nodes over
-    their tributary edges; LINEAR there is the plain penalty K per area, HARD as above), the node-to-face LINEAR law
-    (arctan with its tension; with the flag the linear penalty K per area), a node surface (TYPE=NODE) as the slave,
-    EXPONENTIAL, TABULAR, a pair between planar and 3D elements or between two planar formulations (left out with the
-    flag) and ADJUST (left out with the flag). *FRICTION is Coulomb friction along the master edges (mu, and the
-    stick slope as the tangential penalty per area, as in 3D). *TIE and PRESSURE-OVERCLOSURE=TIED
-    become tied pairs in the plane (``law = "tied"``): *TIE with the automatic tie penalty (CalculiX writes equations),
-    TIED with its slope K per area."""
+    (augmented Lagrange with the automatic penalty 10 E / h per area, as the 3D import); LINEAR (face-to-face pairs
+    the penalty K per area, node-to-face ones CalculiX's arctan curve with its tension), EXPONENTIAL and TABULAR as
+    in 3D, per area. Listed as unsupported (CalculiX has them, contact in the plane does not): face-to-face contact
+    (with --ignore-unsupported the pair is node-to-segment with the same law: CalculiX integrates it over the slave
+    faces, here at the slave nodes over their tributary edges), a node surface (TYPE=NODE) as the slave, a pair
+    between planar and 3D elements or between two planar formulations (left out with the flag) and ADJUST (left out
+    with the flag). *FRICTION is Coulomb friction along the master edges (mu, and the stick slope as the tangential
+    penalty per area, as in 3D). *TIE and PRESSURE-OVERCLOSURE=TIED become tied pairs in the plane
+    (``law = "tied"``): *TIE with the automatic tie penalty (CalculiX writes equations), TIED with its slope K per
+    area."""
     kinds = {b: _planar_bodies(w).get(int(b)) for b in (sb, mb)}
     if kinds[sb] is None and kinds[mb] is None:
         return None
@@ -205,10 +205,6 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
     if it.behavior == "tied":  # face-to-face: the slope K per area (the stick slope checked as in 3D)
         entry = {"weighting": "area"}
         return entry if w._tied_pair(entry, it, True, where) else False
-    if it.behavior in ("exponential", "tabular"):
-        w.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE={it.behavior.upper()} on {etype} elements ({where}): "
-                             f"contact in the plane has the linear penalty and hard (augmented) contact only; {flag}")
-        return False
     if sk == "NODE":
         w.unsupported.append(f"{where}: a node surface (TYPE=NODE) as the slave of a pair on {etype} elements: "
                              f"CalculiX weights such nodes by their share of the body's boundary faces, which contact "
@@ -219,16 +215,11 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
                              f"node-to-segment; with --ignore-unsupported the pair is node-to-segment with the same "
                              f"law (K g per area at the slave nodes over their tributary edges; CalculiX integrates it "
                              f"over the slave faces)")
-    elif it.behavior == "linear":
-        w.unsupported.append(f"{it.where}: PRESSURE-OVERCLOSURE=LINEAR on the NODE TO SURFACE pair {where} on {etype} "
-                             f"elements: CalculiX's node-to-face law (arctan, with its tension) is not available in "
-                             f"the plane; with --ignore-unsupported the linear penalty law with the same K per area")
-    if it.behavior == "linear":
-        K = it.values[0] if it.values and it.values[0] > 0.0 else 50.0 * w._first_modulus()
-        if not (it.values and it.values[0] > 0.0):
-            w.notes.append(f"{it.where}: *SURFACE BEHAVIOR, LINEAR without a slope K: CalculiX's default 50 E = {K:g} "
-                           f"is used")
-        entry: dict = {"penalty": K, "weighting": "area"}
+    entry: dict = {"weighting": "area"}
+    if it.behavior == "linear":  # (face-to-face: the linear penalty K; node-to-face: the arctan curve, as in 3D)
+        w._linear(entry, it, sts, where)
+    elif it.behavior in ("exponential", "tabular"):
+        entry.update(it.curve(w.dialect))
     else:
         entry = {"penalty": "auto", "method": "augmented", "weighting": "area"}
     if it.friction is not None and it.friction[0] > 0:  # covariant Coulomb friction along the master edges
