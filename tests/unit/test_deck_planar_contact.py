@@ -82,22 +82,17 @@ def _run(text: str, tmp_path: Path, *flags) -> tuple[Path, subprocess.CompletedP
 
 @pytest.mark.parametrize("etype, x0", [("CPE4", 0.0), ("CAX4", 1.0)])
 def test_face_to_face_linear_penalty_is_calculix_law(tmp_path, etype, x0):
-    """TYPE=SURFACE TO SURFACE, LINEAR K: listed as unsupported (contact in the plane is node-to-segment); with
-    --ignore-unsupported the pair is node-to-segment with K per area. The overclosure is P / K (CalculiX's K per area
-    of its expanded face: per the thickness 0.5 of the CPE4 block, per 2 pi R of the CAX4 ring, the same at every
-    radius), the blocks the uniaxial closed form; both equal CalculiX's .dat to its 7 digits. The base's reaction is
-    P times the area: the thickness's (CPE4) or pi (R2^2 - R1^2) / 180, the .dat's 2 degree segment (CAX4; CalculiX's
-    own is 2e-4 lower, its expanded segment's)."""
+    """TYPE=SURFACE TO SURFACE, LINEAR K: segment-to-segment contact in the plane (the Gauss points of the slave
+    edges, K per area), read without a word. The overclosure is P / K (CalculiX's K per area of its expanded face:
+    per the thickness 0.5 of the CPE4 block, per 2 pi R of the CAX4 ring, the same at every radius), the blocks the
+    uniaxial closed form; both equal CalculiX's .dat to its 7 digits. The base's reaction is P times the area: the
+    thickness's (CPE4) or pi (R2^2 - R1^2) / 180, the .dat's 2 degree segment (CAX4; CalculiX's own is 2e-4 lower,
+    its expanded segment's)."""
     text = _deck(etype, x0=x0)
-    _, proc = _run(text, tmp_path)
-    assert proc.returncode == 2
-    assert re.search(r"blocks\.inp:\d+: TYPE=SURFACE TO SURFACE on " + etype + r" elements: contact in the plane is "
-                     r"node-to-segment; with --ignore-unsupported the pair is node-to-segment with the same law",
-                     proc.stderr), proc.stderr
-    dat, proc = _run(text, tmp_path, "--ignore-unsupported")
+    dat, proc = _run(text, tmp_path)
     assert proc.returncode == 0, proc.stderr
     entry = tomllib.loads((tmp_path / "o" / "deck" / "blocks.toml").read_text())["contact"][0]
-    assert entry["penalty"] == K and entry["weighting"] == "area" and "type" not in entry
+    assert entry["penalty"] == K and entry["type"] == "sts"
     U, RF = _last(dat, "displacements"), _last(dat, "forces")
     d = (_stretch() - 1.0) * H
     expect = {1: 0.0, 2: 0.0, 3: 0.0, 4: d, 5: d, 6: d, 11: d - P / K, 12: d - P / K, 13: d - P / K,

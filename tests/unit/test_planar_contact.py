@@ -416,8 +416,8 @@ def test_shrink_fit_against_lame(tmp_path, method, penalty):
 
 def test_bad_planar_pairs(tmp_path):
     """A planar pair the code cannot take: one line naming the pair (exit 2 from the command line)."""
-    text = blocks("plane_strain", "quad4", 4, 0.0, "").replace('weighting = "area"\n', 'weighting = "area"\ntype = "sts"\n')
+    text = blocks("plane_strain", "quad4", 4, 0.0, "").replace('weighting = "area"\n', 'weighting = "area"\nadjust = 0.01\n')
     path = tmp_path / "bad.toml"
     path.write_text(text)
-    with pytest.raises(Exception, match="node-to-segment"):
+    with pytest.raises(Exception, match="adjust is not available on planar bodies"):
         load_problem(path)

@@ -129,8 +129,16 @@ def slave_weights(X: np.ndarray, edges: np.ndarray, formulation: str, thickness:
     out = np.zeros(len(X))
     if not len(edges):
         return out
+    N, ds = edge_rule(X, edges, formulation, thickness, 5)
+    np.add.at(out, edges.ravel(), np.einsum("fk,ka->fa", ds, N).ravel())
+    return out
+
+
+def edge_rule(X: np.ndarray, edges: np.ndarray, formulation: str, thickness: float, order: int):
+    """The Gauss rule of ``order`` points on each edge (nf, 2 or 3) in the reference configuration: (N (k, nen) the
+    shape values at the points, ds (nf, k) their measures w_k |dX/dxi| t, t the thickness or 2 pi R at the point)."""
     nen = edges.shape[1]
-    pts, wts = np.polynomial.legendre.leggauss(5)
+    pts, wts = np.polynomial.legendre.leggauss(order)
     N = np.zeros((len(pts), nen))
     dN = np.zeros((len(pts), nen))
     ddN = np.zeros(3)
@@ -145,8 +153,7 @@ def slave_weights(X: np.ndarray, edges: np.ndarray, formulation: str, thickness:
         ds = ds * 2.0 * np.pi * np.einsum("ka,fa->fk", N, Xe[:, :, 0])
     else:
         ds = ds * float(thickness)
-    np.add.at(out, edges.ravel(), np.einsum("fk,ka->fa", ds, N).ravel())
-    return out
+    return N, ds
 
 
 # -- pairs on planar bodies ----------------------------------------------------------------------------------------
@@ -172,8 +179,6 @@ def check_pair(pair, bodies, rigid) -> str | None:
                 f"circles")
     if len(planar) > 1:
         return f"{name}: the bodies have different formulations ({' and '.join(sorted(planar))})"
-    if pair.type != "nts":
-        return f"{name}: planar bodies take node-to-segment contact only (type = \"nts\")"
 
     if pair.adjust is not None:
         return f"{name}: adjust is not available on planar bodies"
@@ -221,7 +226,18 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
         raise ValueError(f"contact {pair.name}: no node set {slave[1]!r} on body {slave[0]!r}")
     nodes = smesh.node_sets[slave[1]] + soff
     faces = smesh.face_sets[slave[1]] + soff if slave[1] in smesh.face_sets else None
-    weight = slave_weights(X, faces, sb.formulation, thickness)[nodes] if faces is not None else np.ones(len(nodes))
+    own = None
+    if pair.type == "sts":  # segment-to-segment: the Gauss points of the slave edges as slaves (virtual points)
+        if faces is None:
+            raise ValueError(f"contact {pair.name}: segment-to-segment contact needs an edge set named {slave[1]!r}")
+        N, ds = edge_rule(X, faces, sb.formulation, thickness, pair.order or (2 if faces.shape[1] == 2 else 3))
+        per = N.shape[0]
+        nodes = num.points.add(np.repeat(faces, per, axis=0), np.tile(N, (len(faces), 1)))
+        weight, own = ds.ravel(), np.repeat(np.arange(len(faces)), per)
+    elif faces is not None:
+        weight = slave_weights(X, faces, sb.formulation, thickness)[nodes]
+    else:
+        weight = np.ones(len(nodes))
     mb = planar_body(num, master[0])
     segments = None
     if mb is not None:
@@ -239,7 +255,7 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
         penalty = pair.penalty_factor() * num.material_E((mb if mb is not None else sb).name) / h
     else:
         penalty = float(pair.penalty)
-    if pair.weighting == "area" or pair.penalty == "auto":
+    if pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
         if faces is None:
             raise ValueError(f"contact {pair.name}: area weighting needs an edge set named {slave[1]!r}")
         eps = penalty * weight
@@ -248,8 +264,8 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
     eps, eps_t, band, law = law_terms(pair, eps, penalty)   # (the pressure-overclosure laws as in 3D)
     kw = {"eps_t": eps_t, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
-          "slave_body": slave[0], "master_body": master[0], "band": band, "kind": "nts", "slave_faces": faces,
-          "law": law}
+          "slave_body": slave[0], "master_body": master[0], "band": band, "kind": pair.type, "slave_faces": faces,
+          "slave_facet": own, "law": law}
     if segments is not None:
         p = Pass(name, nodes, eps, weight, **kw)
         p.curve = Curve(segments)
@@ -257,7 +273,8 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
         rb = next(r for r in num.problem.rigid if r.name == master[0])
         p = Pass(name, nodes, eps, weight, analytic=analytic_surface(rb), rigid=rb.name, **kw)
     if pair.law == "tied":
-        p.tie_facet, p.tie_N = tie(p.curve, X, X[nodes], pair.tie_tolerance)
+        xs = np.vstack([X, num.points.positions(X)])[nodes] if pair.type == "sts" else X[nodes]
+        p.tie_facet, p.tie_N = tie(p.curve, X, xs, pair.tie_tolerance)
         if not (p.tie_facet >= 0).any():
             raise ValueError(f"contact {pair.name}: no slave node lies within the tie tolerance of the master edges; "
                              f"the edges do not meet: check the geometry or raise tie_tolerance")

@@ -210,18 +210,13 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
                              f"CalculiX weights such nodes by their share of the body's boundary faces, which contact "
                              f"in the plane does not have (its slaves are edge surfaces); {flag}")
         return False
-    if sts:
-        w.unsupported.append(f"{where}: TYPE=SURFACE TO SURFACE on {etype} elements: contact in the plane is "
-                             f"node-to-segment; with --ignore-unsupported the pair is node-to-segment with the same "
-                             f"law (K g per area at the slave nodes over their tributary edges; CalculiX integrates it "
-                             f"over the slave faces)")
-    entry: dict = {"weighting": "area"}
+    entry: dict = {"type": "sts"} if sts else {"weighting": "area"}   # (face-to-face: segment-to-segment)
     if it.behavior == "linear":  # (face-to-face: the linear penalty K; node-to-face: the arctan curve, as in 3D)
         w._linear(entry, it, sts, where)
     elif it.behavior in ("exponential", "tabular"):
         entry.update(it.curve(w.dialect))
     else:
-        entry = {"penalty": "auto", "method": "augmented", "weighting": "area"}
+        entry.update({"penalty": "auto", "method": "augmented"})
     if it.friction is not None and it.friction[0] > 0:  # covariant Coulomb friction along the master edges
         entry["friction"] = it.friction[0]
         if it.friction[1] is not None and it.friction[1] > 0:  # the stick slope, per area as K
