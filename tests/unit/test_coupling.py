@@ -320,7 +320,7 @@ def test_coupling_errors_and_refusals(tmp_path):
     """One line each (exit 2): a coupling on an undefined surface, a dof outside 1..6, *DISTRIBUTING on a node
     surface, *KINEMATIC of rotations alone, *KINEMATIC not after *COUPLING; refused (listed with the line, exit 2):
     ORIENTATION, a *BOUNDARY on a *DISTRIBUTING REF NODE, dofs 4-6 on a node that is no reference node, a moment on a
-    dof the *DISTRIBUTING does not name."""
+    dof the *DISTRIBUTING does not name, a *DISTRIBUTING in the Abaqus dialect (a constraint there)."""
     s1 = step("*CLOAD\n1000, 1, 1.0")
     kin = "*COUPLING, REF NODE=1000, SURFACE=SEND, CONSTRAINT NAME=C\n*KINEMATIC\n{dofs}"
     dist = "*COUPLING, REF NODE=1000, SURFACE=SEND, CONSTRAINT NAME=C\n*DISTRIBUTING\n{dofs}"
@@ -350,6 +350,16 @@ def test_coupling_errors_and_refusals(tmp_path):
     for k, (text, words) in enumerate(refused.items()):
         code, err = _run(tmp_path, f"ref{k}", text)
         assert code == 2 and words in err, (words, err)
+    # an Abaqus deck's *DISTRIBUTING (a constraint there): listed, not read as CalculiX's load distribution
+    deck = tmp_path / "abq.inp"
+    deck.write_text(bar(dist.format(dofs="4, 6"), s1))
+    buf = io.StringIO()
+    with contextlib.redirect_stderr(buf):
+        from covcontact.cli import main
+
+        code = main(["import", str(deck), "--out", str(tmp_path / "abq.toml"), "--dialect", "abaqus"])
+    assert code == 2 and "*DISTRIBUTING in an Abaqus deck: Abaqus' distributing coupling is a constraint" in \
+        buf.getvalue(), buf.getvalue()
 
 
 def test_reference_node_rotations_of_a_rigid_body(tmp_path):

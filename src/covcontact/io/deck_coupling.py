@@ -286,6 +286,12 @@ class DeckCouplings:
                                         f"node of another coupling or rigid body; with --ignore-unsupported this "
                                         f"coupling is left out")
                 continue
+            if dialect == "abaqus":  # (the same card, another meaning: listed, CalculiX's used with the flag)
+                self.unsupported.append(f"{cp.where}: *DISTRIBUTING in an Abaqus deck: Abaqus' distributing coupling "
+                                        f"is a constraint (the REF NODE follows the surface's weighted mean motion, "
+                                        f"the forces the deformed surface); covcontact has CalculiX's reading, dead "
+                                        f"nodal loads on the reference configuration: with --ignore-unsupported "
+                                        f"those are used (the same for small rotations)")
             self.by_label[cp.ref] = len(self.dist)
             self.dist.append(cp)
         self.coef, self.labels = [], []
