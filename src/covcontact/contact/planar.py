@@ -39,6 +39,7 @@ from .element import CASE_A, CASE_B, CASE_C, CASE_D, CASE_EXACT  # noqa: F401  (
 # uses them too
 from .planar_kernels import (INSIDE_TOL, MAX_ITER, project_on_segment, segment_core, segment_point,  # noqa: E402,F401
                              segment_shapes, vertex_core)
+from .selfcontact import FRONT_COS, HOLD_COS  # noqa: E402
 
 
 class Curve:
@@ -62,16 +63,23 @@ class Curve:
 
 
 FACET, VERTEX = 1, 2
+#: self-contact: a projection counts as inside its segment up to this far beyond its ends in xi (a slave facing a node
+#: of the other wall of a flattened surface otherwise flips between its two segments and the vertex on round-off)
+SELF_TOL_INSIDE = 1e-4
 
 
 def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, keep: np.ndarray | None = None,
-                   keep_band: float = 0.0):
+                   keep_band: float = 0.0, exclude: np.ndarray | None = None, own: np.ndarray | None = None,
+                   cos_max: np.ndarray | None = None):
     """Closest points of slaves xs (ns, 3) on the curve at positions xe: per slave (kind 0 none, FACET on a segment,
     VERTEX at a vertex; segment (the vertex's first segment for VERTEX); xi (the vertex's xi there); g; vertex node
     id (-1); sign). Candidates: the segments with a corner within ``reach`` (a segment length or more) of the slave;
     among the projections inside their segment the one of smallest |g|; none inside: the nearest corner shared by
     two segments. ``keep`` (frictional passes): per slave the segment of the last iterate (-1 none), kept while the
-    projection on it lies within ``keep_band`` of it (xi not clipped)."""
+    projection on it lies within ``keep_band`` of it (xi not clipped). Self-contact (``exclude``, (ns, k) segments
+    each slave never touches, -1 padded; ``own`` (ns, 2) its own outward normal; ``cos_max`` (ns,)): a segment counts
+    only if its normal makes a cosine below cos_max with the slave's own, a vertex only if the slave lies in front of
+    it (within FRONT_COS of -own, seen from the vertex) and is not the slave's own node (docs/theory.md section 13)."""
     from scipy.spatial import cKDTree
 
     ns = len(xs)
@@ -95,11 +103,14 @@ def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, k
                 kind[i], seg[i], xi[i], g[i] = FACET, keep[i], z, gap
                 continue
         cand = sorted({s for k in near[i] for s in curve.vertex_segments[int(nodes[k])]})
+        if exclude is not None:
+            cand = [s for s in cand if s not in exclude[i] and float(normals[s] @ own[i]) < cos_max[i]]
         best = np.inf
+        tol = INSIDE_TOL if exclude is None else SELF_TOL_INSIDE
         for s in cand:
             xseg = np.ascontiguousarray(xe[curve.segments[s]])
             z, gap, ok = project_on_segment(xseg, xs[i], 0.0)
-            if ok and abs(z) <= 1.0 + INSIDE_TOL and abs(gap) < best:
+            if ok and abs(z) <= 1.0 + tol and abs(gap) < best:
                 best = abs(gap)
                 kind[i], seg[i], xi[i], g[i] = FACET, s, min(max(z, -1.0), 1.0), gap
         if kind[i]:
@@ -112,6 +123,10 @@ def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, k
             if len(segs) != 2:
                 continue
             d = xs[i, :2] - xe[v, :2]
+            if exclude is not None:  # (self-contact: a vertex in front of the slave only, never its own node)
+                dn = float(np.linalg.norm(d))
+                if dn == 0.0 or float(-d @ own[i]) < FRONT_COS * dn or segs[0] in exclude[i] and segs[1] in exclude[i]:
+                    continue
             sg = 1.0 if float(d @ (normals[segs[0]] + normals[segs[1]])) >= 0.0 else -1.0
             kind[i], seg[i], vert[i], sign[i] = VERTEX, segs[0], v, sg
             xi[i] = -1.0 if curve.segments[segs[0], 0] == v else 1.0
@@ -168,8 +183,13 @@ def check_pair(pair, bodies, rigid) -> str | None:
     """Why the contact ``pair`` cannot run as planar contact (one line), or None. Called for pairs with a planar body
     on either side."""
     name = f"contact pair {pair.name!r}"
-    if pair.self_surfaces:
-        return f"{name}: self-contact of planar bodies is not available (give slave and master)"
+    if pair.self_surfaces:  # self-contact: edge sets of planar bodies of one formulation
+        own = [_body(bodies, b) for b, _ in pair.self_surfaces]
+        forms = {b.formulation if b is not None else "rigid" for b in own}
+        if len(forms) > 1 or not forms <= set(PLANAR_FORMULATIONS):
+            return (f"{name}: a self-contact surface in the plane is made of edge sets of planar bodies of one "
+                    f"formulation (found {', '.join(sorted(forms))})")
+        return None
     sb, mb = _body(bodies, pair.slave[0]), _body(bodies, pair.master[0])
     forms = {b.formulation for b in (sb, mb) if b is not None}
     planar = forms & set(PLANAR_FORMULATIONS)
@@ -209,6 +229,51 @@ def planar_body(num, name):
     """The planar Body ``name`` of the problem, or None."""
     b = _body(num.problem.bodies, name)
     return b if b is not None and b.formulation in PLANAR_FORMULATIONS else None
+
+
+def make_self_pass(num, name: str, pair, tangent: str | None, Pass, law_terms):
+    """The self-contact pass of ``pair`` in the plane: its edge sets (``pair.self_surfaces``) are one curve, slave and
+    master of itself; the slaves its nodes (or, ``type = "sts"``, the Gauss points of its edges), each excluding the
+    segments around it (its own segment for a point) and meeting the rest face to face (docs/theory.md section 13)."""
+    from .element import CASES
+    from .selfcontact import excluded_facets
+
+    X = num.reference()
+    parts = []
+    for b, f in pair.self_surfaces:
+        mesh, off = num.mesh_of(b)
+        if f not in mesh.face_sets:
+            raise ValueError(f"contact {pair.name}: no edge set {f!r} on body {b!r}")
+        body = planar_body(num, b)
+        parts.append((mesh.face_sets[f] + off, body.formulation, float(body.options.get("thickness", 1.0))))
+    segments = np.vstack([e for e, _, _ in parts])
+    own = None
+    if pair.type == "sts":
+        pts = [edge_rule(X, e, form, t, pair.order or (2 if e.shape[1] == 2 else 3)) + (e,) for e, form, t in parts]
+        conn = np.vstack([np.repeat(e, N.shape[0], axis=0) for N, _, e in pts])
+        slaves = num.points.add(conn, np.vstack([np.tile(N, (len(e), 1)) for N, _, e in pts]))
+        weight = np.concatenate([ds.ravel() for _, ds, _ in pts])
+        own = np.repeat(np.arange(len(segments)), [N.shape[0] for N, _, e in pts for _ in range(len(e))])
+        exclude = own[:, None].copy()
+    else:
+        slaves = np.unique(segments.ravel())
+        weight = sum(slave_weights(X, e, form, t) for e, form, t in parts)[slaves]
+        exclude = excluded_facets(segments, num.n_ext, slave_nodes=slaves)
+    h = float(np.mean(_chords(X, segments)))
+    if pair.penalty == "auto":
+        penalty = pair.penalty_factor() * max(num.material_E(b) for b, _ in pair.self_surfaces) / h
+    else:
+        penalty = float(pair.penalty)
+    eps = penalty * weight if (pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts") else \
+        np.full(len(slaves), penalty)
+    eps, eps_t, band, law = law_terms(pair, eps, penalty)
+    p = Pass(name, slaves, eps, weight, eps_t=eps_t, case=CASES[tangent or pair.tangent], mu=float(pair.friction or 0.0),
+             augmented=pair.method == "augmented", max_aug=pair.max_augmentations, pair=pair.name, band=band,
+             kind=pair.type, slave_faces=segments, slave_facet=own, law=law, exclude=exclude)
+    p.curve = Curve(segments)
+    if p.augmented:
+        p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
+    return p
 
 
 def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, analytic_surface, law_terms):
@@ -321,8 +386,21 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
     lengths = np.linalg.norm(xe[curve.segments[:, 1], :2] - xe[curve.segments[:, 0], :2], axis=1)
     reach = 1.5 * float(lengths.max()) if len(lengths) else 0.0
     friction = p.mu > 0.0 and c is not None
-    keep = g0.facet if friction and g0 is not None else None
-    kind, seg, xi, g, vert, sign = closest_points(curve, xe, xs, reach, keep, KEEP_BAND)
+    # every slave keeps its segment of the last iterate up to KEEP_BAND beyond it: a frictional one has its history
+    # there, and a slave at a vertex between two segments (a node facing a node of the other surface, as non-matching
+    # meshes of flat walls and flattened self-contact have them) otherwise flips between them, or falls into the
+    # valley between them, on round-off, and Newton cycles or diverges
+    keep = g0.facet if g0 is not None else None
+    own = cos_max = None
+    if p.exclude is not None:  # self-contact: each slave's own outward normal, the facing test's hysteresis
+        normals = curve.normals(xe)
+        if p.slave_facet is not None:
+            own = normals[p.slave_facet]
+        else:
+            own = np.where(p.exclude[:, :, None] >= 0, normals[np.maximum(p.exclude, 0)], 0.0).sum(axis=1)
+            own /= np.maximum(np.linalg.norm(own, axis=1), 1e-300)[:, None]
+        cos_max = np.where(g0.facet >= 0, HOLD_COS, 0.0) if g0 is not None else np.zeros(len(xs))
+    kind, seg, xi, g, vert, sign = closest_points(curve, xe, xs, reach, keep, KEEP_BAND, p.exclude, own, cos_max)
     ok = kind != 0
     t.facet = np.where(ok, seg, -1).astype(np.int64)
     t.xi = np.column_stack([np.where(ok, xi, 0.0), np.zeros(len(xi))])

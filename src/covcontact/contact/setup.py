@@ -239,6 +239,8 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
     the (body, face set) list of a self-contact, merged into one surface that is both slave and master."""
     if surfaces is None and planar.planar_body(num, slave[0]) is not None:  # contact in the plane (.planar)
         return planar.make_pass(num, name, slave, master, pair, tangent, Pass, analytic_surface, law_terms)
+    if surfaces is not None and planar.planar_body(num, surfaces[0][0]) is not None:
+        return planar.make_self_pass(num, name, pair, tangent, Pass, law_terms)
     X = num.reference()
     if surfaces is not None:
         slave_faces = np.vstack([num.mesh_of(b)[0].face_sets[f] + num.mesh_of(b)[1] for b, f in surfaces])
