@@ -92,10 +92,29 @@ class LoadCards:
 
     def _load(self, c: Card) -> None:
         st = self._in_step(c)
-        kind = c.name.lower()
+        kind = "dload" if c.name == "DSLOAD" else c.name.lower()   # (CalculiX keeps both as distributed loads)
         if c.params.get("OP", "MOD").upper() == "NEW":
             st.loads_new.add(kind)
         for k, row in enumerate(c.rows()):
+            if c.name == "DSLOAD":  # 'surface, P, magnitude': the pressure on each face of an element surface
+                if len(row) < 3:
+                    raise c.fail("a *DSLOAD line is 'surface, P, magnitude'", k)
+                if row[1].upper() != "P":
+                    self.m.unsupported.append(f"{c.where(k)}: *DSLOAD type {row[1]} (the pressure P is read)")
+                    continue
+                name = row[0].upper()
+                surf = self.m.surfaces.get(name)
+                if surf is None or name in getattr(self.m, "shell_surfaces", {}):
+                    raise c.fail(f"{row[0]!r} is no element *SURFACE of solid or planar elements defined above" if
+                                 surf is None else f"*DSLOAD on the shell surface {row[0]}: not supported (*DLOAD P "
+                                 f"on the shell elements is)", k)
+                if surf[0] != "ELEMENT":
+                    raise c.fail(f"the surface {row[0]} is a node surface: *DSLOAD needs element faces", k)
+                value = c.number(k, 2, row, "the magnitude")
+                for els, face, _ in surf[1]:
+                    st.loads.append(Load("dload", name, face, value, c.where(k), elements=els,
+                                         amplitude=c.param("AMPLITUDE"), delay=self._delay(c)))
+                continue
             if c.name == "CLOAD":
                 if len(row) < 3:
                     raise c.fail("a *CLOAD line is 'node or set, dof, magnitude'", k)

@@ -30,7 +30,8 @@ from .deck_testdata import (TEST_DATA_CARDS, finish_test_data, is_test_data_inpu
 #: the keywords read (everything else is unsupported); output requests are read for the .dat table
 SUPPORTED = ("HEADING", "NODE", "ELEMENT", "NSET", "ELSET", "SURFACE", "MATERIAL", "ELASTIC", "PLASTIC", "DENSITY",
              "HYPERELASTIC",
-             "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP", "CONTACT PAIR",
+             "SOLID SECTION", "BOUNDARY", "CLOAD", "DLOAD", "DSLOAD", "STEP", "STATIC", "DYNAMIC", "END STEP",
+             "CONTACT PAIR",
              "SURFACE INTERACTION", "SURFACE BEHAVIOR", "FRICTION", "EQUATION", "NODE PRINT", "EL PRINT",
              "NODE FILE", "EL FILE", "CONTACT PRINT", "CONTACT FILE", "NODE OUTPUT", "ELEMENT OUTPUT",
              "CONTACT OUTPUT", "OUTPUT", "RESTART", "AMPLITUDE", "TIE", "CONTROLS", "CHANGE FRICTION", "RIGID BODY",
@@ -400,7 +401,7 @@ class _Reader(LoadCards):
                 self._rigid_body(c)
             elif c.name == "BOUNDARY":
                 self._boundary(c)
-            elif c.name in ("CLOAD", "DLOAD"):
+            elif c.name in ("CLOAD", "DLOAD", "DSLOAD"):
                 self._load(c)
             elif c.name == "CONTROLS":
                 self._controls(c)
@@ -420,7 +421,7 @@ class _Reader(LoadCards):
         for p in c.params:
             if p in _HARMLESS or (c.name == "DYNAMIC" and p == "ALPHA") or (c.name == "CONTROLS") or (
                     c.name == "TIE" and p in ("POSITION TOLERANCE", "ADJUST") and c.params[p].upper() != "NO") or (
-                    p in ("AMPLITUDE", "TIME DELAY") and c.name in ("BOUNDARY", "CLOAD", "DLOAD")) or (
+                    p in ("AMPLITUDE", "TIME DELAY") and c.name in ("BOUNDARY", "CLOAD", "DLOAD", "DSLOAD")) or (
                     p == "FIXED" and c.name == "BOUNDARY" and self.step is not None) or (
                     c.name == "AMPLITUDE" and p == "TIME") or (c.name == "RIGID BODY" and p in ("REF NODE", "ROT NODE", "REFNODE", "ROTNODE")) or (
                     c.name == "CONTACT PAIR" and p in ("ADJUST", "SMALL SLIDING")) or (
