@@ -102,6 +102,9 @@ initial = 0.02
 min = 1e-4
 max = 0.02
 output_at = [0.5, 0.9, 0.95, 0.96, 0.97, 0.98, 0.99, 1.0]
+[output]
+vtu = false
+pictures = false
 """
 WHOLE = """
 [[rigid]]
