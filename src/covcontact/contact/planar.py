@@ -210,9 +210,12 @@ def check_pair(pair, bodies, rigid) -> str | None:
         return f"{name}: a tied planar pair bonds to the edges of a planar body, not to the rigid body {pair.master[0]!r}"
     if mb is None:
         rb = next((r for r in rigid if r.name == pair.master[0]), None)
-        if rb is None or rb.mesh is not None or rb.shape not in ("plane", "cylinder"):
+        if rb is None or rb.mesh is not None or rb.shape not in ("plane", "cylinder", "profile"):
             return (f"{name}: the rigid master {pair.master[0]!r} of a planar pair must be an analytic line (shape = "
-                    f"\"plane\" with a normal in the x-y plane) or circle (shape = \"cylinder\" with its axis along z)")
+                    f"\"plane\" with a normal in the x-y plane), circle (shape = \"cylinder\" with its axis along z) "
+                    f"or profile (shape = \"profile\" extruded along z; axisymmetric: revolved about the y axis)")
+        if rb.shape == "profile":
+            return _profile_in_plane(name, rb, sb.formulation)
         vec = np.asarray(rb.params["normal" if rb.shape == "plane" else "axis"], dtype=float)
         vec = vec / np.linalg.norm(vec)
         if rb.shape == "plane" and abs(vec[2]) > 1e-12:
@@ -222,6 +225,36 @@ def check_pair(pair, bodies, rigid) -> str | None:
         if rb.shape == "cylinder" and sb.formulation == "axisymmetric":
             return (f"{name}: a rigid circle in an axisymmetric model is a torus, not available; an axisymmetric "
                     f"pair takes a rigid line")
+    return None
+
+
+def _profile_in_plane(name: str, rb, formulation: str) -> str | None:
+    """Why the profile tool ``rb`` is no master curve of a planar pair (None when it is): in plane strain and plane
+    stress a profile extruded along z (its drawing in the x-y plane), in an axisymmetric model one revolved about the
+    y axis (x = 0: its drawing is the section's, p the radius); translations in the plane (along the axis in an
+    axisymmetric model) and, in the plane, rotations about z."""
+    ex, rv = rb.params.get("extrude"), rb.params.get("revolve")
+    unit = (lambda v: np.asarray(v, dtype=float) / np.linalg.norm(v))
+    if formulation == "axisymmetric":
+        ok = rv is not None and abs(abs(unit(rv["axis"])[1]) - 1.0) <= 1e-12 and \
+            abs(float(rv["center"][0])) <= 1e-12 and abs(float(rv["center"][2])) <= 1e-12
+        want = "revolved about the model's axis (revolve = { axis = [0, 1, 0], center = [0, y, 0] })"
+    else:
+        ok = ex is not None and abs(abs(unit(ex["axis"])[2]) - 1.0) <= 1e-12 and abs(float(ex["origin"][2])) <= 1e-12
+        want = "extruded along z from the x-y plane (extrude = { axis = [0, 0, 1], origin = [x, y, 0] })"
+    if not ok:
+        return f"{name}: the profile {rb.name!r} of a planar pair must be {want}"
+    m = rb.motion
+    t = np.asarray(getattr(m, "translation", np.zeros(3)), dtype=float)
+    w = np.asarray(getattr(m, "rotation", np.zeros(3)), dtype=float)
+    path = getattr(m, "path", None)
+    if path is not None:
+        path = np.asarray(path, dtype=float)
+        t = np.array([path[:, 1].max() - path[:, 1].min() if formulation == "axisymmetric" else 0.0, 0.0,
+                      np.abs(path[:, 3]).max()])
+    if abs(t[2]) > 0.0 or np.any(w[:2] != 0.0) or (formulation == "axisymmetric" and (t[0] != 0.0 or w[2] != 0.0)):
+        return (f"{name}: the profile {rb.name!r} of a planar pair moves out of its plane: it may translate in the "
+                f"x-y plane and turn about z (axisymmetric: translate along the axis y only)")
     return None
 
 
