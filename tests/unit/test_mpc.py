@@ -17,6 +17,8 @@ from covcontact.io.validate import InputError
 from covcontact.motion import rotation_matrix
 from covcontact.solvers.mpc import beam_constraint, line_constraint, plane_constraint
 
+from test_coupling import dat_blocks
+
 # a 1 x 1 x 4 block of 2 x 2 x 4 hex8: node i + 3 j + 9 k at (i/2, j/2, k)
 BLOCK = """
 [problem]
@@ -231,14 +233,8 @@ def _deck(mpc: str) -> str:
 
 def _dat_u(path) -> dict[int, np.ndarray]:
     """The last displacement block of a .dat."""
-    out: dict[int, np.ndarray] = {}
-    for ln in path.read_text().splitlines():
-        if ln.strip().startswith("displacements"):
-            out = {}
-        f = ln.split()
-        if len(f) == 4 and f[0].isdigit():
-            out[int(f[0])] = np.array([float(v) for v in f[1:]])
-    return out
+    blocks = dat_blocks(path)
+    return blocks[[k for k in blocks if k[0] == "displacements"][-1]]
 
 
 @pytest.mark.parametrize("kind", ["PLANE", "STRAIGHT"])

@@ -14,6 +14,8 @@ import pytest
 from covcontact.io.loader import load_problem
 from covcontact.tangent_check import check_tangent
 
+from planar_blocks import two_blocks
+
 E = 1000.0
 Q = 1.0          # the pressure on the upper block's top
 
@@ -43,24 +45,10 @@ def overclosure(law: str) -> float:
 
 
 def blocks(form: str, law: str, gap: float = 0.0, steps: int = 4, upper: str = "lx = 1.0, ly = 0.5, nx = 4") -> str:
-    ox = 1.0 if form == "axisymmetric" else 0.0
-    hold = "" if form == "axisymmetric" else "".join(
-        f'[[dirichlet]]\nset = "{b}.xmin"\ncomponents = "x"\nvalue = 0.0\n' for b in ("low", "up"))
-    body = """
-[[bodies]]
-name = "{n}"
-formulation = "{form}"
-element = "quad4"
-mesh = {{ generator = "rectangle", {size}, ny = 2, origin = [{ox}, {oy}] }}
-material = {{ model = "svk", E = {E}, nu = 0.3 }}
-"""
-    return ('[problem]\nname = "laws"\n' + body.format(n="low", form=form, ox=ox, oy=0.0, E=E, size="lx = 1.0, ly = 0.5, nx = 4")
-            + body.format(n="up", form=form, ox=ox + (0.05 if "0.9" in upper else 0.0), oy=0.5 + gap, E=E,
-                          size=upper)
-            + '[[dirichlet]]\nset = "low.ymin"\ncomponents = "y"\nvalue = 0.0\n' + hold
-            + f'[[pressure]]\nset = "up.ymax"\nvalue = {Q}\n'
-            + '[[contact]]\nname = "c"\nslave = "up.ymin"\nmaster = "low.ymax"\nweighting = "area"\n' + LAWS[law]
-            + f"[steps]\ncount = {steps}\n")
+    return two_blocks(form, '[[contact]]\nname = "c"\nslave = "up.ymin"\nmaster = "low.ymax"\nweighting = "area"\n'
+                      + LAWS[law], material=f'model = "svk", E = {E}, nu = 0.3', upper=upper,
+                      ox_up=0.05 if "0.9" in upper else 0.0, gap=gap, load=f'[[pressure]]\nset = "up.ymax"\nvalue = {Q}\n',
+                      steps=steps, name="laws")
 
 
 @pytest.mark.parametrize("form", ["plane_strain", "axisymmetric"])

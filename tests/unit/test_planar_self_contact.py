@@ -13,24 +13,12 @@ from covcontact.io.loader import load_problem
 from covcontact.io.validate import InputError
 from covcontact.tangent_check import check_tangent
 
+from planar_blocks import two_blocks
+
 
 def blocks(form: str, contact: str, upper: str = "lx = 1.0, ly = 0.5, nx = 3", ox_up: float = 0.0) -> str:
-    ox = 1.0 if form == "axisymmetric" else 0.0
-    hold = "" if form == "axisymmetric" else "".join(
-        f'[[dirichlet]]\nset = "{b}.xmin"\ncomponents = "x"\nvalue = 0.0\n' for b in ("low", "up"))
-    body = """
-[[bodies]]
-name = "{n}"
-formulation = "{form}"
-element = "quad8"
-mesh = {{ generator = "rectangle", {size}, ny = 2, origin = [{ox}, {oy}] }}
-material = {{ model = "neo-hooke", E = 1000.0, nu = 0.3 }}
-"""
-    return ('[problem]\nname = "self"\n'
-            + body.format(n="low", form=form, size="lx = 1.0, ly = 0.5, nx = 4", ox=ox, oy=0.0)
-            + body.format(n="up", form=form, size=upper, ox=ox + ox_up, oy=0.5)
-            + '[[dirichlet]]\nset = "low.ymin"\ncomponents = "y"\nvalue = 0.0\n' + hold
-            + '[[pressure]]\nset = "up.ymax"\nvalue = 2.0\n' + contact + "[steps]\ncount = 3\n")
+    return two_blocks(form, contact, cell="quad8", material='model = "neo-hooke", E = 1000.0, nu = 0.3', upper=upper,
+                      ox_up=ox_up, load='[[pressure]]\nset = "up.ymax"\nvalue = 2.0\n', steps=3, name="self")
 
 
 SELF = '[[contact]]\nname = "c"\nself = ["low.ymax", "up.ymin"]\npenalty = 1e5\nweighting = "area"\n'

@@ -14,31 +14,17 @@ import pytest
 from covcontact.io.loader import load_problem
 from covcontact.tangent_check import check_tangent
 
+from planar_blocks import two_blocks
+
 K = 1e5
 Q = 1.0
 
 
 def blocks(form: str, cell: str, upper: str = "lx = 1.0, ly = 0.5, nx = 4", ox_up: float = 0.0, extra: str = "",
            load: str | None = None, steps: int = 4) -> str:
-    ox = 1.0 if form == "axisymmetric" else 0.0
-    hold = "" if form == "axisymmetric" else "".join(
-        f'[[dirichlet]]\nset = "{b}.xmin"\ncomponents = "x"\nvalue = 0.0\n' for b in ("low", "up"))
-    body = """
-[[bodies]]
-name = "{n}"
-formulation = "{form}"
-element = "{cell}"
-mesh = {{ generator = "rectangle", {size}, ny = 2, origin = [{ox}, {oy}] }}
-material = {{ model = "svk", E = 1000.0, nu = 0.3 }}
-"""
-    return ('[problem]\nname = "sts"\n'
-            + body.format(n="low", form=form, cell=cell, size="lx = 1.0, ly = 0.5, nx = 4", ox=ox, oy=0.0)
-            + body.format(n="up", form=form, cell=cell, size=upper, ox=ox + ox_up, oy=0.5)
-            + '[[dirichlet]]\nset = "low.ymin"\ncomponents = "y"\nvalue = 0.0\n'
-            + (hold if load is None else "")
-            + (f'[[pressure]]\nset = "up.ymax"\nvalue = {Q}\n' if load is None else load)
-            + f'[[contact]]\nname = "c"\nslave = "up.ymin"\nmaster = "low.ymax"\ntype = "sts"\npenalty = {K}\n'
-            + extra + f"[steps]\ncount = {steps}\n")
+    contact = f'[[contact]]\nname = "c"\nslave = "up.ymin"\nmaster = "low.ymax"\ntype = "sts"\npenalty = {K}\n' + extra
+    return two_blocks(form, contact, cell=cell, upper=upper, ox_up=ox_up, steps=steps, name="sts", hold=load is None,
+                      load=f'[[pressure]]\nset = "up.ymax"\nvalue = {Q}\n' if load is None else load)
 
 
 @pytest.mark.parametrize("form", ["plane_strain", "axisymmetric"])
