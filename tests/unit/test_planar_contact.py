@@ -29,6 +29,8 @@ from covcontact.contact.planar import (
 )
 from covcontact.io.loader import load_problem
 
+from planar_blocks import two_blocks
+
 EPS = 1.0e3
 H = 1e-6
 
@@ -260,23 +262,12 @@ def run(tmp_path, name: str, text: str):
 
 
 def blocks(form: str, cell: str, nx_up: int, origin_x: float, extra: str = "") -> str:
-    hold = "" if form == "axisymmetric" else "".join(
-        f'\n[[dirichlet]]\nset = "{b}.xmin"\ncomponents = "x"\nvalue = 0.0\n' for b in ("low", "up"))
-    body = '''
-[[bodies]]
-name = "{n}"
-formulation = "{form}"
-element = "{cell}"
-mesh = {{ generator = "rectangle", lx = 1.0, ly = 0.5, nx = {nx}, ny = 2, origin = [{ox}, {oy}] }}
-material = {{ model = "svk", E = 1000.0, nu = 0.3 }}
-'''
-    return (f'[problem]\nname = "patch"\n'
-            + body.format(n="low", form=form, cell=cell, nx=4, ox=origin_x, oy=0.0)
-            + body.format(n="up", form=form, cell=cell, nx=nx_up, ox=origin_x, oy=0.5)
-            + '\n[[dirichlet]]\nset = "low.ymin"\ncomponents = "y"\nvalue = 0.0\n' + hold
-            + '\n[[pressure]]\nset = "up.ymax"\nvalue = 1.0\n'
-            + '\n[[contact]]\nname = "c"\nslave = "up.ymin"\nmaster = "low.ymax"\npenalty = 1e7\nweighting = "area"\n'
-            + extra)
+    """Two blocks of ``cell`` (the upper with ``nx_up`` cells), the upper pressed by 1 (``origin_x``: 1 in an
+    axisymmetric model, 0 otherwise, as planar_blocks places them)."""
+    assert origin_x == (1.0 if form == "axisymmetric" else 0.0)
+    return two_blocks(form, '[[contact]]\nname = "c"\nslave = "up.ymin"\nmaster = "low.ymax"\npenalty = 1e7\n'
+                      'weighting = "area"\n' + extra, cell=cell, upper=f"lx = 1.0, ly = 0.5, nx = {nx_up}", steps=1,
+                      name="patch")
 
 
 @pytest.mark.parametrize("form,cell", [("plane_strain", "quad4"), ("plane_stress", "quad8"),
