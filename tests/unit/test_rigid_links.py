@@ -438,3 +438,47 @@ def test_deck_el_print_peeq(tmp_path):
             assert np.all(rows[:, 2] > 0.0) and 0.0 < rows[:, 2].mean() < np.log(1.25)
         else:
             assert np.all(rows[:, 2] == 0.0)
+
+
+@pytest.mark.parametrize("form", ["plane_strain", "axisymmetric"])
+def test_planar_body_pulled_through_an_attached_cap(tmp_path, form):
+    """A planar block (St. Venant-Kirchhoff, nu = 0) whose top edge is attached to a rigid cap moved up by 0.25 (a
+    deck's *RIGID BODY on CPE or CAX elements): the homogeneous stretch, u_y = 0.25 Y at every node (1e-9), and the
+    base's reaction E/2 (l^3 - l) times the section (1e-9; the thickness 1, or pi (2^2 - 1) about the axis). (The
+    held z-dofs of the planar body kept their diagonal through the attached nodes' reduction: before, the reduced
+    tangent had empty rows there.)"""
+    ox = 1.0 if form == "axisymmetric" else 0.0
+    text = f"""
+[problem]
+name = "cap"
+[[bodies]]
+name = "b"
+formulation = "{form}"
+element = "quad4"
+material = {{ model = "svk", E = 100.0, nu = 0.0 }}
+mesh = {{ generator = "rectangle", lx = 1.0, ly = 1.0, nx = 2, ny = 3, origin = [{ox}, 0.0] }}
+[[dirichlet]]
+set = "b.ymin"
+components = "y"
+[[dirichlet]]
+set = "b.xmin"
+components = "x"
+[[rigid]]
+name = "cap"
+attach = ["b.ymax"]
+attach_components = ["y"]
+reference = [{ox + 0.5}, 1.0, 0.0]
+motion = {{ translation = [0.0, 0.25, 0.0] }}
+[steps]
+count = 2
+"""
+    path = tmp_path / "cap.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0
+    X = load_problem(path).bodies[0].mesh.points
+    u = res.u.reshape(-1, 3)[: len(X)]
+    np.testing.assert_allclose(u[:, 1], 0.25 * X[:, 1], atol=1e-9)
+    area = np.pi * (2.0 ** 2 - 1.0 ** 2) if form == "axisymmetric" else 1.0
+    assert res.summary["steps"][-1]["reactions"]["b.ymin"][1] == pytest.approx(-50.0 * (1.25 ** 3 - 1.25) * area,
+                                                                               rel=1e-9)

@@ -14,6 +14,17 @@ import numpy as np
 import scipy.sparse as sp
 
 
+def unit_diagonal(mask: np.ndarray, system) -> sp.csr_matrix:
+    """The diagonal that a constraint layer adds to its reduced tangent so that the held dofs keep their diagonal
+    in the pattern: 1 at its dependent dofs (``mask``) and at the z-dofs of planar bodies (held: their zero diagonal,
+    which the reduction P^T K P drops, kept as 1)."""
+    on = mask.astype(float)
+    planar = getattr(system, "planar_dofs", np.zeros(0, dtype=np.int64))
+    if len(planar):
+        on[planar] = 1.0
+    return sp.diags(on).tocsr()
+
+
 class LinearConstraints:
     """The equations of a problem (``covcontact.loads.Equation``) on the dofs of ``system``."""
 
@@ -48,12 +59,7 @@ class LinearConstraints:
         self.T = (sp.diags(keep) + A).tocsr()
         self.Tt = self.T.T.tocsr()
         self.rows = A[self.dependent].tocsr()
-        self.unit = sp.diags(self.mask.astype(float)).tocsr()  # (the dependent dofs' diagonal: kept in the pattern)
-        planar = getattr(system, "planar_dofs", np.zeros(0, dtype=np.int64))
-        if len(planar):  # (planar bodies' z-dofs, held: their zero diagonal, which T^T K T drops, kept as 1)
-            on = self.mask.astype(float)
-            on[planar] = 1.0
-            self.unit = sp.diags(on).tocsr()
+        self.unit = unit_diagonal(self.mask, system)
 
     def complete(self, u: np.ndarray) -> None:
         """Set the dependent dofs of ``u`` (in place) from the others."""
@@ -112,7 +118,7 @@ class RigidLinks:
         self.dependent = np.flatnonzero(self.mask)
         keep = np.flatnonzero(~self.mask)
         self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
-        self.unit = sp.diags(self.mask.astype(float)).tocsr()
+        self.unit = unit_diagonal(self.mask, system)
         self._theta = [np.zeros(3) for _ in self.links]  # each body's rotation vector at the last ``complete``
         # the bodies' dofs (t, theta): their diagonal kept in the pattern (a component no eliminated dof depends on,
         # such as a translation a partial coupling does not hold, has no entries; prescribed, it needs its diagonal)

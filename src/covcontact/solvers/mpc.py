@@ -26,6 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..assembly.system import InvertedElementError
+from .constraints import unit_diagonal
 
 #: the kinds, and how many defining nodes each takes before the constrained ones
 KINDS = {"plane": 3, "straight": 2, "beam": 2}
@@ -196,7 +197,7 @@ class NonlinearMPCs:
         self.dependent = np.flatnonzero(self.mask)
         keep = np.flatnonzero(~self.mask)
         self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
-        self.unit = sp.diags(self.mask.astype(float)).tocsr()
+        self.unit = unit_diagonal(self.mask, system)
         self._u = np.zeros(n)
 
     def complete(self, u: np.ndarray) -> None:
