@@ -485,3 +485,38 @@ def test_prescribed_rotation_vector_is_the_total_rotation(tmp_path, kind):
         np.testing.assert_allclose(x, want, rtol=0.0, atol=1e-7)                 # (Newton's tolerance: 1e-8)
         body = next(iter(last[list(last)[k]]["rigid_bodies"].values()))
         np.testing.assert_allclose(body["rotation"], theta, rtol=0.0, atol=1e-12)
+
+
+def test_kinematic_coupling_on_planar_edges(tmp_path):
+    """*COUPLING with *KINEMATIC 1-3 on the right edge (S2) of a CPS4 strip 4 x 1 (thickness 0.5, nu = 0), its REF NODE
+    pulled by *CLOAD F along x: the coupling moves in the plane (z is the planar body's; the rotations about x and
+    y are held), the strip stretches homogeneously, so the REF NODE moves by 4 (l - 1) with E/2 (l^3 - l) A = F,
+    A = 0.5 (St. Venant-Kirchhoff, closed form; the .dat's seven digits); *SECTION PRINT on the planar edge is said
+    in a note, *DISTRIBUTING on planar edges refused with one line."""
+    from scipy.optimize import brentq
+
+    from covcontact.cli import main
+
+    nodes = "\n".join(f"{j * 5 + i + 1}, {float(i)}, {float(j)}, 0." for j in range(2) for i in range(5))
+    els = "\n".join(f"{i + 1}, {i + 1}, {i + 2}, {i + 7}, {i + 6}" for i in range(4))
+    F = 10.0
+    deck = (f"*NODE\n{nodes}\n1000, 4., 0.5, 0.\n*ELEMENT, TYPE=CPS4, ELSET=EALL\n{els}\n"
+            "*ELSET, ELSET=ERIGHT\n4\n*SURFACE, NAME=SR\nERIGHT, S2\n"
+            "*MATERIAL, NAME=M\n*ELASTIC\n100., 0.\n*SOLID SECTION, ELSET=EALL, MATERIAL=M\n0.5\n"
+            "*COUPLING, REF NODE=1000, SURFACE=SR, CONSTRAINT NAME=PULL\n*KINEMATIC\n1, 3\n"
+            "*BOUNDARY\n1, 1, 2\n6, 1\n*NSET, NSET=REF\n1000\n"
+            f"*STEP, NLGEOM\n*STATIC\n0.5, 1.\n*CLOAD\n1000, 1, {F}\n*NODE PRINT, NSET=REF\nU\n"
+            "*SECTION PRINT, SURFACE=SR, NAME=S1\nSOF\n*END STEP\n")
+    path = tmp_path / "strip.inp"
+    path.write_text(deck)
+    buf = io.StringIO()
+    with contextlib.redirect_stderr(buf):
+        assert main(["run", str(path), "--out", str(tmp_path / "o")]) == 0
+    assert "*SECTION PRINT, SURFACE=SR: edges of planar elements (CPS4): not printed" in buf.getvalue()
+    lam = brentq(lambda x: 50.0 * (x ** 3 - x) * 0.5 - F, 1.0, 2.0, xtol=1e-15)
+    u = dat_blocks(tmp_path / "o" / "strip.dat")
+    ref = u[[k for k in u if k[0] == "displacements"][-1]][1000]
+    assert ref[0] == pytest.approx(4.0 * (lam - 1.0), rel=1e-6) and abs(ref[1]) < 1e-9
+    path.write_text(deck.replace("*KINEMATIC\n1, 3", "*DISTRIBUTING\n1, 3"))
+    code, err = _run(tmp_path, "dist", path.read_text())
+    assert code == 2 and "*DISTRIBUTING on the edges of planar elements (CPS4) is not supported" in err

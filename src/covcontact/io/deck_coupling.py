@@ -46,6 +46,12 @@ FACE_NODES = {
     "hex8": {k: v[:4] for k, v in _HEX20.items()}, "hex20": _HEX20,
     "tet4": {k: v[:3] for k, v in _TET10.items()}, "tet10": _TET10, "wedge6": _WEDGE6,
 }
+#: the faces S1..Sn of planar elements: their edges, from corner k to corner k + 1 (then the edge's mid-node)
+EDGE_NODES = {
+    "quad4": {1: (0, 1), 2: (1, 2), 3: (2, 3), 4: (3, 0)},
+    "quad8": {1: (0, 1, 4), 2: (1, 2, 5), 3: (2, 3, 6), 4: (3, 0, 7)},
+    "tri3": {1: (0, 1), 2: (1, 2), 3: (2, 0)}, "tri6": {1: (0, 1, 3), 2: (1, 2, 4), 3: (2, 0, 5)},
+}
 
 _G2 = 1.0 / np.sqrt(3.0)
 _G3 = np.sqrt(0.6)
@@ -164,6 +170,10 @@ def read_coupling_card(reader, c: Card, following: Card | None) -> None:
         if not pending.faces:
             raise c.fail(f"the surface {pending.surface} of the *COUPLING is a node surface: *DISTRIBUTING needs an "
                          f"element (face) surface")
+        planar = sorted({etype for etype, _ in pending.faces if etype[:3] in ("CPE", "CPS", "CAX")})
+        if planar:
+            raise c.fail(f"*DISTRIBUTING on the edges of planar elements ({', '.join(planar)}) is not supported "
+                         f"(*KINEMATIC is)")
         pending.dofs = tuple(sorted(set(dofs)))
         return
     if not dofs:  # (Abaqus: all dofs; CalculiX couples none)
@@ -207,10 +217,10 @@ def _faces(m, refs, surface: str = "", owner: str = "") -> list:
             hit = np.isin(els, labels)
             if not hit.any():
                 continue
-            if cell not in FACE_NODES:  # (planar elements' faces are edges)
+            table = FACE_NODES.get(cell, EDGE_NODES.get(cell))  # (planar elements' faces are edges)
+            if table is None:
                 raise DeckError(f"{where}: *SURFACE{' ' + surface if surface else ''}: {etype} elements: a coupling "
-                                f"on planar elements is not supported{owner}")
-            table = FACE_NODES[cell]
+                                f"on them is not supported{owner}")
             if face not in table:
                 raise DeckError(f"{where}: S{face}: {cell} elements have the faces S1..S{len(table)}")
             rows = conn[np.isin(labels, els)]
@@ -447,11 +457,20 @@ def coupling_names(m, names: list[str]) -> list[str]:
 
 
 def coupled_components(m) -> dict[int, list[int]]:
-    """{rigid body: the components 0..2 its nodes follow} of the *KINEMATIC couplings that hold some of them only."""
+    """{rigid body: the components 0..2 its nodes follow} of the *KINEMATIC couplings that hold some of them only (on
+    planar elements never z, which their bodies hold)."""
     out = {}
+    planar = planar_couplings(m)
     for cp in _couplings(m):
         if cp.kind == "kinematic" and cp.rigid >= 0:
-            comps = [d - 1 for d in cp.dofs if d <= 3]
+            comps = [d - 1 for d in cp.dofs if d <= 3 and not (d == 3 and cp.rigid in planar)]
             if len(comps) < 3:
                 out[cp.rigid] = comps
     return out
+
+
+def planar_couplings(m) -> set[int]:
+    """The rigid bodies of *KINEMATIC couplings on the edges of planar elements (CPE, CPS, CAX): they move in the
+    plane, so their translation along z and rotations about x and y are held."""
+    return {cp.rigid for cp in _couplings(m) if cp.kind == "kinematic" and cp.rigid >= 0
+            and any(etype[:3] in ("CPE", "CPS", "CAX") for etype, _ in cp.faces)}

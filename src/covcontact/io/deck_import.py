@@ -934,6 +934,14 @@ class _Writer:
             self.notes.append(f"{where}: *SECTION PRINT, SURFACE={name}: a node surface; section forces need element "
                               f"faces (nothing printed, as in CalculiX)")
             return False
+        els = np.concatenate([e for e, _, _ in self.m.surfaces[name][1]] or [np.zeros(0, np.int64)])
+        planar = sorted({t for t, _, labels, _ in self.m.blocks if t[:3] in ("CPE", "CPS", "CAX")
+                         and np.isin(labels, els).any()})
+        if planar:  # (CalculiX prints its expanded elements' section; covcontact tabulates 3D faces only)
+            self.notes.append(f"{where}: *SECTION PRINT, SURFACE={name}: edges of planar elements ({', '.join(planar)}): "
+                              f"not printed in the .dat (the reactions and contact forces are in covcontact's own "
+                              f"results)")
+            return False
         return True
 
     def _contact_pairs(self) -> dict[str, str]:

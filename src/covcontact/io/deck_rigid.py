@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .deck import DeckError
-from .deck_coupling import coupled_components, coupling_names
+from .deck_coupling import coupled_components, coupling_names, planar_couplings
 
 _NAMES = ("x", "y", "z", "rx", "ry", "rz")
 
@@ -43,6 +43,8 @@ class DeckRigid:
         # (a *KINEMATIC coupling of some dofs: the translations its nodes do not follow move nothing, they are held
         # where nothing prescribes them, as CalculiX leaves such a dof out)
         self.idle = {r: [c for c in range(3) if c not in comps] for r, comps in self.components.items()}
+        for r in planar_couplings(m):  # (on planar elements: in the plane; tz is idle already, no node follows it)
+            self.idle[r] = sorted(set(self.idle.get(r, [])) | {3, 4})
         # each body's reference point: its REF NODE, or (without one: its translation can be neither prescribed nor
         # loaded) the centroid of its nodes
         self.origins = [m.X[index[ref]] if ref is not None else m.X[index[nodes]].mean(axis=0)
