@@ -329,13 +329,14 @@ def test_node_line_without_coordinates_is_at_the_origin(tmp_path):
 
 def test_dsload_is_the_pressure_on_the_surface_faces(tmp_path):
     """*DSLOAD 'surface, P, magnitude' (CalculiX's pressure on an element surface) loads the surface's faces as *DLOAD
-    Pn on them does: the same [[pressure]] entries and the same displacements (CPE4 blocks pressed together); a load
-    type other than P is listed as unsupported, a node surface is one line (exit 2)."""
+    Pn on them does: the same displacements (CPE4 blocks pressed together; the surface's faces on four lines of one
+    face number, which an early version lost but the last of); a load type other than P is listed as unsupported, a
+    node surface is one line (exit 2)."""
     from test_planar_laws import _deck
 
     base = _deck("CPE4", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n500., 0.05\n")
     ds = base.replace("*DLOAD\nTOPU, P3, 1.0", "*DSLOAD\nTOPS, P, 1.0").replace(
-        "*SURFACE, NAME=MAST", "*SURFACE, NAME=TOPS\nTOPU, S3\n*SURFACE, NAME=MAST")
+        "*SURFACE, NAME=MAST", "*SURFACE, NAME=TOPS\n13, S3\n14, S3\n15, S3\n16, S3\n*SURFACE, NAME=MAST")
     assert ds != base
     u = []
     for name, text in (("dload", base), ("dsload", ds)):
@@ -350,6 +351,7 @@ def test_dsload_is_the_pressure_on_the_surface_faces(tmp_path):
     deck = tmp_path / "bad.inp"
     deck.write_text(ds.replace("TOPS, P, 1.0", "TOPS, TRVEC, 1.0, 0., 1., 0."))
     assert "*DSLOAD type TRVEC" in " ".join(import_deck(deck, tmp_path / "bad" / "p.toml").unsupported)
-    deck.write_text(ds.replace("*SURFACE, NAME=TOPS\nTOPU, S3", "*SURFACE, NAME=TOPS, TYPE=NODE\n26"))
+    deck.write_text(ds.replace("*SURFACE, NAME=TOPS\n13, S3\n14, S3\n15, S3\n16, S3",
+                               "*SURFACE, NAME=TOPS, TYPE=NODE\n26"))
     with pytest.raises(DeckError, match=r"bad\.inp:\d+: \*DSLOAD: the surface TOPS is a node surface"):
         import_deck(deck, tmp_path / "bad2" / "p.toml")

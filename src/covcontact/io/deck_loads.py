@@ -111,8 +111,11 @@ class LoadCards:
                 if surf[0] != "ELEMENT":
                     raise c.fail(f"the surface {row[0]} is a node surface: *DSLOAD needs element faces", k)
                 value = c.number(k, 2, row, "the magnitude")
+                by_face: dict[int, list] = {}   # (one load per face number: the surface's lines grouped)
                 for els, face, _ in surf[1]:
-                    st.loads.append(Load("dload", name, face, value, c.where(k), elements=els,
+                    by_face.setdefault(face, []).append(np.asarray(els, dtype=np.int64))
+                for face, parts in by_face.items():
+                    st.loads.append(Load("dload", name, face, value, c.where(k), elements=np.concatenate(parts),
                                          amplitude=c.param("AMPLITUDE"), delay=self._delay(c)))
                 continue
             if c.name == "CLOAD":
