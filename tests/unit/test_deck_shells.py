@@ -387,3 +387,28 @@ def test_edges_of_other_shells_are_refused(tmp_path):
                              "*ELEMENT, TYPE=S3, ELSET=SHELL\n2, 11, 12, 14\n3, 12, 15, 16")
     with pytest.raises(DeckError, match="S6 of an S3 element is an edge: covcontact reads the edges of S4 and S4R"):
         import_deck(_write(tmp_path / "s3.inp", text), tmp_path / "i" / "s3.toml")
+
+
+@pytest.mark.parametrize("fold, knot", [(90.0, True), (30.0, True), (10.0, False)])
+def test_creases_beyond_calculix_s_knot_angle_are_listed(tmp_path, fold, knot):
+    """The S4 cantilever folded about the line x = L / 2 by ``fold`` degrees: beyond 20 degrees between the
+    elements' normals at a node CalculiX expands the node once per normal and joins the expansions by a knot, which
+    covcontact's one director per node is not (at a 90 degree junction the mean director bends it): listed as
+    unsupported with the elements, the node and the angle (exit 2); a 10 degree fold is one smooth director and runs."""
+    text = plate_deck()
+    a = np.radians(fold)
+    out = []
+    for line in text.splitlines():
+        f = line.split(", ")
+        if len(f) == 4 and f[0].isdigit() and not line.startswith("*"):
+            x = float(f[1])
+            if x > 5.0:
+                f[1], f[3] = repr(float(5.0 + (x - 5.0) * np.cos(a))), repr(float((x - 5.0) * np.sin(a)))
+            line = ", ".join(f)
+        out.append(line)
+    deck, res = _run_deck(tmp_path, "\n".join(out) + "\n")
+    if knot:
+        assert res.returncode == 2 and f"at {fold:.0f} degrees" in res.stderr and "knot" in res.stderr, res.stderr
+        assert "shell elements" in res.stderr and "meet at node" in res.stderr
+    else:
+        assert res.returncode == 0, res.stderr

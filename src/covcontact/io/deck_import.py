@@ -90,6 +90,7 @@ class _Writer:
         self.b = Parts(m)
         self.shells = DeckShells(m, self.b, dialect)  # (shell elements made into solid-shells: bodies after these)
         self.notes += self.shells.notes
+        self.unsupported += self.shells.unsupported
         self.body_names = self._body_names()
         self.rigid = DeckRigid(m, self.b)
         self.couplings = DeckCouplings(m, self.b, self.rigid, self.unsupported, self.notes, dialect)

@@ -176,10 +176,11 @@ class DeckShells:
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
 
-        from ..mesh.shell import ShellMeshError, extrude_surface
+        from ..mesh.shell import ShellMeshError, _orient, extrude_surface, knots
 
         self.m, self.parts, self.first, self.dialect = m, parts, parts.n, dialect
         self.notes: list[str] = []
+        self.unsupported: list[str] = []
         self.bodies: list[dict] = []
         self.label_body = np.full(int(m.node_labels.max()) + 1 if m.node_labels.size else 1, -1, dtype=np.int64)
         self.label_index = np.full(self.label_body.size, -1, dtype=np.int64)
@@ -268,6 +269,19 @@ class DeckShells:
                                         f"shells have one thickness per node (give it with *NODAL THICKNESS)")
                     t[i], t_src[i] = sec[2], sec[4]
             points = m.X[index[nodes]]
+            try:
+                found = knots(points, _orient(cells, cell), cell)
+            except ShellMeshError:
+                found = []  # (a surface that cannot be oriented is said by extrude_surface below)
+            if found:  # (CalculiX's knot: a rigid body of the node's expansions, one per normal; not here)
+                i, a, b, angle = found[0]
+                self.unsupported.append(
+                    f"{where[mine[a]]}: shell elements {int(labels[mine[a]])} and {int(labels[mine[b]])} meet at node "
+                    f"{int(nodes[i])} at {angle:.0f} degrees ({len(found)} such node{'s' if len(found) > 1 else ''}: a "
+                    f"junction or a crease beyond CalculiX's 20): CalculiX expands the node once per normal and joins "
+                    f"the expansions by a knot, covcontact's solid-shells have one director per node (the mean), which "
+                    f"bends such a junction; with --ignore-unsupported the mean is used. Mesh the junction with solid "
+                    f"elements, or refine a curved shell below 20 degrees between neighbours")
             try:
                 mesh0 = extrude_surface(points, cell, cells, t, offs.pop())
             except ShellMeshError as exc:

@@ -41,7 +41,9 @@ OFFSETS = {"middle": 0.0, "top": 0.5, "bottom": -0.5}
 
 _CORNERS = {"quad4": 4, "quad9": 4}
 #: a quad9 cell's nodes in reversed orientation (corners 0 3 2 1, edge mid-nodes 3-0 2-3 1-2 0-1, centre)
-_REVERSE = {"quad4": np.array([0, 3, 2, 1]), "quad9": np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])}
+_REVERSE = {"quad4": np.array([0, 3, 2, 1]), "quad9": np.array([0, 3, 2, 1, 7, 6, 5, 4, 8]),
+            "quad8": np.array([0, 3, 2, 1, 7, 6, 5, 4]), "tri3": np.array([0, 2, 1]),
+            "tri6": np.array([0, 2, 1, 5, 4, 3])}
 #: natural coordinates of a quad9's nodes (the quad4's are its first four)
 _Q9_NAT = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0, 1], [-1, 0], [0, 0]], dtype=float)
 
@@ -136,6 +138,41 @@ def _directors(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndar
         raise ShellMeshError(f"node {bad} (0-based) has no direction: the normals of its cells cancel (a fold of "
                              f"the surface onto itself?)")
     return acc / np.where(size > 0.0, size, 1.0)[:, None]
+
+
+def knots(points: np.ndarray, cells: np.ndarray, cell_type: str, limit: float = 20.0) -> list[tuple[int, int, int,
+                                                                                                     float]]:
+    """The nodes where CalculiX's shell expansion makes a knot because the normals of the cells there spread: per
+    node, the normals x_xi x x_eta of its cells at it (``cells`` oriented consistently), and a knot where one of them
+    makes more than ``limit`` degrees with the first cell's (CalculiX's reference normal: the cells within 20 degrees
+    of it share one normal, the others another). Returns (node, first cell, other cell, angle) per such node."""
+    from ..fem.shapes import shape_functions
+
+    if cell_type == "quad8":  # (its serendipity surface, as quad9 with the centre node)
+        points, _, cells = _quad8_to_quad9(points, np.zeros(points.shape[0]), cells)
+        cell_type = "quad9"
+    x = points[cells]
+    if cell_type.startswith("tri"):  # (the plane of the corners)
+        flat = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+        normal = np.repeat(flat[:, None, :], cells.shape[1], axis=1)
+    else:
+        _, dN, _ = shape_functions(cell_type, _Q9_NAT[: cells.shape[1]])
+        normal = np.cross(np.einsum("ebi,ab->eai", x, dN[:, :, 0]), np.einsum("ebi,ab->eai", x, dN[:, :, 1]))
+    normal /= np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-300)
+    node, cell = cells.ravel(), np.repeat(np.arange(len(cells)), cells.shape[1])
+    first = np.full(points.shape[0], -1, dtype=np.int64)
+    order = np.argsort(cell, kind="stable")
+    for k in order[::-1]:  # (the lowest cell at each node last, so it stays)
+        first[node[k]] = k
+    cos = np.einsum("ki,ki->k", normal.reshape(-1, 3), normal.reshape(-1, 3)[first[node]])
+    bad = np.flatnonzero(cos < np.cos(np.radians(limit)))
+    out, seen = [], set()
+    for k in bad[np.argsort(cos[bad])]:
+        if int(node[k]) not in seen:
+            seen.add(int(node[k]))
+            out.append((int(node[k]), int(cell[first[node[k]]]), int(cell[k]),
+                        float(np.degrees(np.arccos(np.clip(cos[k], -1.0, 1.0))))))
+    return out
 
 
 def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thickness, offset="middle",
