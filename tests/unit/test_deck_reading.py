@@ -355,3 +355,24 @@ def test_dsload_is_the_pressure_on_the_surface_faces(tmp_path):
                                "*SURFACE, NAME=TOPS, TYPE=NODE\n26"))
     with pytest.raises(DeckError, match=r"bad\.inp:\d+: \*DSLOAD: the surface TOPS is a node surface"):
         import_deck(deck, tmp_path / "bad2" / "p.toml")
+
+
+def test_a_node_defined_again_takes_its_last_place(tmp_path):
+    """A *NODE card that defines a node again (cgx's mean-rotation files do): the last coordinates hold, as in
+    CalculiX, said in a note; a *SECTION PRINT on a surface no *SURFACE defines prints nothing, said in a note (CalculiX
+    warns and goes on)."""
+    from test_planar_laws import _deck
+
+    base = _deck("CPE4", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=LINEAR\n500., 0.05\n")
+    text = base.replace("*ELEMENT, TYPE=CPE4, ELSET=EL", "*NODE\n30, 9., 9., 0.\n30, 1., 1., 0.\n"
+                        "*ELEMENT, TYPE=CPE4, ELSET=EL", 1).replace(
+        "*END STEP", "*SECTION PRINT, SURFACE=NOPE, NAME=S1\nSOF\n*END STEP")
+    deck = tmp_path / "again.inp"
+    deck.write_text(text)
+    imp = import_deck(deck, tmp_path / "a" / "p.toml")
+    assert not imp.unsupported
+    assert any("node(s) defined again (the first 30" in n and "the last definition holds" in n for n in imp.notes)
+    assert any("*SECTION PRINT names the surface 'NOPE'" in n for n in imp.notes)
+    mesh = load_problem(imp.problem).bodies[1].mesh
+    np.testing.assert_allclose(mesh.points.min(axis=0)[:2], [0.0, 0.5])
+    np.testing.assert_allclose(mesh.points.max(axis=0)[:2], [1.0, 1.0])

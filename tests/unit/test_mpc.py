@@ -282,7 +282,8 @@ def test_deck_mpc_keeps_calculix_meaning(tmp_path, kind):
 
 def test_deck_mpc_clash_unsupported_and_errors(tmp_path):
     """A node whose dependent dof an earlier *MPC has taken: its constraint left out with a note, as CalculiX leaves
-    it out; MEANROT and DIST listed as unsupported (exit 2, each named); a *MPC naming an undefined set or node, or
+    it out; MEANROT (also by its old name 1, as cgx writes it under *MPC, USER) and DIST listed as unsupported
+    (exit 2, each named); a *MPC naming an undefined set or node, or
     a PLANE of three nodes: one line with the deck's line (exit 2)."""
     from covcontact.io.deck_import import import_deck
 
@@ -297,6 +298,7 @@ def test_deck_mpc_clash_unsupported_and_errors(tmp_path):
     assert [m.kind for m in problem.mpcs] == ["plane"]
     for mpc, words in [("*MPC\nMEANROT, 1, 1, 1, 2, 2, 2, 3\n", "*MPC MEANROT (a mean rotation"),
                        ("*MPC\nDIST, 1, 1, 1, 2, 2, 2, 3\n", "*MPC DIST (a maximum distance"),
+                       ("*MPC, USER\n1, 1, 1, 1, 2, 2, 2, 3\n", "*MPC MEANROT (a mean rotation"),
                        ("*MPC\nPLANE, TOPS\n", "*MPC PLANE: no node set TOPS"),
                        ("*MPC\nPLANE, 1, 2, 99999\n", "node 99999 is not defined"),
                        ("*MPC\nPLANE, 1, 2, 3\n", "needs 3 defining nodes and at least one more")]:

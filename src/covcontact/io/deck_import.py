@@ -929,8 +929,10 @@ class _Writer:
         """Whether *SECTION PRINT's surface is an element face surface (else a note: nothing printed, as CalculiX
         warns and prints nothing)."""
         kind = self.m.surfaces.get(name, (None,))[0]
-        if kind is None:
-            raise DeckError(f"{where}: *SECTION PRINT names the surface {name!r}, which no *SURFACE defines")
+        if kind is None:  # (CalculiX warns and prints nothing)
+            self.notes.append(f"{where}: *SECTION PRINT names the surface {name!r}, which no *SURFACE defines: nothing "
+                              f"printed (CalculiX warns likewise)")
+            return False
         if kind != "ELEMENT":
             self.notes.append(f"{where}: *SECTION PRINT, SURFACE={name}: a node surface; section forces need element "
                               f"faces (nothing printed, as in CalculiX)")

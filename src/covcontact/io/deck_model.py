@@ -560,10 +560,15 @@ class _Reader(LoadCards):
             coords.clear()
             order = np.argsort(lab, kind="stable")
             lab, xyz = lab[order], xyz[order]
-            if lab.size > 1 and np.any(lab[1:] == lab[:-1]):
-                dup = int(lab[1:][lab[1:] == lab[:-1]][0])
-                raise DeckError(f"*NODE: node {dup} is defined twice (node labels are unique in a deck; the file and "
-                                f"line of each *NODE card: {', '.join(self.node_cards)})")
+            if lab.size > 1 and np.any(lab[1:] == lab[:-1]):  # (CalculiX: a node defined again takes the new place)
+                again = lab[1:] == lab[:-1]
+                moved = again & np.any(xyz[1:] != xyz[:-1], axis=1)
+                dup = int(lab[1:][again][0])
+                self.m.notes.append(f"*NODE: {int(again.sum())} node(s) defined again (the first {dup}; the *NODE "
+                                    f"cards: {', '.join(self.node_cards)}): the last definition holds, as in CalculiX"
+                                    + (f" ({int(moved.sum())} of them moved)" if moved.any() else ""))
+                last = np.append(lab[1:] != lab[:-1], True)
+                lab, xyz = lab[last], xyz[last]
             self.m.node_labels, self.m.X = lab, xyz
         elif nodes:
             nodes.clear()

@@ -37,16 +37,18 @@ def read_mpc_card(reader, c: Card) -> None:
     """*MPC (model data): the type on the first line, then the nodes (kept in ``DeckModel.mpcs``)."""
     if reader.step is not None:
         raise c.fail("is model data: it belongs before the first *STEP")
-    for p, v in c.params.items():
-        reader.m.unsupported.append(f"{c.where()}: *MPC, {p}{'=' + v if v else ''} is not supported (the card takes no "
-                                    f"parameters)")
+    for p, v in c.params.items():  # (CalculiX warns and goes on: cgx writes *MPC, USER)
+        reader.m.notes.append(f"{c.where()}: *MPC, {p}{'=' + v if v else ''}: the card takes no parameters; ignored, "
+                              f"as CalculiX ignores it")
     rows = [[f.strip() for f in row if f.strip()] for row in c.rows()]
     if not rows or not rows[0]:
         raise c.fail("needs its line 'type, nodes...' (PLANE, STRAIGHT, BEAM, MEANROT, DIST or a user MPC's name)")
     kind = rows[0][0].upper()
-    if kind.lstrip("+-").isdigit():
-        raise c.fail(f"its first line starts with the MPC's type (PLANE, STRAIGHT, BEAM, ...), not a node ({kind})", 0)
+    if kind == "1":  # (CalculiX's old name of MEANROT, which cgx still writes)
+        kind = "MEANROT"
     entries = [f for row in [rows[0][1:]] + rows[1:] for f in row if f != "0"]
+    if kind in _OTHER and entries and entries[-1].isdigit():  # (its extra node: loads on it act on nothing here)
+        reader.m.unsupported_nodes[int(entries[-1])] = f"{c.where()}: *MPC {kind}"
     if not hasattr(reader.m, "mpcs"):
         reader.m.mpcs = []
     reader.m.mpcs.append(DeckMPC(kind, entries, c.where()))
