@@ -291,6 +291,8 @@ def make_self_pass(num, name: str, pair, tangent: str | None, Pass, law_terms):
     else:
         slaves = np.unique(segments.ravel())
         weight = sum(slave_weights(X, e, form, t) for e, form, t in parts)[slaves]
+        if pair.weighting == "area" or pair.penalty == "auto":  # (no contact on the axis: see make_pass)
+            slaves, weight = slaves[weight > 0.0], weight[weight > 0.0]
         exclude = excluded_facets(segments, num.n_ext, slave_nodes=slaves)
     h = float(np.mean(_chords(X, segments)))
     if pair.penalty == "auto":
@@ -356,6 +358,9 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
     if pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts":
         if faces is None:
             raise ValueError(f"contact {pair.name}: area weighting needs an edge set named {slave[1]!r}")
+        if pair.type != "sts" and np.any(weight <= 0.0):  # (the corner on the axis of a quadratic edge of an
+            keep = weight > 0.0                              # axisymmetric body: no circumference, no contact)
+            nodes, weight = nodes[keep], weight[keep]
         eps = penalty * weight
     else:
         eps = np.full(len(nodes), penalty)
