@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from .motion import RigidMotion
 
 
@@ -36,6 +38,31 @@ class Equation:
 
     terms: list[tuple[str, str, int, float]]
     name: str = ""
+
+
+#: the kinds of nonlinear multi-point constraints (``MPC``), and how many defining nodes each takes before the
+#: constrained ones
+KINDS = {"plane": 3, "straight": 2, "beam": 2}
+
+
+def dependent_components(kind: str, X: np.ndarray) -> list[tuple[int, int]]:
+    """The dependent dofs (node index within the constraint's nodes, component) of one constraint of ``kind`` whose
+    nodes' reference positions are ``X`` (defining nodes first, then one constrained node; beam: the two)."""
+    if kind == "plane":
+        n = np.cross(X[0] - X[2], X[1] - X[2])
+        return [(3, int(np.argmax(np.abs(n))))]
+    k = int(np.argmax(np.abs(X[0] - X[1])))
+    if kind == "straight":
+        return [(2, j) for j in range(3) if j != k]
+    return [(0, k)]
+
+
+def degenerate(kind: str, X: np.ndarray) -> bool:
+    """Whether the defining nodes define nothing: a plane's three on a line, a line's two (or a beam's) at one point."""
+    scale = max(1.0, float(np.abs(X).max()))
+    if kind == "plane":
+        return float(np.linalg.norm(np.cross(X[1] - X[0], X[2] - X[0]))) <= 1e-12 * scale ** 2
+    return float(np.linalg.norm(X[1] - X[0])) <= 1e-12 * scale
 
 
 @dataclass

@@ -302,8 +302,8 @@ def make_self_pass(num, name: str, pair, tangent: str | None, Pass, law_terms):
     eps = penalty * weight if (pair.weighting == "area" or pair.penalty == "auto" or pair.type == "sts") else \
         np.full(len(slaves), penalty)
     eps, eps_t, band, law = law_terms(pair, eps, penalty)
-    p = Pass(name, slaves, eps, weight, eps_t=eps_t, case=CASES[tangent or pair.tangent], mu=float(pair.friction or 0.0),
-             augmented=pair.method == "augmented", max_aug=pair.max_augmentations, pair=pair.name, band=band,
+    p = Pass(name, slaves, eps, weight, eps_t=eps_t, case=CASES[tangent or pair.tangent],
+             mu=float(pair.friction or 0.0), augmented=pair.method == "augmented", max_aug=pair.max_augmentations, pair=pair.name, band=band,
              kind=pair.type, slave_faces=segments, slave_facet=own, law=law, exclude=exclude)
     p.curve = Curve(segments)
     if p.augmented:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..solvers.mpc import KINDS, degenerate, dependent_components
+from ..loads import KINDS, degenerate, dependent_components
 from .deck import Card, DeckError
 
 #: *MPC types covcontact does not read: what they are, for the line that lists them

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..loads import MPC
-from ..solvers.mpc import KINDS, degenerate, dependent_components
+from ..loads import KINDS, MPC, degenerate, dependent_components
 from .validate import Section, suggest
 
 _WHAT = {"plane": "the first three nodes (sets of one node each) define the plane, the sets after them hold the nodes "
@@ -19,9 +18,9 @@ _WHAT = {"plane": "the first three nodes (sets of one node each) define the plan
 def read_mpcs(top: Section, sets, bodies: list, dirichlet: list, equations: list, rigid: list) -> list[MPC]:
     """Every ``[[mpc]]`` entry: ``type`` and ``nodes = ["body.set", ...]``. One line each for: a defining set of more
     than one node, defining nodes that define nothing (collinear, coincident), no constrained node besides the defining
-    ones (which the constrained sets may hold: they are left out), a dependent dof (``covcontact.solvers.mpc.dependent_components``) that is another constraint's dependent dof,
-    is held by a Dirichlet condition, follows a rigid body or is an input of another constraint (no chains), and
-    an equation's eliminated dof among a constraint's inputs."""
+    ones (which the constrained sets may hold: they are left out), a dependent dof (``loads.dependent_components``) that
+    is another constraint's dependent dof, is held by a Dirichlet condition, follows a rigid body or is an input of
+    another constraint (no chains), and an equation's eliminated dof among a constraint's inputs."""
     out: list[MPC] = []
     planar = {b.name for b in bodies if b.formulation in ("plane_strain", "plane_stress", "axisymmetric")}
     entries = top.get("mpc", "array", [])

@@ -26,11 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..assembly.system import InvertedElementError
+from ..loads import KINDS, dependent_components
 from .constraints import unit_diagonal
-
-#: the kinds, and how many defining nodes each takes before the constrained ones
-KINDS = {"plane": 3, "straight": 2, "beam": 2}
-
 
 class UnsolvableConstraint(InvertedElementError):
     """A beam constraint with no solution at a trial displacement (the independent components alone already
@@ -40,26 +37,6 @@ class UnsolvableConstraint(InvertedElementError):
         RuntimeError.__init__(self, f"the multi-point constraint {name} has no solution at this trial "
                                     f"displacement (the nodes' other components already exceed its length)")
         self.body, self.element = name, -1
-
-
-def dependent_components(kind: str, X: np.ndarray) -> list[tuple[int, int]]:
-    """The dependent dofs (node index within the constraint's nodes, component) of one constraint of ``kind`` whose
-    nodes' reference positions are ``X`` (defining nodes first, then one constrained node; beam: the two)."""
-    if kind == "plane":
-        n = np.cross(X[0] - X[2], X[1] - X[2])
-        return [(3, int(np.argmax(np.abs(n))))]
-    k = int(np.argmax(np.abs(X[0] - X[1])))
-    if kind == "straight":
-        return [(2, j) for j in range(3) if j != k]
-    return [(0, k)]
-
-
-def degenerate(kind: str, X: np.ndarray) -> bool:
-    """Whether the defining nodes define nothing: a plane's three on a line, a line's two (or a beam's) at one point."""
-    scale = max(1.0, float(np.abs(X).max()))
-    if kind == "plane":
-        return float(np.linalg.norm(np.cross(X[1] - X[0], X[2] - X[0]))) <= 1e-12 * scale ** 2
-    return float(np.linalg.norm(X[1] - X[0])) <= 1e-12 * scale
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -180,7 +157,8 @@ class NonlinearMPCs:
         groups: dict[str, tuple[list, list, list]] = {}
         for c in mpcs:
             nodes = [int(system.global_nodes(b, s)[0]) for b, s in c.nodes[:KINDS[c.kind]]]
-            rest = [int(v) for b, s in c.nodes[KINDS[c.kind]:] for v in system.global_nodes(b, s) if int(v) not in nodes]
+            rest = [int(v) for b, s in c.nodes[KINDS[c.kind]:] for v in system.global_nodes(b, s)
+                    if int(v) not in nodes]
             rest = list(dict.fromkeys(rest))
             for extra in ([[]] if c.kind == "beam" else [[v] for v in rest]):
                 these = nodes + extra
