@@ -303,8 +303,8 @@ def make_self_pass(num, name: str, pair, tangent: str | None, Pass, law_terms):
         np.full(len(slaves), penalty)
     eps, eps_t, band, law = law_terms(pair, eps, penalty)
     p = Pass(name, slaves, eps, weight, eps_t=eps_t, case=CASES[tangent or pair.tangent],
-             mu=float(pair.friction or 0.0), augmented=pair.method == "augmented", max_aug=pair.max_augmentations, pair=pair.name, band=band,
-             kind=pair.type, slave_faces=segments, slave_facet=own, law=law, exclude=exclude)
+             mu=float(pair.friction or 0.0), augmented=pair.method == "augmented", max_aug=pair.max_augmentations,
+             pair=pair.name, band=band, kind=pair.type, slave_faces=segments, slave_facet=own, law=law, exclude=exclude)
     p.curve = Curve(segments)
     if p.augmented:
         p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
