@@ -122,3 +122,30 @@ def test_profiles_out_of_the_plane_refused(tmp_path):
         with pytest.raises(InputError) as err:
             load_problem(path)
         assert words in str(err.value) and "\n" not in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("form", ["plane_strain", "axisymmetric"])
+def test_meshed_rigid_die_is_the_rigid_line(tmp_path, form):
+    """A rigid die meshed with quad4 cells in the plane (``shape = "mesh"``, a rectangle), its top edge set the master:
+    the block pressed onto it takes the displacements of the rigid line there to 1e-12 of the largest; a die of
+    hexahedra, or one that moves out of the plane, is refused with one line."""
+    origin = (1.0, 0.0) if form == "axisymmetric" else (-0.2, 0.0)
+    line = '[[rigid]]\nname = "tool"\nshape = "plane"\npoint = [0.0, -0.001, 0.0]\nnormal = [0.0, 1.0, 0.0]\n'
+    x0 = 0.5 if form == "axisymmetric" else -1.0
+    die = (f'[[rigid]]\nname = "tool"\nshape = "mesh"\n'
+           f'mesh = {{ generator = "rectangle", lx = 3.0, ly = 0.5, nx = 6, ny = 1, origin = [{x0}, -0.501] }}\n')
+    a = _run(tmp_path, "line", block(form, line, origin))
+    b = _run(tmp_path, "die", block(form, die, origin).replace('master = "tool"', 'master = "tool.ymax"'))
+    ua, ub = np.asarray(a.u), np.asarray(b.u)
+    n = np.abs(ua).size
+    assert np.abs(ua).max() > 0.01
+    assert np.abs(ua - ub[:n]).max() <= 1e-12 * np.abs(ua).max()
+    path = tmp_path / "bad.toml"
+    for master, words in ((die.replace('generator = "rectangle", lx = 3.0, ly = 0.5, nx = 6, ny = 1, origin = '
+                                       f'[{x0}, -0.501]', 'generator = "block", lx = 3.0, ly = 0.5, lz = 1.0, nx = 6, '
+                                       'ny = 1, nz = 1'), "must be a mesh of planar cells"),
+                          (die + "motion = { rotation = [0.1, 0.0, 0.0] }\n", "moves out of its plane")):
+        path.write_text(block(form, master, origin).replace('master = "tool"', 'master = "tool.ymax"'))
+        with pytest.raises(InputError) as err:
+            load_problem(path)
+        assert words in str(err.value) and "\n" not in str(err.value), str(err.value)

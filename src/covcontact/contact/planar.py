@@ -210,7 +210,9 @@ def check_pair(pair, bodies, rigid) -> str | None:
         return f"{name}: a tied planar pair bonds to the edges of a planar body, not to the rigid body {pair.master[0]!r}"
     if mb is None:
         rb = next((r for r in rigid if r.name == pair.master[0]), None)
-        if rb is None or rb.mesh is not None or rb.shape not in ("plane", "cylinder", "profile"):
+        if rb is not None and rb.mesh is not None:
+            return _rigid_mesh_in_plane(name, rb, pair.master[1], sb.formulation)
+        if rb is None or rb.shape not in ("plane", "cylinder", "profile"):
             return (f"{name}: the rigid master {pair.master[0]!r} of a planar pair must be an analytic line (shape = "
                     f"\"plane\" with a normal in the x-y plane), circle (shape = \"cylinder\" with its axis along z) "
                     f"or profile (shape = \"profile\" extruded along z; axisymmetric: revolved about the y axis)")
@@ -225,6 +227,42 @@ def check_pair(pair, bodies, rigid) -> str | None:
         if rb.shape == "cylinder" and sb.formulation == "axisymmetric":
             return (f"{name}: a rigid circle in an axisymmetric model is a torus, not available; an axisymmetric "
                     f"pair takes a rigid line")
+    return None
+
+
+def _rigid_mesh_in_plane(name: str, rb, edges: str, formulation: str) -> str | None:
+    """Why the meshed rigid body ``rb`` is no master of a planar pair (None when it is): its mesh is of planar cells
+    in the x-y plane (x >= 0 in an axisymmetric model), ``edges`` one of its edge sets, and it moves in the plane."""
+    from ..fem.planar_cells import EDGES
+
+    mesh = rb.mesh
+    if any(t not in EDGES for t in mesh.cell_types):
+        return (f"{name}: the meshed rigid master {rb.name!r} of a planar pair must be a mesh of planar cells in the "
+                f"x-y plane (quad4, quad8, quad9, tri3, tri6), got {' and '.join(mesh.cell_types)}")
+    if np.abs(mesh.points[:, 2]).max() > 1e-9 * max(1.0, float(np.abs(mesh.points).max())):
+        return f"{name}: the meshed rigid master {rb.name!r} of a planar pair has nodes off the x-y plane (z != 0)"
+    if formulation == "axisymmetric" and mesh.points[:, 0].min() < 0.0:
+        return f"{name}: the meshed rigid master {rb.name!r} of an axisymmetric pair has nodes at negative radius"
+    if edges not in mesh.face_sets:
+        known = ", ".join(sorted(mesh.face_sets)) or "none"
+        return f"{name}: the meshed rigid master {rb.name!r} has no edge set {edges!r} (known: {known})"
+    return _moves_in_plane(name, rb, formulation)
+
+
+def _moves_in_plane(name: str, rb, formulation: str) -> str | None:
+    """Why the rigid master ``rb``'s motion leaves the plane (None when it does not): it may translate in the x-y
+    plane and turn about z (axisymmetric: translate along the axis y only)."""
+    m = rb.motion
+    t = np.asarray(getattr(m, "translation", np.zeros(3)), dtype=float)
+    w = np.asarray(getattr(m, "rotation", np.zeros(3)), dtype=float)
+    path = getattr(m, "path", None)
+    if path is not None:
+        path = np.asarray(path, dtype=float)
+        t = np.array([path[:, 1].max() - path[:, 1].min() if formulation == "axisymmetric" else 0.0, 0.0,
+                      np.abs(path[:, 3]).max()])
+    if abs(t[2]) > 0.0 or np.any(w[:2] != 0.0) or (formulation == "axisymmetric" and (t[0] != 0.0 or w[2] != 0.0)):
+        return (f"{name}: the rigid master {rb.name!r} of a planar pair moves out of its plane: it may translate in "
+                f"the x-y plane and turn about z (axisymmetric: translate along the axis y only)")
     return None
 
 
@@ -244,18 +282,7 @@ def _profile_in_plane(name: str, rb, formulation: str) -> str | None:
         want = "extruded along z from the x-y plane (extrude = { axis = [0, 0, 1], origin = [x, y, 0] })"
     if not ok:
         return f"{name}: the profile {rb.name!r} of a planar pair must be {want}"
-    m = rb.motion
-    t = np.asarray(getattr(m, "translation", np.zeros(3)), dtype=float)
-    w = np.asarray(getattr(m, "rotation", np.zeros(3)), dtype=float)
-    path = getattr(m, "path", None)
-    if path is not None:
-        path = np.asarray(path, dtype=float)
-        t = np.array([path[:, 1].max() - path[:, 1].min() if formulation == "axisymmetric" else 0.0, 0.0,
-                      np.abs(path[:, 3]).max()])
-    if abs(t[2]) > 0.0 or np.any(w[:2] != 0.0) or (formulation == "axisymmetric" and (t[0] != 0.0 or w[2] != 0.0)):
-        return (f"{name}: the profile {rb.name!r} of a planar pair moves out of its plane: it may translate in the "
-                f"x-y plane and turn about z (axisymmetric: translate along the axis y only)")
-    return None
+    return _moves_in_plane(name, rb, formulation)
 
 
 def planar_body(num, name):
@@ -340,7 +367,8 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
         weight = np.ones(len(nodes))
     mb = planar_body(num, master[0])
     segments = None
-    if mb is not None:
+    rigid_mesh = mb is None and num.mesh_of(master[0])[0] is not None   # (a meshed rigid body's edges)
+    if mb is not None or rigid_mesh:
         mmesh, moff = num.mesh_of(master[0])
         if master[1] not in mmesh.face_sets:
             raise ValueError(f"contact {pair.name}: no edge set {master[1]!r} on body {master[0]!r}")
