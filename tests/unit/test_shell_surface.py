@@ -203,3 +203,27 @@ def test_paper_sphere_example_from_a_midsurface_mesh(tmp_path):
     fa, fb = (np.array([s["contact_force"] for s in r]) for r in (a, b))
     assert np.abs(fa).max() > 0.0
     np.testing.assert_allclose(fa, fb, rtol=0.0, atol=1e-9 * np.abs(fb).max())
+
+
+@pytest.mark.parametrize("fold, warned", [(90.0, True), (30.0, False)])
+def test_a_sharp_fold_of_the_mid_surface_is_warned(tmp_path, fold, warned):
+    """The plate's mid-surface folded about the line x = 1 by ``fold`` degrees: beyond 45 degrees between the cells'
+    normals at a node (a junction or a crease, where the mean director bends the shell) the run starts with a warning
+    naming the body, the node and the angle (summary.json ``warnings``); a 30 degree fold runs without one."""
+    ref = plate(2.0, 1.0, 0.1, 4, 2)
+    X, surf = _mid_surface(ref, 4)
+    a = np.radians(fold)
+    far = X[:, 0] > 1.0 + 1e-12
+    X = X.copy()
+    X[far, 2] = (X[far, 0] - 1.0) * np.sin(a)
+    X[far, 0] = 1.0 + (X[far, 0] - 1.0) * np.cos(a)
+    meshio.write(tmp_path / "s.vtu", meshio.Mesh(X, [("quad", surf)]))
+    path = tmp_path / "p.toml"
+    path.write_text(CANTILEVER.replace("MESH", 'shell = { thickness = 0.1 }\nmesh = { file = "s.vtu" }')
+                    .replace('set = "p.xmin"', 'set = "p.edges"').replace("p.xmax", "p.top"))
+    res = load_problem(path).run(out=tmp_path / "o")
+    words = [w for w in res.summary.get("warnings", []) if "junction or a crease" in w]
+    if warned:
+        assert len(words) == 1 and f"up to {fold:.0f}" in words[0] and "body 'p'" in words[0], words
+    else:
+        assert not words

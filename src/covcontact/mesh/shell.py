@@ -211,6 +211,10 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     cells = _orient(cells, cell_type)
     turned = np.any(cells != given, axis=1)  # (cells whose top is the side against their own normal)
     d = _directors(points, cells, cell_type)
+    # (nodes where the cells' normals spread beyond 45 degrees: a junction or a crease, where the mean director bends
+    # the shell; said as a warning at the start of a run, covcontact.solvers.model)
+    creases = [(int(cell_of[a]), int(cell_of[b]), n, angle) for n, a, b, angle in knots(points, cells, cell_type, 45.0)
+               if n < n_surface]
     mid = points - (o * t)[:, None] * d
     bottom = mid - 0.5 * t[:, None] * d
     top = mid + 0.5 * t[:, None] * d
@@ -264,6 +268,7 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             mesh.add_face_set(name, f)
             if name not in mesh.node_sets:
                 mesh.add_node_set(name, np.unique(f))
+    mesh.shell_creases = creases  # (surface cells a, b, surface node, angle in degrees) per such node
     return mesh
 
 

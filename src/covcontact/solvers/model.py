@@ -318,6 +318,15 @@ class Model:
         """Warnings about the start of a run that is legal but almost certainly wrong: materials whose Young's
         modulus and yield stress look like mixed units; slave nodes inside their master (contact/report.py)."""
         out = self._material_warnings() + list(getattr(self.problem, "adjusted", None) or [])
+        for body in self.problem.bodies:  # (shell bodies whose mid-surface folds sharply: mesh/shell.py)
+            creases = getattr(body.mesh, "shell_creases", None)
+            if creases:
+                a, b, node, angle = max(creases, key=lambda c: c[3])
+                out.append(f"body {body.name!r}: its mid-surface's cells meet at {len(creases)} node(s) at more than "
+                           f"45 degrees (up to {angle:.0f}: node {node} (0-based) between cells {a} and {b}), a junction "
+                           f"or a crease, where the solid-shells take the mean director of the cells around the node "
+                           f"and so bend it: split the surface there (bodies tied along the edge) or mesh the junction "
+                           f"with solid elements")
         if not self.contact.passes or self.size > 1:
             return out
         from ..contact.report import start_warnings
