@@ -249,7 +249,7 @@ def candidates(folder: Path) -> list[str]:
                 continue
             names = {c.name for c in cards}
             types = {c.params.get("TYPE", "").upper() for c in cards if c.name == "ELEMENT"}
-            if names <= set(SUPPORTED) and types and types <= set(ELEMENTS):
+            if names <= set(SUPPORTED) | {"MPC"} and types and types <= set(ELEMENTS):  # (*MPC: deck_mpc)
                 out.append(name)
     return sorted(set(out))
 
