@@ -149,6 +149,21 @@ def slave_weights(X: np.ndarray, edges: np.ndarray, formulation: str, thickness:
     return out
 
 
+def edge_points(num, X: np.ndarray, parts: list, order: int | None):
+    """The slave points of segment-to-segment contact in the plane: the Gauss points of the edges of ``parts``
+    ((edges, formulation, thickness) each; ``order`` per edge, default 2 on linear and 3 on quadratic edges) as
+    virtual points of ``num``. Returns (their ids, their measures w J t or w J 2 pi R, the index of each point's edge
+    among all the parts' edges)."""
+    ids, weight, own, first = [], [], [], 0
+    for edges, formulation, thickness in parts:
+        N, ds = edge_rule(X, edges, formulation, thickness, order or (2 if edges.shape[1] == 2 else 3))
+        ids.append(num.points.add(np.repeat(edges, N.shape[0], axis=0), np.tile(N, (len(edges), 1))))
+        weight.append(ds.ravel())
+        own.append(first + np.repeat(np.arange(len(edges)), N.shape[0]))
+        first += len(edges)
+    return np.concatenate(ids), np.concatenate(weight), np.concatenate(own)
+
+
 def edge_rule(X: np.ndarray, edges: np.ndarray, formulation: str, thickness: float, order: int):
     """The Gauss rule of ``order`` points on each edge (nf, 2 or 3) in the reference configuration: (N (k, nen) the
     shape values at the points, ds (nf, k) their measures w_k |dX/dxi| t, t the thickness or 2 pi R at the point)."""
@@ -309,11 +324,7 @@ def make_self_pass(num, name: str, pair, tangent: str | None, Pass, law_terms):
     segments = np.vstack([e for e, _, _ in parts])
     own = None
     if pair.type == "sts":
-        pts = [edge_rule(X, e, form, t, pair.order or (2 if e.shape[1] == 2 else 3)) + (e,) for e, form, t in parts]
-        conn = np.vstack([np.repeat(e, N.shape[0], axis=0) for N, _, e in pts])
-        slaves = num.points.add(conn, np.vstack([np.tile(N, (len(e), 1)) for N, _, e in pts]))
-        weight = np.concatenate([ds.ravel() for _, ds, _ in pts])
-        own = np.repeat(np.arange(len(segments)), [N.shape[0] for N, _, e in pts for _ in range(len(e))])
+        slaves, weight, own = edge_points(num, X, parts, pair.order)
         exclude = own[:, None].copy()
     else:
         slaves = np.unique(segments.ravel())
@@ -357,10 +368,7 @@ def make_pass(num, name: str, slave, master, pair, tangent: str | None, Pass, an
     if pair.type == "sts":  # segment-to-segment: the Gauss points of the slave edges as slaves (virtual points)
         if faces is None:
             raise ValueError(f"contact {pair.name}: segment-to-segment contact needs an edge set named {slave[1]!r}")
-        N, ds = edge_rule(X, faces, sb.formulation, thickness, pair.order or (2 if faces.shape[1] == 2 else 3))
-        per = N.shape[0]
-        nodes = num.points.add(np.repeat(faces, per, axis=0), np.tile(N, (len(faces), 1)))
-        weight, own = ds.ravel(), np.repeat(np.arange(len(faces)), per)
+        nodes, weight, own = edge_points(num, X, [(faces, sb.formulation, thickness)], pair.order)
     elif faces is not None:
         weight = slave_weights(X, faces, sb.formulation, thickness)[nodes]
     else:

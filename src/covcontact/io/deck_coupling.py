@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fem.planar_cells import EDGES
 from .deck import Card, DeckError
 from .deck_loads import Boundary, Load
 
@@ -47,11 +48,7 @@ FACE_NODES = {
     "tet4": {k: v[:3] for k, v in _TET10.items()}, "tet10": _TET10, "wedge6": _WEDGE6,
 }
 #: the faces S1..Sn of planar elements: their edges, from corner k to corner k + 1 (then the edge's mid-node)
-EDGE_NODES = {
-    "quad4": {1: (0, 1), 2: (1, 2), 3: (2, 3), 4: (3, 0)},
-    "quad8": {1: (0, 1, 4), 2: (1, 2, 5), 3: (2, 3, 6), 4: (3, 0, 7)},
-    "tri3": {1: (0, 1), 2: (1, 2), 3: (2, 0)}, "tri6": {1: (0, 1, 3), 2: (1, 2, 4), 3: (2, 0, 5)},
-}
+EDGE_NODES = {cell: {k + 1: tuple(int(i) for i in e) for k, e in enumerate(edges)} for cell, edges in EDGES.items()}
 
 _G2 = 1.0 / np.sqrt(3.0)
 _G3 = np.sqrt(0.6)

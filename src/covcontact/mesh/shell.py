@@ -120,15 +120,18 @@ def _orient(cells: np.ndarray, cell_type: str) -> np.ndarray:
     return out
 
 
-def _directors(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndarray:
-    """The unit mean at every node of the normals x_xi x x_eta of its cells there."""
+def _cell_normals(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndarray:
+    """(ne, nen, 3): the normals x_xi x x_eta of the cells (quad4, quad9) at each of their nodes."""
     from ..fem.shapes import shape_functions
 
     _, dN, _ = shape_functions(cell_type, _Q9_NAT[: cells.shape[1]])  # (nnodes, nen, 2): at the cell's nodes
     x = points[cells]  # (ne, nen, 3)
-    a1 = np.einsum("ebi,ab->eai", x, dN[:, :, 0])
-    a2 = np.einsum("ebi,ab->eai", x, dN[:, :, 1])
-    normal = np.cross(a1, a2)  # (ne, nen, 3): at each of the cell's nodes
+    return np.cross(np.einsum("ebi,ab->eai", x, dN[:, :, 0]), np.einsum("ebi,ab->eai", x, dN[:, :, 1]))
+
+
+def _directors(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndarray:
+    """The unit mean at every node of the normals x_xi x x_eta of its cells there."""
+    normal = _cell_normals(points, cells, cell_type)
     acc = np.zeros_like(points)
     np.add.at(acc, cells.ravel(), normal.reshape(-1, 3))
     size = np.linalg.norm(acc, axis=1)
@@ -146,18 +149,15 @@ def knots(points: np.ndarray, cells: np.ndarray, cell_type: str, limit: float = 
     node, the normals x_xi x x_eta of its cells at it (``cells`` oriented consistently), and a knot where one of them
     makes more than ``limit`` degrees with the first cell's (CalculiX's reference normal: the cells within 20 degrees
     of it share one normal, the others another). Returns (node, first cell, other cell, angle) per such node."""
-    from ..fem.shapes import shape_functions
-
     if cell_type == "quad8":  # (its serendipity surface, as quad9 with the centre node)
         points, _, cells = _quad8_to_quad9(points, np.zeros(points.shape[0]), cells)
         cell_type = "quad9"
-    x = points[cells]
     if cell_type.startswith("tri"):  # (the plane of the corners)
+        x = points[cells]
         flat = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
         normal = np.repeat(flat[:, None, :], cells.shape[1], axis=1)
     else:
-        _, dN, _ = shape_functions(cell_type, _Q9_NAT[: cells.shape[1]])
-        normal = np.cross(np.einsum("ebi,ab->eai", x, dN[:, :, 0]), np.einsum("ebi,ab->eai", x, dN[:, :, 1]))
+        normal = _cell_normals(points, cells, cell_type)
     normal /= np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-300)
     node, cell = cells.ravel(), np.repeat(np.arange(len(cells)), cells.shape[1])
     first = np.full(points.shape[0], -1, dtype=np.int64)
