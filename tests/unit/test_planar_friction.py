@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from covcontact.contact.friction_kernels import H_FLAG, H_T, H_XI
-from covcontact.contact.planar import project_on_segment, segment_point
+from covcontact.contact.planar import project_on_segment, segment_point, vertex_core
 from covcontact.contact.planar_friction import (
     OPEN,
     SLIP,
@@ -26,6 +26,8 @@ from covcontact.contact.planar_friction import (
     segment_friction,
     start_history,
     transfer_history,
+    vertex_friction,
+    vertex_history,
 )
 from covcontact.io.loader import load_problem
 
@@ -145,6 +147,62 @@ def test_history_across_segments():
     # a new slave sticks at its projection
     h = start_history(s2, np.array([2.0, -0.01, 0.0]), 0.0, EPS_T)
     assert h[H_XI] == pytest.approx(0.0, abs=1e-14) and h[H_T] == 0.0 and h[H_FLAG] == 1.0
+
+
+def vertex_residual(y, du0, t_n, sign, lam=0.0):
+    """Normal and friction residual of a slave at a vertex; y = (x_v, x_s) (6,), the displacement since the commit
+    du0 + (x_s - x_v) - (x_s0 - x_v0) follows the positions."""
+    xv, xs = y[:3], y[3:]
+    R = np.zeros(6)
+    K = np.zeros((6, 6))
+    vertex_core(xv, xs, sign, EPS, lam, R, K)
+    Rf, Kf, T, st = vertex_friction(xv, xs, du0 + (xs - xv), t_n, sign, EPS, EPS_T, MU, lam)
+    return R + Rf, K + Kf, T, st
+
+
+@pytest.mark.parametrize("du,t_n,state", [((1e-5, 0.0), (0.0, 0.0), STICK), ((-2e-5, 1e-5), (0.004, -0.002), STICK),
+                                          ((3e-3, 0.0), (0.0, 0.0), SLIP), ((-6e-3, 0.0), (0.05, 0.01), SLIP)])
+@pytest.mark.parametrize("sign", [-1.0, 1.0])
+def test_vertex_friction_tangent_against_central_differences(du, t_n, state, sign):
+    """Friction at a vertex (a slave in the region of a convex corner, normal along x_s - x_v): the exact tangent
+    against central differences, the return mapping (|T| = mu N in slip), the forces balanced."""
+    xv = np.array([0.3, -0.2, 0.0])
+    d = np.array([0.004, 0.007, 0.0])
+    xs = xv + (d if sign > 0 else -d)
+    lam = 0.0 if sign < 0 else -EPS * 0.016      # (g = |d| > 0: the multiplier makes it active)
+    y = np.concatenate([xv, xs])
+    du0 = np.array([*du, 0.0]) - (xs - xv)
+    tn = np.array([*t_n, 0.0])
+    R, K, T, st = vertex_residual(y, du0, tn, sign, lam)
+    assert st == state
+    Kfd = fd_jacobian(lambda z: vertex_residual(z, du0, tn, sign, lam)[0], y)
+    assert rel(K, Kfd) < 1e-6
+    N = -(lam + EPS * sign * np.linalg.norm(d))
+    assert N > 0.0
+    if st == SLIP:
+        assert abs(T) == pytest.approx(MU * N, rel=1e-12)
+    else:
+        assert abs(T) < MU * N
+    assert np.abs(R[:3] + R[3:]).max() < 1e-12 * np.abs(R).max()
+    # the friction force is tangential (normal to x_s - x_v) and opposes the relative displacement in slip
+    Rf = vertex_friction(xv, xs, du0 + (xs - xv), tn, sign, EPS, EPS_T, MU, lam)[0]
+    assert abs(Rf[3:5] @ d[:2]) < 1e-12 * np.linalg.norm(Rf) * np.linalg.norm(d)
+    if st == SLIP and not any(t_n):
+        assert float(-Rf[3:5] @ np.array(du)) < 0.0
+
+
+def test_vertex_history_moves_on_to_either_segment():
+    """The history of a slave at a vertex holds its traction vector's component along the segment: moved on to the
+    next segment (across the corner) it carries the same traction vector up to the corner's turn."""
+    s1 = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    s2 = np.array([[1.0, 0.0, 0.0], [2.0, -0.1, 0.0]])
+    t_vec = np.array([0.3, 0.0, 0.0])
+    h = vertex_history(s1, 1.0, t_vec)
+    assert h[H_XI] == 1.0 and h[H_FLAG] == 1.0 and h[H_T] == pytest.approx(0.3 * 0.5)
+    h2 = transfer_history(h, s2, 0.0, EPS_T)
+    assert h2[H_XI] == pytest.approx(-1.0, abs=1e-12)
+    r2 = (s2[1] - s2[0]) / 2.0
+    assert h2[H_T] == pytest.approx(float(t_vec @ r2), rel=1e-12)
 
 
 # -- problems ------------------------------------------------------------------------------------------------------

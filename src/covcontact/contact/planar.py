@@ -540,11 +540,12 @@ def segment_pass(manager, p, xe: np.ndarray, case: int, t, want_K: bool, want_pa
                                        float(sign[s]), e_j, l_j, Rj, Kj)
                 R[j] += Rj
                 K[j] += Kj
+            if friction:
+                Rf, Kf = _vertex_friction(p, c, s, int(seg[s]), float(xi[s]), int(vert[s]), float(sign[s]),
+                                          float(eps_s[s]), float(lam_s[s]), bool(pull[s]), xe, x_commit, t)
+                R[j] += Rf
+                K[j] += Kf
         t.force[idx] = -R[:, -3:]
-        if friction:  # frictionless at a vertex; the committed history is carried through unchanged
-            t.hist[idx] = c.hist[idx]
-            t.hist_facet[idx] = c.hist_facet[idx]
-            t.status[idx] = SLIP_AT_VERTEX
         manager._add(ev.blocks, conn, R, K if want_K else None, xe)
         if want_parts:
             ev.parts[0].add(conn, np.zeros_like(R), K)
@@ -564,8 +565,31 @@ def _laws(eps: float, lam: float, g: float, pull: bool) -> tuple:
 #: frictional passes: how far outside its segment of the last Newton iterate (in xi) a slave keeps it (a slave
 #: resting on the node between two segments would otherwise cycle between them, its history moving each time)
 KEEP_BAND = 0.02
-#: the friction state of a slave at a vertex (frictionless there)
-SLIP_AT_VERTEX = 2
+
+
+def _vertex_friction(p, c, s: int, segment: int, xi: float, v: int, sign: float, eps: float, lam: float, pull: bool,
+                     xe, x_commit, t):
+    """The friction part (R, K on (vertex, slave)) of slave ``s`` at vertex node ``v`` (:func:`.planar_friction.
+    vertex_friction`): its committed traction vector (from its history on whichever segment it was), its displacement
+    relative to the vertex since the last commit; writes the history to commit (on the vertex's ``segment`` at its end
+    ``xi``) and the friction state into ``t``."""
+    from .planar_friction import NEW, traction_vector, vertex_friction, vertex_history
+
+    t.hist_facet[s] = segment
+    if pull or x_commit is None:  # (a pull carries no friction; no commit yet: frictionless, as a segment's NEW)
+        t.hist[s] = 0.0
+        t.status[s] = 0 if pull else NEW
+        return np.zeros(6), np.zeros((6, 6))
+    slave = p.slaves[s]
+    du = (xe[slave] - x_commit[slave]) - (xe[v] - x_commit[v])
+    R, K, T, t.status[s] = vertex_friction(xe[v], xe[slave], du, traction_vector(c.hist[s]), sign, eps,
+                                           float(p.eps_t[s]), float(p.mu), lam)
+    d = xe[slave, :2] - xe[v, :2]
+    n = d / (sign * np.linalg.norm(d))
+    t.hist[s] = vertex_history(np.ascontiguousarray(xe[p.curve.segments[segment]]), xi,
+                               T * np.array([-n[1], n[0], 0.0]))
+    return R, K
+
 
 
 def _segment_history(p, c, s: int, segment: int, xi: float, x_commit) -> np.ndarray:

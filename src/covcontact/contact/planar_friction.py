@@ -64,7 +64,7 @@ TRANSFER_BAND = 0.5
 _TRANSFER_METRIC = 0.05
 
 __all__ = ["HIST_SIZE", "NEW", "OPEN", "SLIP", "STICK", "TRANSFER_BAND", "make_history", "segment_friction",
-           "segment_friction_core", "start_history", "transfer_history"]
+           "segment_friction_core", "start_history", "transfer_history", "vertex_friction", "vertex_history"]
 
 
 @njit(cache=True)
@@ -182,6 +182,63 @@ def segment_friction(xseg, xs, xi, eps_n, eps_t, mu, hist, lam_k=0.0):
     return R, K, ho, float(g), int(st)
 
 
+def vertex_friction(xv, xs, du, t_n, sign: float, eps_n: float, eps_t: float, mu: float, lam_k: float = 0.0):
+    """Coulomb friction of slave xs against the vertex xv between two segments (docs/theory.md section 28, "Friction
+    at a vertex"): the normal n = (x_s - x_v) / g, g = sign |x_s - x_v|, the tangent tau = (-n_y, n_x); the trial
+    tangential force T^tr = tau . (t_n - eps_T du) with ``du`` the slave's displacement relative to the vertex node
+    since the last commit and ``t_n`` the committed traction vector; stick: T = T^tr below the cone mu N (N = -eps
+    g_e), slip: T = mu N sign(T^tr). The friction part of the residual, R_v = T tau, R_s = -T tau, and its exact
+    tangent, on (vertex, slave) as (6,) and (6, 6) (in-plane entries). Returns (R, K, T, state); the normal part is
+    :func:`.planar_kernels.vertex_core`'s."""
+    R = np.zeros(6)
+    K = np.zeros((6, 6))
+    d = np.asarray(xs[:2], dtype=float) - np.asarray(xv[:2], dtype=float)
+    dist = float(np.hypot(d[0], d[1]))
+    if dist == 0.0:
+        return R, K, 0.0, NEW
+    g = sign * dist
+    ge = g + lam_k / eps_n
+    if not is_active(g, lam_k, eps_n):
+        return R, K, 0.0, OPEN
+    n = d / g
+    tau = np.array([-n[1], n[0]])
+    w = np.asarray(t_n[:2], dtype=float) - eps_t * np.asarray(du[:2], dtype=float)
+    T_tr = float(tau @ w)
+    N = -eps_n * ge
+    if abs(T_tr) < mu * N * (1.0 - 1e-10):
+        T, state = T_tr, STICK
+        dT = -sign * float(n @ w) / dist * tau - eps_t * tau      # d T / d(x_s - x_v)
+    else:
+        sg = 1.0 if T_tr >= 0.0 else -1.0
+        T, state = mu * N * sg, SLIP
+        dT = -mu * eps_n * sg * n
+    Kss = -np.outer(tau, dT) + T * sign / dist * np.outer(n, tau)  # d R_s / d(x_s - x_v), d tau = -sign n tau^T / |d|
+    R[3:5] = -T * tau
+    R[0:2] = T * tau
+    K[3:5, 3:5] = Kss
+    K[0:2, 0:2] = Kss
+    K[3:5, 0:2] = -Kss
+    K[0:2, 3:5] = -Kss
+    return R, K, T, state
+
+
+def vertex_history(xseg, xi: float, traction: np.ndarray) -> np.ndarray:
+    """The history to commit of a slave at a vertex: a history on the vertex's segment ``xseg`` at its end ``xi``
+    (+-1) holding the traction vector ``traction`` (its component along the segment, covariantly), so that it moves
+    on to either segment as a segment's history does."""
+    rho, rc = _frame(xseg, xi)
+    return make_history(xi, float(rc[:2] @ np.asarray(traction[:2], dtype=float)), rho, rc)
+
+
+def traction_vector(history) -> np.ndarray:
+    """The committed traction vector t_n = T_n rho_n / a_n of a history (zero without one)."""
+    hist = np.asarray(history, dtype=np.float64)
+    if hist[H_FLAG] == 0.0:
+        return np.zeros(3)
+    rc = hist[H_RHO_COV:H_RHO_COV + 3]
+    return hist[H_T] * rc / float(rc @ rc)
+
+
 # -- history: make, start, move across segments -----------------------------------------------------------------
 def make_history(xi_n: float, traction: float = 0.0, rho_n=(0.0, 0.0, 0.0), rho_cov_n=(1.0, 0.0, 0.0)) -> np.ndarray:
     """A valid planar history: stick point xi_n, covariant traction T_n, the point x(xi_n) and rho(xi_n)."""
@@ -244,9 +301,7 @@ def transfer_history(history, xseg, xi0: float = 0.0, eps_t: float = 0.0) -> np.
     hist = np.asarray(history, dtype=np.float64)
     if hist[H_FLAG] == 0.0:
         return hist.copy()
-    rc = hist[H_RHO_COV:H_RHO_COV + 3]
-    t_n = hist[H_T] * rc / float(rc @ rc)
-    return _anchored(xseg, hist[H_RHO:H_RHO + 3], t_n, float(eps_t), xi0)
+    return _anchored(xseg, hist[H_RHO:H_RHO + 3], traction_vector(hist), float(eps_t), xi0)
 
 
 def start_history(xseg, xs, xi0: float, eps_t: float = 0.0) -> np.ndarray:
