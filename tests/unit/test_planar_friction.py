@@ -319,7 +319,7 @@ def test_block_sliding_on_an_edge(tmp_path, cell):
     assert N == pytest.approx(0.5, rel=1e-3)
 
 
-def capstan_text(nt_belt, nt_pulley, mu=0.3, t=0.01, d=1e-4, penalty=1e7, steps=4, cell="quad8"):
+def capstan_text(nt_belt, nt_pulley, mu=0.3, t=0.01, d=1e-4, penalty=1e7, steps=4, cell="quad8", two_pass=False):
     """A belt (plane stress, E = 1e8, nu = 0, thickness t = R / 100, one quadratic cell through it) lying on a deformable
     half-disc pulley (a half annulus r 0.5 .. 1 held at its bore), wrapped over theta = pi; its end at angle 0 hangs a
     dead load T1 = 1 (-y), its end at pi is pulled down by d = 1e-4 (about ten times the belt's elastic elongation),
@@ -360,6 +360,7 @@ master = "pulley.outer"
 penalty = {penalty}
 weighting = "area"
 friction = {mu}
+two_pass = {str(two_pass).lower()}
 [steps]
 factors = [{f}]
 [output]
@@ -383,3 +384,13 @@ def test_capstan_belt_over_a_pulley(tmp_path, nt_belt, nt_pulley):
               f"({ratio / exact - 1:+.2e}), slip {pair.get('slip')} of {pair['active_contacts']}")
         assert abs(ratio / exact - 1) < 5e-3
         assert pair.get("stick", 0) == 0
+
+
+def test_capstan_on_a_polygon_with_two_passes(tmp_path):
+    """quad4 belt and pulley (linear segments, the pulley a 40-gon), 97 belt cells so that no belt node starts on a
+    corner, both passes: T2 / T1 within 1 % of exp(mu pi) (measured +0.80 %); one pass lets the pulley's corners
+    through the belt's chords (docs/verification.md, "Contact in the plane")."""
+    res = run(tmp_path, "capstan_q4", capstan_text(97, 40, cell="quad4", two_pass=True))
+    s = res.summary["steps"][-1]
+    ratio = -s["reactions"]["belt.angle1"][1] / s["load_factor"]
+    assert abs(ratio / math.exp(MU * math.pi) - 1) < 1e-2
