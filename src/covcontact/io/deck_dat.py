@@ -7,7 +7,8 @@ deck's node and element labels, at each output increment:
   volume; the reference volume, as CalculiX prints it also with NLGEOM), TOTALS their sums;
 - *CONTACT PRINT: per active slave node (node-to-surface) or slave Gauss point (surface-to-surface, labelled by its
   element and face) CDIS (clearance and relative tangential displacement), CSTR (pressure and tangential tractions),
-  CELS (the energy stored in the contact law), and CNUM (the number of active slaves);
+  CELS (the energy stored in the contact law), and CNUM (the number of active slaves); a node-to-surface pair on
+  linear planar edges as CalculiX's expanded model: each slave node as its two face nodes with CalculiX's labels;
 - *SECTION PRINT (SOF, SOM): the force and moment the rest of the model exerts on the surface's elements (the sum of
   their internal forces at the surface's nodes), the surface's area, centre and mean normal.
 
@@ -71,8 +72,8 @@ def fortran_e(x: float) -> str:
 
 
 def _row(values) -> str:
-    """Values as CalculiX's 1p,(1x,e13.6) fields."""
-    return "".join(f"{v:14.6E}" for v in values)
+    """Values as CalculiX's 1p,(1x,e13.6) fields (a zero unsigned, as Fortran prints it)."""
+    return "".join(f"{v + 0.0:14.6E}" for v in values)
 
 
 # -- Gauss-point kinematics and energies ------------------------------------------------------------------------------
@@ -519,7 +520,11 @@ class _Now:
         ue = xe - x0 if x0 is not None and x0.shape == xe.shape else None
         rho, t1, t2, n = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
         zero = np.zeros(3)
+        planar = self.info.get("planar_contact") or {}
         for k, p in enumerate(manager.passes):
+            if p.curve is not None and p.pair in planar.get("pairs", {}):
+                rows += self._planar_rows(k, p, xe, ue, planar)
+                continue
             if p.surface is None or p.tied or (printed is not None and p.pair not in printed):
                 continue
             face_of = self._face_labels(p, printed.get(p.pair) if printed else None) if p.kind == "sts" else None
@@ -549,6 +554,39 @@ class _Now:
                 # (the shear stress as CalculiX prints it: the spring's force, opposite to the one on the slave)
                 rows.append((key[0], key[1], gap, float(f @ n), (-float(f @ e1), -float(f @ e2)),
                              (float(rel @ e1), float(rel @ e2)), energy))
+        return rows
+
+    def _planar_rows(self, k: int, p, xe: np.ndarray, ue: np.ndarray | None, planar: dict) -> list[tuple]:
+        """The rows of a planar node-to-segment pass as CalculiX prints its expanded model: per active slave node its
+        two face nodes (labels ``planar["labels"]`` + 0 and + 2), each with the 2D node's gap, pressure, shear and
+        slip and half its energy (an axisymmetric pass: of the 2 degree segment)."""
+        from ..contact.planar_kernels import segment_point
+
+        state = self.run.state.contact.passes[k]
+        label = {node: lab for lab, node in self.where().items()}
+        first = {int(lab): int(v) for lab, v in planar["labels"].items()}
+        share = 0.5 / (AXISYMMETRIC_SEGMENTS if planar["pairs"][p.pair] == "axisymmetric" else 1.0)
+        rows = []
+        for j in np.flatnonzero(self.model.contact.active_mask(k, self.run.state.contact) & (state.facet >= 0)):
+            lab = first.get(label.get(int(p.slaves[j]), -1))
+            if lab is None:
+                continue
+            nodes = p.curve.segments[state.facet[j]]
+            x, r, _ = segment_point(np.ascontiguousarray(xe[nodes]), float(state.xi[j, 0]))
+            gap = float(state.gap[j])
+            n = np.array([r[1], -r[0], 0.0]) / float(np.hypot(r[0], r[1]))
+            d = xe[p.slaves[j]] - np.array([x[0], x[1], 0.0])   # (g n, also at a vertex)
+            if abs(gap) > 1e-9 * float(np.hypot(r[0], r[1])):
+                n = d / np.linalg.norm(d) * np.sign(gap)
+            e1, e2 = ccx_tangents(n)
+            f = state.force[j] / p.area[j]
+            rel = np.zeros(3)
+            if p.mu > 0.0 and ue is not None:
+                u, _, _ = segment_point(np.ascontiguousarray(ue[nodes]), float(state.xi[j, 0]))
+                rel = ue[p.slaves[j]] - np.array([u[0], u[1], 0.0])
+            energy = share * contact_energy(p, j, state.force[j], n, gap, float(state.multiplier[j]))
+            values = (gap, float(f @ n), (-float(f @ e1), -float(f @ e2)), (float(rel @ e1), float(rel @ e2)), energy)
+            rows += [("node", lab, *values), ("node", lab + 2, *values)]
         return rows
 
     def contact_kinds(self) -> set[str]:

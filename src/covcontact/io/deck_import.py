@@ -22,7 +22,7 @@ from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 from .deck_coupling import DeckCouplings
-from .deck_planar import element_names, planar_body, planar_contact, planar_dof3
+from .deck_planar import contact_print_labels, element_names, planar_body, planar_contact, planar_dof3
 from .deck_rigid import DeckRigid
 from .deck_shells import DeckShells
 from .deck_mpc import DeckMPCs
@@ -631,7 +631,7 @@ class _Writer:
     # -- contact ------------------------------------------------------------------------------------
     def _contacts(self) -> str:
         text = ""
-        self._plane_pairs: set[str] = set()  # (pairs on planar elements: node-to-segment contact in the plane)
+        self._plane_pairs: dict[str, tuple] = {}  # (pairs on planar elements: slave body, face-to-face, tied)
         pairs = list(self.m.pairs) + [("*TIE", "TIE", slave, master, where) for _, slave, master, _, where in self.m.ties]
         ties = {where: tol for _, _, _, tol, where in self.m.ties}
         for k, (inter, kind, slave, master, where) in enumerate(pairs):
@@ -671,7 +671,7 @@ class _Writer:
                 continue
             if plane is not None:  # (node-to-segment: the .dat tabulates its slave nodes)
                 text += _table("[[contact]]", entry | plane)
-                self._plane_pairs.add(entry["name"])
+                self._plane_pairs[entry["name"]] = (sb, plane.get("type") == "sts", plane.get("law") == "tied")
                 continue
             if sts:
                 entry["type"] = "sts"
@@ -881,11 +881,14 @@ class _Writer:
         el_prints = [[[elset, list(v), totals, order[w]] for elset, v, w, totals in self.m.steps[s].el_print]
                      for s, _ in self.stage_steps]
         contact_prints = [list(self.m.steps[s].contact_print) for s, _ in self.stage_steps]
-        planar = sorted(getattr(self, "_plane_pairs", ()))
         printing = [self.m.steps[s].contact_card[0] for s, _ in self.stage_steps if self.m.steps[s].contact_print]
-        if planar and printing:  # (said, not left to an empty table)
-            self.notes.append(f"{printing[0]}: *CONTACT PRINT: the pairs on planar elements ({', '.join(planar)}) "
-                              f"are not tabulated in the .dat; their gap and contact pressure are in the VTU output")
+        contact = {name: (sb, sts) for name, (sb, sts, tied) in getattr(self, "_plane_pairs", {}).items()
+                   if not tied}   # (tied pairs and *TIE: no contact elements, as in 3D)
+        planar, left = contact_print_labels(self, contact) if printing else ({}, [])
+        if left:  # (said, not left to an empty table)
+            self.notes.append(f"{printing[0]}: *CONTACT PRINT: the pairs on planar elements ({', '.join(left)}: "
+                              f"face-to-face, quadratic edges, or a deck with shells or beams) are not tabulated in "
+                              f"the .dat; their gap and contact pressure are in the VTU output")
         contact_cards = [[self.m.steps[s].contact_card[1], order.get(self.m.steps[s].contact_card[0], 0)]
                          for s, _ in self.stage_steps]
         section_prints = [[[surf, name, list(v), order[w]] for surf, name, v, w in self.m.steps[s].section_print
@@ -902,7 +905,7 @@ class _Writer:
                                       "rigid": self.rigid.labels(),
                                       "elements": self.element_labels, "el_print": el_prints,
                                       "contact_print": contact_prints, "contact_card": contact_cards,
-                                      "contact_pairs": self._contact_pairs(),
+                                      "contact_pairs": self._contact_pairs(), "planar_contact": planar,
                                       "section_print": section_prints,
                                       "surfaces": self._surface_faces(section_prints),
                                       "elsets": {k: self.m.elsets[k].tolist() for k in sorted(el_wanted)},

@@ -15,6 +15,8 @@ circumference"); pressures are per area; the reactions of the .dat are of the sa
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from .deck import DeckError
@@ -225,6 +227,36 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
         w.unsupported.append(f"{where}: ADJUST on {etype} elements: not available in the plane; with "
                              f"--ignore-unsupported the slave nodes are not moved")
     return entry
+
+
+#: deck types CalculiX expands into 3D elements (shells, membranes, beams, planar elements): their nodes get new labels
+_EXPANDED = re.compile(r"^(S\d|M3D|B3\d|CPE|CPS|CAX)")
+
+
+def contact_print_labels(w, pairs: dict[str, tuple[int, bool]]) -> tuple[dict, list[str]]:
+    """The planar pairs whose slaves the .dat tabulates as CalculiX does, and those it cannot: ``pairs`` maps a
+    planar pair's name to (slave body, face-to-face). CalculiX expands each node of its 2D elements (in the order of
+    the labels) into three, numbered after the deck's largest label: max + 3 j + 1, + 2, + 3 (j the node's place
+    among them), and its node-to-face contact elements on linear edges (CPE3/4, CPS3/4, CAX3/4) are the two face nodes
+    + 1 and + 3, each with half the 2D node's force (an axisymmetric one: of the 2 degree segment). Returns ({"pairs":
+    {name: formulation}, "labels": {deck label: max + 3 j + 1}}, the names left out: face-to-face pairs, quadratic
+    edges, and every pair of a deck with shells, membranes or beams, whose expansion numbers nodes otherwise)."""
+    kinds = _planar_bodies(w)
+    expanded = [j for j, (etype, _, _, _) in enumerate(w.m.blocks) if _EXPANDED.match(etype)]
+    others = any(not is_planar_type(w.m.blocks[j][0]) for j in expanded) or bool(w.m.shell_blocks) or \
+        any(_EXPANDED.match(etype) for etype, _, _ in w.m.skipped_blocks)
+    printed, left = {}, []
+    for name, (sb, sts) in sorted(pairs.items()):
+        etype = kinds.get(int(sb), "")
+        if sts or others or PLANAR_ELEMENTS.get(etype, ("",))[0] not in ("quad4", "tri3"):
+            left.append(name)
+        else:
+            printed[name] = formulation_of(etype)
+    if not printed:
+        return {}, left
+    nodes = np.unique(np.concatenate([w.m.blocks[j][3].ravel() for j in expanded]))
+    top = int(w.m.node_labels.max())
+    return {"pairs": printed, "labels": {int(n): top + 3 * j + 1 for j, n in enumerate(nodes)}}, left
 
 
 def element_names(types) -> str:
