@@ -22,7 +22,8 @@ from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Interaction, Load, read_model
 from .deck_coupling import DeckCouplings
-from .deck_planar import contact_print_labels, element_names, planar_body, planar_contact, planar_dof3
+from .deck_planar import (contact_print_labels, element_names, is_planar_type, planar_body, planar_contact,
+                          planar_dof3)
 from .deck_rigid import DeckRigid
 from .deck_shells import DeckShells
 from .deck_mpc import DeckMPCs
@@ -236,7 +237,9 @@ class _Writer:
             entries.update(planar_body(self, k, name, types, secs, labels))  # (CPE, CPS, CAX: deck_planar)
             if len(secs) > 1:
                 entries["materials"] = {_name(s): self._material(mat, w) for s, mat, w in secs[1:]}
-            if hybrid:
+            if hybrid and "formulation" in entries:  # (planar: the planar F-bar)
+                options["fbar"] = True
+            elif hybrid:
                 entries["formulation"] = "fbar"
             if options:
                 entries["options"] = options
@@ -249,6 +252,7 @@ class _Writer:
         locking, docs/theory.md), said in a note; ``options`` lose the flag. Mixing hybrid and other elements in a
         body, and hybrid cells F-bar does not have, are listed as unsupported."""
         from ..elements.fbar import FBAR_CELLS
+        from ..elements.planar_fbar import PLANAR_FBAR_CELLS
 
         flags = {ELEMENTS[t][1].get("hybrid", False) for t in types}
         options.pop("hybrid", None)
@@ -260,6 +264,22 @@ class _Writer:
                                     f"({', '.join(sorted(set(types) - set(hyb)))}): give all of them one kind")
             return False
         cells = {ELEMENTS[t][0] for t in hyb}
+        if is_planar_type(hyb[0]) and cells == {"tri3"}:
+            self.notes.append(f"{self.deck}: body {name}: {', '.join(hyb)} (hybrid) read as {', '.join(t[:-1] for t in hyb)}"
+                              f": a linear triangle has one volume change, which its constant pressure takes as it is "
+                              f"(the same element for a compressible material; it locks as nearly incompressible)")
+            return False
+        if is_planar_type(hyb[0]) and not cells <= set(PLANAR_FBAR_CELLS):
+            self.unsupported.append(f"{self.deck}: body {name}: {', '.join(hyb)} (hybrid): covcontact's planar "
+                                    f"element without volumetric locking (F-bar) has {', '.join(PLANAR_FBAR_CELLS)} "
+                                    f"cells; mesh the body with quadrilaterals only, or take CPE3 / CAX3")
+            return False
+        if is_planar_type(hyb[0]):
+            options.pop("integration", None)  # (the planar F-bar integrates fully)
+            self.notes.append(f"{self.deck}: body {name}: {', '.join(hyb)} (hybrid, mixed u/p in the manuals) become "
+                              f"planar F-bar elements (options.fbar: the volume change of the element centre or its "
+                              f"projection; no volumetric locking; docs/theory.md section 27)")
+            return True
         if not cells <= set(FBAR_CELLS):
             self.unsupported.append(f"{self.deck}: body {name}: {', '.join(hyb)} (hybrid): covcontact's element "
                                     f"without volumetric locking (F-bar) has {', '.join(FBAR_CELLS)} cells only")

@@ -27,6 +27,10 @@ PLANAR_FORMULATION = {"CPE": "plane_strain", "CPS": "plane_stress", "CAX": "axis
 PLANAR_ELEMENTS = {f"{p}{n}": cell for p in PLANAR_FORMULATION for n, cell in (
     ("3", ("tri3", {})), ("4", ("quad4", {})), ("4R", ("quad4", {})), ("6", ("tri6", {})), ("8", ("quad8", {})),
     ("8R", ("quad8", {"integration": "reduced"})))}
+#: Abaqus's hybrid plane strain and axisymmetric elements (there are no plane stress ones): the planar F-bar
+#: (``options.fbar``; deck_import, a note), the triangle the plain one (one point: nothing to relieve)
+PLANAR_ELEMENTS.update({f"{p}{n}H": (cell, {"hybrid": True}) for p in ("CPE", "CAX") for n, cell in (
+    ("3", "tri3"), ("4", "quad4"), ("4R", "quad4"), ("6", "tri6"), ("8", "quad8"), ("8R", "quad8"))})
 #: nodes and faces (edges) of the planar cells
 PLANAR_NNODE = {"quad4": 4, "quad8": 8, "tri3": 3, "tri6": 6}
 PLANAR_NFACES = {"quad4": 4, "quad8": 4, "tri3": 3, "tri6": 3}
