@@ -345,16 +345,28 @@ U
 """
 
 
-def test_shell_edge_tied_to_a_solid_is_a_clamp(tmp_path):
-    """An S4 strip whose edge (S6: from its node 4 to node 1) is tied (*TIE) to the face of a C3D8 block held in
-    place: the edge is clamped, so the tip deflects as the same strip clamped at that edge (its edge nodes held in
-    dofs 1-6) to 0.5 % (measured 0.17 %: the tie is a penalty, 100 E / h with h the shell's thickness, the smaller
-    facet dimension; with the contact pairs' 10 E / h of the block's face it was 17 % softer)."""
-    dat, proc = _run_deck(tmp_path, TIED_EDGE, "tied")
+#: TIED_EDGE with S8R shells: the mid-nodes 21 .. 27 (24 on the tied edge, 26 at the tip)
+TIED_EDGE_S8R = TIED_EDGE.replace("16, 3.0, 1.0, 0.5\n", "16, 3.0, 1.0, 0.5\n" + "".join(
+    f"{n}, {x}, {y}, 0.5\n" for n, x, y in ((21, 1.5, 0.0), (22, 2.0, 0.5), (23, 1.5, 1.0), (24, 1.0, 0.5),
+                                              (25, 2.5, 0.0), (26, 3.0, 0.5), (27, 2.5, 1.0)))).replace(
+    "*ELEMENT, TYPE=S4, ELSET=SHELL\n2, 11, 12, 13, 14\n3, 12, 15, 16, 13",
+    "*ELEMENT, TYPE=S8R, ELSET=SHELL\n2, 11, 12, 13, 14, 21, 22, 23, 24\n3, 12, 15, 16, 13, 25, 26, 27, 22").replace(
+    "*NSET, NSET=TIP\n15, 16", "*NSET, NSET=TIP\n15, 16, 26")
+
+
+@pytest.mark.parametrize("kind", ["S4", "S8R"])
+def test_shell_edge_tied_to_a_solid_is_a_clamp(tmp_path, kind):
+    """A strip whose edge (S6: from its node 4 to node 1) is tied (*TIE) to the face of a C3D8 block held in place:
+    the edge is clamped, so the tip deflects as the same strip clamped at that edge (its edge nodes held in dofs 1-5)
+    to 0.5 % (S4, measured 0.17 %: the tie is a penalty, 100 E / h with h the shell's thickness, the smaller facet
+    dimension; with the contact pairs' 10 E / h of the block's face it was 17 % softer). S8R: the six-node side face
+    of the edge as its two 4-node halves, the slave of the tie (measured 0.24 %)."""
+    deck = TIED_EDGE if kind == "S4" else TIED_EDGE_S8R
+    dat, proc = _run_deck(tmp_path, deck, "tied")
     assert proc.returncode == 0, proc.stderr
     tied = _dat(dat)["U"][15][2]
-    clamp = TIED_EDGE.replace("*TIE, NAME=T1, POSITION TOLERANCE=0.1\nSHELLEDGE, SOLIDFACE\n", "").replace(
-        "FIX, 1, 3", "FIX, 1, 3\n11, 1, 5\n14, 1, 5")
+    clamp = deck.replace("*TIE, NAME=T1, POSITION TOLERANCE=0.1\nSHELLEDGE, SOLIDFACE\n", "").replace(
+        "FIX, 1, 3", "FIX, 1, 3\n11, 1, 5\n14, 1, 5" + ("\n24, 1, 5" if kind == "S8R" else ""))
     dat, proc = _run_deck(tmp_path, clamp, "clamped")
     assert proc.returncode == 0, proc.stderr
     clamped = _dat(dat)["U"][15][2]
@@ -385,8 +397,18 @@ def test_shell_edge_faces():
 def test_edges_of_other_shells_are_refused(tmp_path):
     text = TIED_EDGE.replace("*ELEMENT, TYPE=S4, ELSET=SHELL\n2, 11, 12, 13, 14\n3, 12, 15, 16, 13",
                              "*ELEMENT, TYPE=S3, ELSET=SHELL\n2, 11, 12, 14\n3, 12, 15, 16")
-    with pytest.raises(DeckError, match="S6 of an S3 element is an edge: covcontact reads the edges of S4 and S4R"):
+    with pytest.raises(DeckError, match="S6 of an S3 element is an edge: covcontact reads the edges of S4, S4R, S8"):
         import_deck(_write(tmp_path / "s3.inp", text), tmp_path / "i" / "s3.toml")
+
+
+def test_s8_edges_as_master_are_listed(tmp_path):
+    """The edge of S8R shells as the master of a *TIE: its side faces' 4-node halves serve slave surfaces only (their
+    chords are not the edge's curve), so the tie is listed as unsupported, one line naming it."""
+    text = TIED_EDGE_S8R.replace("SHELLEDGE, SOLIDFACE", "SOLIDFACE, SHELLEDGE")
+    deck = _write(tmp_path / "m.inp", text)
+    proc = _cli(["run", deck, "--out", tmp_path / "m", "--quiet"])
+    assert proc.returncode == 2
+    assert "the master surface SHELLEDGE holds edges of S8/S8R elements" in proc.stderr, proc.stderr
 
 
 @pytest.mark.parametrize("fold, knot", [(90.0, True), (30.0, True), (10.0, False)])

@@ -25,7 +25,7 @@ from .deck_coupling import DeckCouplings
 from .deck_planar import (contact_print_labels, element_names, is_planar_type, planar_body, planar_contact,
                           planar_dof3)
 from .deck_rigid import DeckRigid
-from .deck_shells import DeckShells
+from .deck_shells import DeckShells, quadratic_edges
 from .deck_mpc import DeckMPCs
 from .deck_springs import DeckSprings
 
@@ -666,6 +666,12 @@ class _Writer:
             if mk != "ELEMENT":
                 raise DeckError(f"{where}: the master surface {master} must be an element surface (faces)")
             if self._on_skipped([master, slave], where):
+                continue
+            if quadratic_edges(self.m, master):
+                self.unsupported.append(f"{where}: the master surface {master} holds edges of S8/S8R elements: the side "
+                                        f"faces of their solid-shells have six nodes, a facet type covcontact has for "
+                                        f"slave surfaces only (swap slave and master, or use S4 elements there); with "
+                                        f"--ignore-unsupported the pair is left out")
                 continue
             mb = self._surface_body(master, mrefs, where)
             sk, sref = self.m.surfaces[slave]

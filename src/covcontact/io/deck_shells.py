@@ -110,6 +110,16 @@ def read_shell_card(reader, c: Card) -> None:
     m.shell_sections.append((elset, material, thickness, _offset(c), c.where()))
 
 
+def quadratic_edges(m, name: str) -> bool:
+    """Whether the shell surface ``name`` holds edges (S3..S6) of S8 or S8R elements: the side faces of their 18-node
+    solid-shells have six nodes, each taken as its two 4-node halves (mesh.shell), which serve slave surfaces (nodes
+    and their tributary areas), not masters (the halves' chords are not the edge's curve)."""
+    rows = m.shell_surfaces.get(name, [])
+    eight = [labs for t, _, labs, _ in m.shell_blocks if t in ("S8", "S8R")]
+    return any(side.startswith("EDGE") and any(np.intersect1d(labs, els).size for labs in eight)
+               for els, side, _ in rows)
+
+
 def shell_surface_row(reader, c: Card, k: int, row: list[str], name: str) -> bool:
     """Whether line ``k`` of an element *SURFACE names a shell face (SPOS, SNEG; S1 = SNEG and S2 = SPOS of shell
     elements, as CalculiX numbers them), which is then kept in ``shell_surfaces``; an edge (S3..S6) of a shell
@@ -142,12 +152,10 @@ def shell_surface_row(reader, c: Card, k: int, row: list[str], name: str) -> boo
         raise c.fail(f"{face} names shell and solid elements at once ({row[0]}): give them on separate lines", k)
     if face in ("S3", "S4", "S5", "S6"):  # (an edge: the solid-shell's lateral face along it, of 4-node shells)
         types = {t for t, _, labs, _ in m.shell_blocks if np.intersect1d(labs, np.asarray(els, dtype=np.int64)).size}
-        other = sorted(types - {"S4", "S4R"})
+        other = sorted(types - {"S4", "S4R", "S8", "S8R"})
         if other:
-            why = (" (the side faces of their 18-node solid-shells have six nodes, a facet type covcontact does not "
-                   "have)" if other[0] in ("S8", "S8R") else "")
-            raise c.fail(f"{face} of an {other[0]} element is an edge: covcontact reads the edges of "
-                         f"S4 and S4R elements (their solid-shells' side faces), not of {other[0]}{why}", k)
+            raise c.fail(f"{face} of an {other[0]} element is an edge: covcontact reads the edges of S4, S4R, S8 "
+                         f"and S8R elements (their solid-shells' side faces), not of {other[0]}", k)
         m.shell_surfaces.setdefault(name, []).append((np.asarray(els, dtype=np.int64), f"EDGE{int(face[1:]) - 2}",
                                                       c.where(k)))
         return True

@@ -179,7 +179,10 @@ class Mesh:
     @property
     def face_types(self) -> tuple[str, ...]:
         """The face types a face set of this mesh may have: one, or for wedges and mixed meshes tri3 and quad4 (a set
-        of one)."""
+        of one); hex18 solid-shells quad9 (top and bottom) and quad4 (the halves of their six-node side faces,
+        covcontact.mesh.shell)."""
+        if self.cell_type == "hex18":
+            return ("quad9", "quad4")
         if self.is_mixed:
             made = {t for c in self.cell_types for t in (WEDGE_FACE_TYPES if c == "wedge6" else (FACE_TYPE[c],))}
             return tuple(t for t in WEDGE_FACE_TYPES if t in made)

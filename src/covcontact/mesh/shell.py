@@ -278,12 +278,14 @@ EDGE_SIDES = ("edge1", "edge2", "edge3", "edge4")
 
 
 def _edge_faces(name, side, given, surface_type, cell_of, ids, points) -> np.ndarray:
-    """The side faces (outward) along edge ``side`` of the quad4 surface cells ``ids``: (bottom a, bottom b, top b,
-    top a) of the cell's edge from corner a to corner b. ShellMeshError for other cells (the side faces of hex18
-    solid-shells have six nodes, no facet type) or an edge of two cells."""
-    if surface_type != "quad4":
-        raise ShellMeshError(f"face set {name!r}: {side} names an edge of a quad4 shell cell (a deck's S4, S4R); these "
-                             f"cells are {surface_type}")
+    """The side faces (outward) along edge ``side`` of the quad4 or quad8 surface cells ``ids``: (bottom a, bottom b,
+    top b, top a) of the cell's edge from corner a to corner b; along a quad8 cell's edge (whose hex18 side face has
+    six nodes, no facet type) its two halves, from a and from b to the edge's mid-node m, 4-node faces whose nodes
+    are the side face's and whose areas add up to it (a slave surface's nodes and weights; as a master their chords
+    would not be the edge's curve). ShellMeshError for other cells or an edge of two cells."""
+    if surface_type not in ("quad4", "quad8"):
+        raise ShellMeshError(f"face set {name!r}: {side} names an edge of a quad4 or quad8 shell cell (a deck's S4, "
+                             f"S4R, S8, S8R); these cells are {surface_type}")
     n = points.shape[0] // 2
     k = EDGE_SIDES.index(side)
     corners = given[:, :4]
@@ -299,11 +301,13 @@ def _edge_faces(name, side, given, surface_type, cell_of, ids, points) -> np.nda
             raise ShellMeshError(f"face set {name!r}: {side} of surface cell {c} (0-based) is shared with another cell, "
                                  f"not an edge of the shell: it has no side face")
         centre = points[np.concatenate([given[c], given[c] + n])].mean(axis=0)
-        face = np.array([a, b, b + n, a + n], dtype=np.int64)
-        x = points[face]
-        if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
-            face = face[::-1]
-        out.append(face)
+        pieces = [(a, b)] if surface_type == "quad4" else [(a, int(given[c, 4 + k])), (int(given[c, 4 + k]), b)]
+        for p, q in pieces:
+            face = np.array([p, q, q + n, p + n], dtype=np.int64)
+            x = points[face]
+            if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
+                face = face[::-1]
+            out.append(face)
     return np.array(out, dtype=np.int64).reshape(-1, 4)
 
 
