@@ -6,7 +6,10 @@ per increment, cutbacks, the lid force at the end, wall time and wall time per N
 The example's material is c10 = 0.8, c01 = 0.2 (mu0 = 2), d1 = 5e-4 (K0 / mu0 = 2000); the variants change d1
 (K0 = 2 / d1) and the cells' F-bar option.
 
-    python benchmarks/rubber_seal.py [--variants ...] [--out rubber_seal.json]
+    python benchmarks/rubber_seal.py [--variants ...] [--solver "line_search = true; predictor = 'extrapolate'"]
+                                     [--out rubber_seal.json]
+
+``--solver`` gives every variant those ``[solver]`` keys (';' between them).
 """
 
 from __future__ import annotations
@@ -41,15 +44,18 @@ VARIANTS = {
 }
 
 
-def run(name: str, work: Path) -> dict:
+def run(name: str, work: Path, solver: str = "") -> dict:
     ratio, subs = VARIANTS[name]
+    if solver:
+        keys = "\n".join(k.strip() for k in solver.split(";") if k.strip())
+        subs = subs + [("[steps]", f"[solver]\n{keys}\n\n[steps]")]
     key = f"v{list(VARIANTS).index(name)}"
     summary, wall, code = run_variant(PROBLEM, subs, work, key)
     steps = summary["steps"]
     n, its = len(steps), sum(s["iterations"] for s in steps)
     last = steps[-1] if steps else {}
     lid = last.get("contact_force_on", {}).get("lid", [0.0, 0.0])[1]
-    return {"variant": name, "K0_over_mu0": ratio, "exit_code": code, "status": summary["status"], "increments": n,
+    return {"variant": name, "solver": solver, "K0_over_mu0": ratio, "exit_code": code, "status": summary["status"], "increments": n,
             "iterations": its, "per_increment": round(its / max(n, 1), 2),
             "cutbacks": sum(s.get("cutbacks", 0) for s in steps), "lid_force": lid, "wall_s": round(wall, 2),
             "ms_per_iteration": round(1e3 * summary.get("wall_time_s", wall) / max(its, 1), 2)}
@@ -59,11 +65,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--variants", default=None, help="comma-separated indices into the list (default: all): "
                     + "; ".join(f"{k}: {v}" for k, v in enumerate(VARIANTS)))
+    ap.add_argument("--solver", default="", help="[solver] keys for every variant, ';' between them")
     ap.add_argument("--out", default=None, help="JSON file (default: stdout)")
     args = ap.parse_args(argv)
     names = list(VARIANTS) if args.variants is None else [list(VARIANTS)[int(k)] for k in args.variants.split(",")]
     with tempfile.TemporaryDirectory() as tmp:
-        rows = [run(v, Path(tmp)) for v in names]
+        rows = [run(v, Path(tmp), args.solver) for v in names]
     lines = ["| variant | status | increments | Newton iterations | per increment | cutbacks | lid force | wall s | "
              "ms per iteration |", "|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['variant']} | {r['status']} | {r['increments']} | {r['iterations']} | {r['per_increment']} | "
