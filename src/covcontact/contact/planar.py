@@ -54,6 +54,13 @@ class Curve:
             self.vertex_segments.setdefault(int(v0), []).append(s)
             self.vertex_segments.setdefault(int(v1), []).append(s)
         self.corner_nodes = np.unique(corners)
+        # (the same as arrays for the compiled search: each corner's segments, in increasing order, by its place in
+        # corner_nodes)
+        pos = np.searchsorted(self.corner_nodes, corners.ravel())
+        order = np.argsort(pos, kind="stable")
+        self.node_segs = np.ascontiguousarray(np.repeat(np.arange(len(corners)), 2)[order], dtype=np.int64)
+        self.node_ptr = np.concatenate([[0], np.cumsum(np.bincount(pos, minlength=len(self.corner_nodes)))]
+                                       ).astype(np.int64)
 
     def normals(self, xe: np.ndarray) -> np.ndarray:
         """Unit chord normals of the segments (nseg, 2)."""
@@ -82,6 +89,8 @@ def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, k
     it (within FRONT_COS of -own, seen from the vertex) and is not the slave's own node (docs/theory.md section 13)."""
     from scipy.spatial import cKDTree
 
+    from .planar_search import closest_core
+
     ns = len(xs)
     kind = np.zeros(ns, dtype=np.int64)
     seg = np.full(ns, -1, dtype=np.int64)
@@ -92,46 +101,19 @@ def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, k
     nodes = curve.corner_nodes
     tree = cKDTree(xe[nodes, :2])
     near = tree.query_ball_point(xs[:, :2], reach)
-    normals = curve.normals(xe)
-    for i in range(ns):
-        if not near[i]:
-            continue
-        if keep is not None and keep[i] >= 0:
-            xseg = np.ascontiguousarray(xe[curve.segments[keep[i]]])
-            z, gap, ok = project_on_segment(xseg, xs[i], 0.0)
-            if ok and abs(z) <= 1.0 + keep_band:
-                kind[i], seg[i], xi[i], g[i] = FACET, keep[i], z, gap
-                continue
-        cand = sorted({s for k in near[i] for s in curve.vertex_segments[int(nodes[k])]})
-        if exclude is not None:
-            cand = [s for s in cand if s not in exclude[i] and float(normals[s] @ own[i]) < cos_max[i]]
-        best = np.inf
-        tol = INSIDE_TOL if exclude is None else SELF_TOL_INSIDE
-        for s in cand:
-            xseg = np.ascontiguousarray(xe[curve.segments[s]])
-            z, gap, ok = project_on_segment(xseg, xs[i], 0.0)
-            if ok and abs(z) <= 1.0 + tol and abs(gap) < best:
-                best = abs(gap)
-                kind[i], seg[i], xi[i], g[i] = FACET, s, min(max(z, -1.0), 1.0), gap
-        if kind[i]:
-            continue
-        # no segment holds the projection: the nearest vertex between two segments
-        ks = sorted(near[i], key=lambda k: float(np.linalg.norm(xe[nodes[k], :2] - xs[i, :2])))
-        for k in ks:
-            v = int(nodes[k])
-            segs = curve.vertex_segments[v]
-            if len(segs) != 2:
-                continue
-            d = xs[i, :2] - xe[v, :2]
-            if exclude is not None:  # (self-contact: a vertex in front of the slave only, never its own node)
-                dn = float(np.linalg.norm(d))
-                if dn == 0.0 or float(-d @ own[i]) < FRONT_COS * dn or segs[0] in exclude[i] and segs[1] in exclude[i]:
-                    continue
-            sg = 1.0 if float(d @ (normals[segs[0]] + normals[segs[1]])) >= 0.0 else -1.0
-            kind[i], seg[i], vert[i], sign[i] = VERTEX, segs[0], v, sg
-            xi[i] = -1.0 if curve.segments[segs[0], 0] == v else 1.0
-            g[i] = sg * float(np.linalg.norm(d))
-            break
+    sizes = np.fromiter(map(len, near), dtype=np.int64, count=ns)
+    near_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    near_k = np.fromiter((k for row in near for k in row), dtype=np.int64, count=int(near_ptr[-1]))
+    self_mode = exclude is not None
+    closest_core(np.ascontiguousarray(xe, dtype=np.float64), np.ascontiguousarray(xs, dtype=np.float64),
+                 curve.segments, nodes.astype(np.int64), curve.node_ptr, curve.node_segs, near_ptr, near_k,
+                 np.full(ns, -1, dtype=np.int64) if keep is None else np.ascontiguousarray(keep, dtype=np.int64),
+                 float(keep_band), float(SELF_TOL_INSIDE if self_mode else INSIDE_TOL), self_mode,
+                 np.ascontiguousarray(exclude, dtype=np.int64) if self_mode else np.full((ns, 1), -1, dtype=np.int64),
+                 np.ascontiguousarray(own[:, :2], dtype=np.float64) if self_mode else np.zeros((ns, 2)),
+                 np.ascontiguousarray(cos_max, dtype=np.float64) if self_mode else np.zeros(ns),
+                 np.ascontiguousarray(curve.normals(xe), dtype=np.float64), float(FRONT_COS),
+                 kind, seg, xi, g, vert, sign)
     return kind, seg, xi, g, vert, sign
 
 

@@ -114,7 +114,22 @@ class ResultWriter:
         atomic_write_text(self.out / "convergence.csv", "\n".join(self.csv_rows) + "\n")
 
     def write_summary(self, summary: dict) -> None:
-        atomic_write_text(self.out / "summary.json", json.dumps(summary, indent=2, default=_jsonable) + "\n")
+        atomic_write_text(self.out / "summary.json", summary_text(summary))
+
+
+def summary_text(summary: dict) -> str:
+    """summary.json's text: a key per line, and a list of records (the steps) a record per line. Written after every
+    increment, so the compact dumps of json's compiled encoder: an indented dump runs its pure-Python one, whose cost
+    over a long run's rewrites grows with the square of the steps (1.4 s of a 70-step 6 s run)."""
+    lines = []
+    for key, value in summary.items():
+        head = f"  {json.dumps(key)}: "
+        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            body = ",\n".join("    " + json.dumps(v, default=_jsonable) for v in value)
+            lines.append(f"{head}[\n{body}\n  ]")
+        else:
+            lines.append(head + json.dumps(value, default=_jsonable))
+    return "{\n" + ",\n".join(lines) + "\n}\n"
 
 
 def _jsonable(obj):
