@@ -185,7 +185,7 @@ def test_example(runs, tmp_path):
     a = np.array([s["load_factor"] for s in steps])            # the example's load factor is delta / D in %
     assert a == pytest.approx(APPROACH)
     F = np.array([-s["pairs"]["plate"]["contact_force"][1] for s in steps])
-    held = np.array([s["reactions"]["ball.equator"][1] + s["reactions"]["ball.core"][1] for s in steps])
+    held = np.array([s["reactions"]["ball.equator"][1] + s["reactions"]["ball.inner"][1] for s in steps])
     assert held == pytest.approx(F, rel=1e-6)
     at = [APPROACH.index(p) for p in TABULATED]
     assert F[at] == pytest.approx(runs[32]["F"][at], rel=0.02)
