@@ -168,9 +168,9 @@ def planar_contact(w, sb: int, mb: int, kind: str, sk: str, it, where: str) -> d
     forces totals as the body's. Mapped: PRESSURE-OVERCLOSURE=HARD on NODE TO SURFACE pairs of element surfaces
     (augmented Lagrange with the automatic penalty 10 E / h per area, as the 3D import); LINEAR (face-to-face pairs
     the penalty K per area, node-to-face ones CalculiX's arctan curve with its tension), EXPONENTIAL and TABULAR as
-    in 3D, per area. Listed as unsupported (CalculiX has them, contact in the plane does not): face-to-face contact
-    (with --ignore-unsupported the pair is node-to-segment with the same law: CalculiX integrates it over the slave
-    faces, here at the slave nodes over their tributary edges), a node surface (TYPE=NODE) as the slave, a pair
+    in 3D, per area. Face-to-face pairs (TYPE=SURFACE TO SURFACE on element surfaces) are segment-to-segment
+    contact in the plane (``type = "sts"``: the Gauss points of the slave edges). Listed as unsupported (CalculiX has
+    them, contact in the plane does not): a node surface (TYPE=NODE) as the slave, a pair
     between planar and 3D elements or between two planar formulations (left out with the flag) and ADJUST (left out
     with the flag). *FRICTION is Coulomb friction along the master edges (mu, and the stick slope as the tangential
     penalty per area, as in 3D). *TIE and PRESSURE-OVERCLOSURE=TIED become tied pairs in the plane
