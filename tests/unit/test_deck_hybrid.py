@@ -47,16 +47,17 @@ def _cube(etype: str, lateral: str) -> str:
                       "*BOUNDARY", bcs, "*NODE PRINT, NSET=TOP, TOTALS=ONLY", "RF", "*END STEP", ""])
 
 
-def _run(tmp_path, etype, lateral, capsys):
+def _run(tmp_path, etype, lateral, capsys, text=None, axis=2):
+    """Run the cube deck (or ``text``): the force on its TOP set along ``axis``, stderr, the imported problem."""
     deck = tmp_path / f"{etype}_{lateral}.inp"
-    deck.write_text(_cube(etype, lateral))
+    deck.write_text(_cube(etype, lateral) if text is None else text)
     out = tmp_path / f"o_{etype}_{lateral}"
     code = main(["run", str(deck), "--out", str(out), "--quiet"])
     err = capsys.readouterr().err
     assert code == 0, err
     summary = json.loads((out / "summary.json").read_text())
     force = sum(np.asarray(v) for k, v in summary["steps"][-1]["reactions"].items() if k.endswith(".TOP"))
-    return force[2], err, (out / "deck" / f"{deck.stem}.toml").read_text()
+    return force[axis], err, (out / "deck" / f"{deck.stem}.toml").read_text()
 
 
 def test_hybrid_cube_is_fbar_and_exact_in_uniaxial_compression(tmp_path, capsys):
@@ -117,15 +118,7 @@ def _square(etype: str, lateral: str, x0: float = 0.0) -> str:
 
 
 def _run_planar(tmp_path, etype, lateral, capsys, x0=0.0):
-    deck = tmp_path / f"{etype}_{lateral}.inp"
-    deck.write_text(_square(etype, lateral, x0))
-    out = tmp_path / f"o_{etype}_{lateral}"
-    code = main(["run", str(deck), "--out", str(out), "--quiet"])
-    err = capsys.readouterr().err
-    assert code == 0, err
-    summary = json.loads((out / "summary.json").read_text())
-    force = sum(np.asarray(v) for k, v in summary["steps"][-1]["reactions"].items() if k.endswith(".TOP"))
-    return force[1], err, (out / "deck" / f"{deck.stem}.toml").read_text()
+    return _run(tmp_path, etype, lateral, capsys, _square(etype, lateral, x0), axis=1)
 
 
 @pytest.mark.parametrize("etype", ["CPE4H", "CPE8RH"])
