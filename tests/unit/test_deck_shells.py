@@ -394,6 +394,40 @@ def test_shell_edge_faces():
         extrude_surface(pts, "tri3", np.array([[0, 1, 2]]), 0.1, face_sets={"E": [(np.array([0]), "edge1")]})
 
 
+def test_side_faces_of_quadratic_shells_are_halves():
+    """quad8 cells (hex18 solid-shells, whose side faces have six nodes): the side face along an edge (`edge4`, a
+    deck's S6), the `edges` set and a node set's side faces come as 4-node halves, corner to mid-node, outward; their
+    areas add up to the edge's length times the thickness."""
+    from covcontact.mesh.shell import extrude_surface
+
+    ids: dict = {}
+    pts: list = []
+
+    def node(x, y):
+        if (x, y) not in ids:
+            ids[x, y] = len(pts)
+            pts.append([x, y, 0.0])
+        return ids[x, y]
+
+    cells = np.array([[node(i, 0), node(i + 1, 0), node(i + 1, 1), node(i, 1), node(i + 0.5, 0), node(i + 1, 0.5),
+                       node(i + 0.5, 1), node(i, 0.5)] for i in range(2)])
+    left = [ids[0, 0], ids[0, 0.5], ids[0, 1]]
+    m = extrude_surface(np.array(pts, float), "quad8", cells, 0.1, node_sets={"left": left},
+                        face_sets={"E": [(np.array([0]), "edge4")]})
+
+    def area_normals(faces):
+        x = m.points[faces]
+        n = np.cross(x[:, 1] - x[:, 0], x[:, 3] - x[:, 0])
+        return np.linalg.norm(n, axis=1).sum(), n / np.linalg.norm(n, axis=1)[:, None]
+
+    assert m.face_sets["edges"].shape == (12, 4)
+    assert area_normals(m.face_sets["edges"])[0] == pytest.approx(6 * 0.1, rel=1e-12)
+    for name in ("E", "left"):
+        area, normals = area_normals(m.face_sets[name])
+        assert m.face_sets[name].shape == (2, 4) and area == pytest.approx(0.1, rel=1e-12)
+        np.testing.assert_allclose(normals, [[-1.0, 0.0, 0.0]] * 2, atol=1e-12)
+
+
 def test_edges_of_other_shells_are_refused(tmp_path):
     text = TIED_EDGE.replace("*ELEMENT, TYPE=S4, ELSET=SHELL\n2, 11, 12, 13, 14\n3, 12, 15, 16, 13",
                              "*ELEMENT, TYPE=S3, ELSET=SHELL\n2, 11, 12, 14\n3, 12, 15, 16")

@@ -234,6 +234,8 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     faces, _, _ = boundary_faces(mesh)
     in_plane = np.zeros(2 * n, dtype=bool)
     lateral = faces[~(np.all(faces < n, axis=1) | np.all(faces >= n, axis=1))]
+    if cell_type == "quad9":  # (hex18: the six-node side faces as their 4-node halves, _edge_faces)
+        lateral = _side_halves(cells, mesh.points)
     if lateral.shape[0]:
         mesh.add_face_set("edges", lateral)
         mesh.add_node_set("edges", np.unique(lateral))
@@ -303,6 +305,27 @@ def _edge_faces(name, side, given, surface_type, cell_of, ids, points) -> np.nda
         centre = points[np.concatenate([given[c], given[c] + n])].mean(axis=0)
         pieces = [(a, b)] if surface_type == "quad4" else [(a, int(given[c, 4 + k])), (int(given[c, 4 + k]), b)]
         for p, q in pieces:
+            face = np.array([p, q, q + n, p + n], dtype=np.int64)
+            x = points[face]
+            if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
+                face = face[::-1]
+            out.append(face)
+    return np.array(out, dtype=np.int64).reshape(-1, 4)
+
+
+def _side_halves(cells: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The side faces along the free edges of quad9 surface ``cells`` (their hex18 solid-shells' six-node side faces)
+    as 4-node halves, corner to mid-node, outward (:func:`_edge_faces`)."""
+    n = points.shape[0] // 2
+    corners = cells[:, :4]
+    pairs = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
+    _, inverse, counts = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
+    out = []
+    for j in np.flatnonzero(counts[inverse.ravel()] == 1):
+        c, k = divmod(int(j), 4)
+        a, b, m = int(cells[c, k]), int(cells[c, (k + 1) % 4]), int(cells[c, 4 + k])
+        centre = points[np.concatenate([cells[c], cells[c] + n])].mean(axis=0)
+        for p, q in ((a, m), (m, b)):
             face = np.array([p, q, q + n, p + n], dtype=np.int64)
             x = points[face]
             if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
