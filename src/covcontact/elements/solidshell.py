@@ -413,6 +413,47 @@ class SolidShellBody(ElementBody):
                          self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
                          want_K, Ke, fe, flags, nblocks, hist_n, hist)
 
+    def shell_resultants(self, u: np.ndarray, state: dict | None = None) -> dict[str, np.ndarray]:
+        """Per element, in the deformed configuration (docs/theory.md section 6, "Stress resultants"): ``frame``
+        (ne, 3, 3) rows e1, e2, e3 (e3 the element's mean director, the bottom-to-top node vectors' mean; e1 the
+        global x axis projected off e3, the z axis where e3 is nearly x; e2 = e3 x e1); ``thickness`` (ne,) the mean
+        bottom-to-top distance; per unit length of the mid-surface the membrane forces ``N`` (N11, N22, N12), the
+        bending moments ``M`` (M11, M22, M12: int sigma_ab z dz, z along e3 from the mid-surface, so M11 > 0
+        stretches the top) and the transverse shear forces ``Q`` (Q1, Q2); the stresses on the ``bottom`` and
+        ``top`` faces (ne, 6 in the frame: 11, 22, 33, 12, 23, 13), the least-squares line through the Gauss
+        points' stresses over the thickness coordinate taken at -1 and +1."""
+        ng = self.weights.size
+        ne = self.n_elements
+        f = self._fields(u, 3, 7 * ng, state).reshape(ne, ng, 7)
+        sig, dv = f[..., :6], f[..., 6]
+        zeta = self.points[:ng, 2]
+        x = self.X + self._u(u)
+        h = self.cells.shape[1] // 2
+        d = x[self.cells[:, h:]] - x[self.cells[:, :h]]
+        t = np.linalg.norm(d, axis=2).mean(axis=1)
+        e3 = d.mean(axis=1)
+        e3 /= np.linalg.norm(e3, axis=1)[:, None]
+        near_x = 1.0 - np.abs(e3[:, 0]) < 1.5231e-6
+        axis = np.where(near_x[:, None], np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]))
+        e1 = axis - (axis * e3).sum(axis=1)[:, None] * e3
+        e1 /= np.linalg.norm(e1, axis=1)[:, None]
+        frame = np.stack([e1, np.cross(e3, e1), e3], axis=1)
+        i, j = np.array([0, 1, 2, 0, 1, 0]), np.array([0, 1, 2, 1, 2, 2])
+        S = np.empty((ne, ng, 3, 3))
+        S[..., i, j] = sig
+        S[..., j, i] = sig
+        local = np.einsum("eai,egij,ebj->egab", frame, S, frame)[..., i, j]   # (ne, ng, 6) in the frame
+        area = dv.sum(axis=1) / t
+        z = zeta[None, :] * (0.5 * t)[:, None]
+        N = np.einsum("eg,egk->ek", dv, local) / area[:, None]
+        M = np.einsum("eg,egk->ek", dv * z, local) / area[:, None]
+        mean = np.einsum("eg,egk->ek", dv, local) / dv.sum(axis=1)[:, None]
+        zc = zeta[None, :] - (dv * zeta[None, :]).sum(axis=1)[:, None] / dv.sum(axis=1)[:, None]
+        slope = np.einsum("eg,egk->ek", dv * zc, local) / (dv * zc * zc).sum(axis=1)[:, None]
+        zbar = (dv * zeta[None, :]).sum(axis=1) / dv.sum(axis=1)
+        return {"frame": frame, "thickness": t, "N": N[:, [0, 1, 3]], "M": M[:, [0, 1, 3]], "Q": N[:, [5, 4]],
+                "bottom": mean + slope * (-1.0 - zbar)[:, None], "top": mean + slope * (1.0 - zbar)[:, None]}
+
     def _gauss_fields(self, u, mode, out, state) -> None:
         # the history of ``state`` is read as the committed one (never written)
         hist_n = state.get("hist") if self.n_hist else None

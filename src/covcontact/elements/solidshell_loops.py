@@ -67,7 +67,8 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
 
     mode 0: out (ne, 1) strain energy int W(E) dV (inf if E is not admissible); mode 1: out (ne, 1)
     minimum det J0 over the centre and all evaluation points; mode 2: out (ne, 18) volume averages of
-    Cauchy stress (pushed forward with the compatible F), S and the assumed strain E (Voigt).
+    Cauchy stress (pushed forward with the compatible F), S and the assumed strain E (Voigt); mode 3: out
+    (ne, 7 ng) per Gauss point its Cauchy stress (6) and current volume det F w det J0 (shell resultants).
     """
     ne = conn.shape[0]
     nen = conn.shape[1]
@@ -78,6 +79,7 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
     htr = np.empty((ng, hist_n.shape[2]))
     Gx = np.empty((nen, 3))
     Fc = np.empty((3, 3))
+    row = np.zeros(12)
     Gp, gp, _sig = ws3
     Tg, D = ws4
     Ep, S, Et, Ec = ws2
@@ -120,6 +122,14 @@ def solidshell_fields(kind, params, X, u, conn, alpha, dNp, dNc, w, tie_ptr, tie
             # Cauchy stress with the compatible F = I + sum_a u_a (x) dN_a/dX at the Gauss point
             _jacobian(Xe, dNp[g], J0, Ji)
             _kinematics(dNp[g], Ji, ue, Gx, Fc)
+            if mode == 3:
+                add_cauchy_pk2(Fc, S[g], 1.0, row)
+                for I in range(6):
+                    out[e, 7 * g + I] = row[I]
+                    row[I] = 0.0
+                    row[6 + I] = 0.0
+                out[e, 7 * g + 6] = wd * np.linalg.det(Fc)
+                continue
             add_cauchy_pk2(Fc, S[g], wd, out[e])
             for I in range(6):
                 out[e, 12 + I] += wd * (Et[g, I] if I < 3 else 0.5 * Et[g, I])

@@ -206,18 +206,58 @@ def result_fields(model, u: np.ndarray, lam: float, state) -> tuple:
     if state.dynamics:  # a dynamic stage: velocities and accelerations
         pdata["velocity"] = state.dynamics["v"].reshape(-1, 3)[:n].copy()
         pdata["acceleration"] = state.dynamics["a"].reshape(-1, 3)[:n].copy()
-    extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, fields)
     pdata.update(model.contact.point_data(n, state.contact, fields, per_pass) if model.contact.passes else {})
-    if extra_pts is not None and len(extra_pts):
-        m = len(extra_pts)
-        points = np.vstack([points, extra_pts])
-        for key, arr in list(pdata.items()):
-            pad_shape = (m,) + arr.shape[1:]
-            pad = extra_pdata.get(key, np.zeros(pad_shape) if key == "displacement" else np.full(pad_shape, np.nan))
-            pdata[key] = np.concatenate([arr, pad])
-        for ctype, conn, cd in extra_blocks:
-            blocks.append((ctype, conn + n, cd))
+    points = _append(points, pdata, blocks, *shell_mid_surfaces(sysm, model.problem.bodies, U, state))
+    extra_pts, extra_blocks, extra_pdata = rigid_visual(model.contact, lam, fields)
+    if extra_pts is not None:
+        points = _append(points, pdata, blocks, extra_pts, extra_blocks, extra_pdata)
     return points, blocks, pdata
+
+
+def _append(points, pdata, blocks, extra_pts, extra_blocks, extra_pdata):
+    """``points`` with ``extra_pts`` appended: the point data padded (their values where ``extra_pdata`` has them,
+    else zero displacement and NaN), the extra blocks' connectivity shifted past the points."""
+    if not len(extra_pts):
+        return points
+    n, m = len(points), len(extra_pts)
+    for key, arr in list(pdata.items()):
+        pad = extra_pdata.get(key, np.zeros((m,) + arr.shape[1:]) if key == "displacement" else
+                              np.full((m,) + arr.shape[1:], np.nan))
+        pdata[key] = np.concatenate([arr, pad])
+    blocks += [(ctype, conn + n, cd) for ctype, conn, cd in extra_blocks]
+    return np.vstack([points, extra_pts])
+
+
+def shell_mid_surfaces(sysm, bodies, U: np.ndarray, state) -> tuple:
+    """The mid-surfaces of the solid-shell bodies (each bottom-top node pair's mid-point, deformed by the pair's
+    mean displacement; quad4 cells of hex8, quad9 of hex18) with their elements' thickness, membrane forces N,
+    bending moments M, transverse shear forces Q and bottom and top stresses in the elements' shell frames
+    (:meth:`SolidShellBody.shell_resultants`; docs/input.md, "Output"): (points, blocks, point data)."""
+    from ..elements.solidshell import SolidShellBody
+
+    pts, blocks, disp = [], [], []
+    count = 0
+    for body_id, (blk, body, est) in enumerate(zip(sysm.blocks, bodies, state.elements)):
+        if not isinstance(blk.solid, SolidShellBody):
+            continue
+        cells = blk.solid.cells
+        h = cells.shape[1] // 2
+        pairs, mid = np.unique(np.stack([cells[:, :h], cells[:, h:]], axis=2).reshape(-1, 2), axis=0,
+                               return_inverse=True)
+        sl = slice(blk.offset, blk.offset + blk.n_nodes)
+        u = U[sl]
+        r = blk.solid.shell_resultants(u, est)
+        pts.append(0.5 * (blk.solid.X[pairs[:, 0]] + blk.solid.X[pairs[:, 1]]))
+        disp.append(0.5 * (u[pairs[:, 0]] + u[pairs[:, 1]]))
+        cd = {"shell_thickness": r["thickness"], "membrane_force": r["N"], "bending_moment": r["M"],
+              "transverse_shear_force": r["Q"], "stress_bottom": r["bottom"], "stress_top": r["top"],
+              "shell_frame_e1": r["frame"][:, 0], "body_id": np.full(len(cells), body_id, dtype=float),
+              **blk.solid.plastic_fields(est)}
+        blocks.append(("quad4" if h == 4 else "quad9", count + mid.reshape(len(cells), h), cd))
+        count += len(pairs)
+    if not pts:
+        return np.zeros((0, 3)), [], {}
+    return np.vstack(pts), blocks, {"displacement": np.vstack(disp)}
 
 
 class Checkpoints(Observer):

@@ -58,9 +58,13 @@ def _rigid_mask(mesh, block: int, n: int) -> np.ndarray:
 
 
 def _contact_facets(mesh, block: int) -> bool:
-    """True for a block of slave facets written for their contact pressure (not a body to draw)."""
-    arr = mesh.cell_data.get("contact_facet_pressure")
-    return arr is not None and not np.all(np.isnan(np.asarray(arr[block], dtype=float)))
+    """True for a block of slave facets written for their contact pressure, or of a solid-shell body's mid-surface
+    written for its resultants (not a body to draw)."""
+    for key in ("contact_facet_pressure", "shell_thickness"):
+        arr = mesh.cell_data.get(key)
+        if arr is not None and not np.all(np.isnan(np.asarray(arr[block], dtype=float))):
+            return True
+    return False
 
 
 #: the faces of a tetrahedron and of a wedge by their corners, triangles as quadrilaterals with a repeated corner
