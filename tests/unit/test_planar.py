@@ -18,7 +18,8 @@ from covcontact.elements.planar import PlanarBody, edge_load_vector, planar_mass
 from covcontact.fem.planar_cells import EDGES, PLANAR_CELLS
 from covcontact.materials import J2Plasticity, NeoHooke, SaintVenantKirchhoff
 from covcontact.materials.hyperelastic import stress_tangent
-from covcontact.mesh.generators_planar import annulus, rectangle
+from covcontact.mesh.faces import check_orientation
+from covcontact.mesh.generators_planar import annulus, quarter_disc, rectangle
 
 FORMS = ("plane_strain", "plane_stress", "axisymmetric")
 ELASTIC = NeoHooke(E=200.0, nu=0.3)
@@ -233,6 +234,15 @@ def test_generators_sets():
         rad = np.hypot(a.points[:, 0], a.points[:, 1])
         assert np.allclose(rad[a.node_sets["inner"]], 1.0) and np.allclose(rad[a.node_sets["outer"]], 2.0)
         assert np.allclose(a.points[a.node_sets["angle0"], 1], 0.0)
+        q = quarter_disc(2.0, 6, 2, cell=cell, center=(0.0, 1.0))
+        assert set(q.face_sets) == {"arc", "xmin", "ymin"} and q.face_sets["arc"].shape[0] == 6
+        x, y = q.points[:, 0], q.points[:, 1] - 1.0
+        assert x.min() == 0.0 and y.min() == 0.0 and np.all(q.points[:, 2] == 0.0)
+        assert np.allclose(np.hypot(x, y)[q.node_sets["arc"]], 2.0)
+        assert np.all(x[q.node_sets["xmin"]] == 0.0) and np.all(y[q.node_sets["ymin"]] == 0.0)
+        assert check_orientation(q) == []
+    with pytest.raises(ValueError, match="n must be even"):
+        quarter_disc(1.0, 5, 2)
 
 
 def _run(tmp_path, body: str, extra: str = "") -> subprocess.CompletedProcess:

@@ -237,5 +237,48 @@ def disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Sequence[f
     return mesh
 
 
-for _fn in (rectangle, annulus, disc):
+def quarter_disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Sequence[float] = (0.0, 0.0),
+                 core: float = 0.5, bias: float = 1.0) -> Mesh:
+    """The quarter x >= cx, y >= cy of :func:`disc` (n, which must be even, the cells along the quarter circle; the
+    other arguments as there): a ball's or a cylinder's section with its symmetry lines on the axes (an axisymmetric
+    ball: center on the axis, x = cx).
+
+    Sets: node and edge sets "arc" (the quarter circle), "xmin" (the line x = cx) and "ymin" (y = cy); node sets
+    "all" and "core" (the square's quarter).
+    """
+    n = _count("n", n)
+    if n % 2:
+        raise ValueError(f"n must be even (the cells along the quarter circle, half of each of two O-grid blocks), "
+                         f"got {n}")
+    whole = disc(radius, n, nr, cell, (0.0, 0.0), core, bias)
+    nc = 3 if cell.startswith("tri") else 4
+    centre = whole.points[whole.cells[:, :nc]].mean(axis=1)
+    cells = whole.cells[(centre[:, 0] > 0.0) & (centre[:, 1] > 0.0)]
+    used = np.unique(cells)
+    new = np.full(whole.n_nodes, -1, dtype=np.int64)
+    new[used] = np.arange(used.size)
+    xy = whole.points[used, :2].copy()
+    tol = 1e-9 * float(radius)
+    xy[np.abs(xy) < tol] = 0.0
+    c = np.asarray(center, dtype=float).reshape(-1)[:2]
+    mesh = Mesh(np.column_stack([c + xy, np.zeros(len(used))]), cell, new[cells])
+    faces, _, _ = boundary_faces(mesh)
+    core_nodes = np.isin(used, whole.node_sets["core"])
+    sets = {"all": np.ones(len(used), dtype=bool), "core": core_nodes,
+            "arc": np.abs(np.hypot(xy[:, 0], xy[:, 1]) - float(radius)) < tol,
+            "xmin": xy[:, 0] == 0.0, "ymin": xy[:, 1] == 0.0}
+    for name, mask in sets.items():
+        nodes = np.flatnonzero(mask)
+        mesh.add_node_set(name, nodes)
+        if name in ("all", "core"):
+            continue
+        on = np.zeros(mesh.n_nodes, dtype=bool)
+        on[nodes] = True
+        f = faces[np.all(on[faces], axis=1)]
+        if len(f):
+            mesh.add_face_set(name, f)
+    return mesh
+
+
+for _fn in (rectangle, annulus, disc, quarter_disc):
     _fn.planar = True
