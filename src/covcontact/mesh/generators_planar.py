@@ -224,6 +224,13 @@ def disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Sequence[f
     sets = {"all": np.ones(len(used), dtype=bool), "core": np.all(np.abs(xy) <= s + tol, axis=1), "outer": circle,
             "top": circle & (xy[:, 1] >= -tol), "bottom": circle & (xy[:, 1] <= tol),
             "left": circle & (xy[:, 0] <= tol), "right": circle & (xy[:, 0] >= -tol)}
+    _node_and_edge_sets(mesh, sets, faces)
+    return mesh
+
+
+def _node_and_edge_sets(mesh: Mesh, sets: dict, faces: np.ndarray) -> None:
+    """Each mask of ``sets`` as a node set of ``mesh`` and (but "all" and "core") as the edge set of the boundary
+    ``faces`` whose nodes all lie in it."""
     for name, mask in sets.items():
         nodes = np.flatnonzero(mask)
         mesh.add_node_set(name, nodes)
@@ -234,7 +241,6 @@ def disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Sequence[f
         f = faces[np.all(on[faces], axis=1)]
         if len(f):
             mesh.add_face_set(name, f)
-    return mesh
 
 
 def quarter_disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Sequence[float] = (0.0, 0.0),
@@ -267,16 +273,7 @@ def quarter_disc(radius: float, n: int, nr: int, cell: str = "quad4", center: Se
     sets = {"all": np.ones(len(used), dtype=bool), "core": core_nodes,
             "arc": np.abs(np.hypot(xy[:, 0], xy[:, 1]) - float(radius)) < tol,
             "xmin": xy[:, 0] == 0.0, "ymin": xy[:, 1] == 0.0}
-    for name, mask in sets.items():
-        nodes = np.flatnonzero(mask)
-        mesh.add_node_set(name, nodes)
-        if name in ("all", "core"):
-            continue
-        on = np.zeros(mesh.n_nodes, dtype=bool)
-        on[nodes] = True
-        f = faces[np.all(on[faces], axis=1)]
-        if len(f):
-            mesh.add_face_set(name, f)
+    _node_and_edge_sets(mesh, sets, faces)
     return mesh
 
 

@@ -302,21 +302,27 @@ def _edge_faces(name, side, given, surface_type, cell_of, ids, points) -> np.nda
         if count[frozenset((a, b))] > 1:
             raise ShellMeshError(f"face set {name!r}: {side} of surface cell {c} (0-based) is shared with another cell, "
                                  f"not an edge of the shell: it has no side face")
-        centre = points[np.concatenate([given[c], given[c] + n])].mean(axis=0)
         pieces = [(a, b)] if surface_type == "quad4" else [(a, int(given[c, 4 + k])), (int(given[c, 4 + k]), b)]
-        for p, q in pieces:
-            face = np.array([p, q, q + n, p + n], dtype=np.int64)
-            x = points[face]
-            if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
-                face = face[::-1]
-            out.append(face)
+        out += _side_faces(pieces, given[c], points)
     return np.array(out, dtype=np.int64).reshape(-1, 4)
+
+
+def _side_faces(pieces, cell: np.ndarray, points: np.ndarray) -> list[np.ndarray]:
+    """The side faces (bottom p, bottom q, top q, top p) of the edge pieces (p, q) of surface ``cell``, each turned
+    outward (away from the centre of the cell's solid-shell)."""
+    n = points.shape[0] // 2
+    centre = points[np.concatenate([cell, cell + n])].mean(axis=0)
+    out = []
+    for p, q in pieces:
+        face = np.array([p, q, q + n, p + n], dtype=np.int64)
+        x = points[face]
+        out.append(face if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) >= 0.0 else face[::-1])
+    return out
 
 
 def _side_halves(cells: np.ndarray, points: np.ndarray) -> np.ndarray:
     """The side faces along the free edges of quad9 surface ``cells`` (their hex18 solid-shells' six-node side faces)
     as 4-node halves, corner to mid-node, outward (:func:`_edge_faces`)."""
-    n = points.shape[0] // 2
     corners = cells[:, :4]
     pairs = np.sort(np.stack([corners, np.roll(corners, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
     _, inverse, counts = np.unique(pairs, axis=0, return_inverse=True, return_counts=True)
@@ -324,13 +330,7 @@ def _side_halves(cells: np.ndarray, points: np.ndarray) -> np.ndarray:
     for j in np.flatnonzero(counts[inverse.ravel()] == 1):
         c, k = divmod(int(j), 4)
         a, b, m = int(cells[c, k]), int(cells[c, (k + 1) % 4]), int(cells[c, 4 + k])
-        centre = points[np.concatenate([cells[c], cells[c] + n])].mean(axis=0)
-        for p, q in ((a, m), (m, b)):
-            face = np.array([p, q, q + n, p + n], dtype=np.int64)
-            x = points[face]
-            if np.cross(x[1] - x[0], x[3] - x[0]) @ (x.mean(axis=0) - centre) < 0.0:
-                face = face[::-1]
-            out.append(face)
+        out += _side_faces(((a, m), (m, b)), cells[c], points)
     return np.array(out, dtype=np.int64).reshape(-1, 4)
 
 
