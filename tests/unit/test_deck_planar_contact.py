@@ -262,3 +262,38 @@ def test_contact_print_of_planar_pairs_as_calculix_prints_its_expansion(tmp_path
             assert energy[lab][0] == pytest.approx(ref["energy"][lab], rel=0.08)
         assert energy[38][0] == pytest.approx(ref["energy"][38], rel=3e-3)
         assert total == pytest.approx(ref["total"], rel=2e-3)
+
+#: CalculiX 2.20 (``ccx -i``) on the frictional deck of the test below, at time 1.25 (a quarter into the sliding
+#: step; CalculiX's own run diverges later in that step): per slave row (pressure, shear t1, gap, slip t1)
+_CCX_FRICTION = {35: (60.32215, 12.06443, -6.330027e-05, 2.293813e-04),
+                 38: (102.0288, 20.40576, -1.050208e-04, 7.156238e-05),
+                 41: (135.6159, 22.33596, -1.386113e-04, 2.233596e-05)}
+
+
+def test_contact_print_of_a_sliding_planar_pair_against_calculix(tmp_path):
+    """The CPE4 node-to-surface deck with *FRICTION (mu 0.2, stick slope 1e6), the upper block's top pushed sideways
+    by 0.002 in a second step (DIRECT, 4 increments): at time 1.25 the slave rows' pressure, shear, gap and slip equal
+    CalculiX's to 1e-3 of each column's largest value (measured 2e-4): nodes 35 and 38 slip (shear = 0.2 pressure),
+    node 41 sticks. (The energies differ by the stick spring's, which CalculiX 2.20 prints twice: docs/input.md.)"""
+    text = _deck("CPE4", kind="NODE TO SURFACE", extra="*FRICTION\n0.2, 1e6\n")
+    text = text.replace("*NSET, NSET=LEFT\n1, 4, 11, 14\n", "*NSET, NSET=LEFT\n1, 4\n*NSET, NSET=TOPN\n14, 15, 16\n")
+    text = text.replace("*STATIC\n0.5, 1.\n", "*STATIC, DIRECT\n0.25, 1.\n")
+    text = text.replace("*END STEP\n", "*CONTACT PRINT\nCSTR, CDIS\n*END STEP\n*STEP, NLGEOM\n*STATIC, DIRECT\n0.25, 1.\n"
+                        "*BOUNDARY\nTOPN, 1, 1, 0.002\n*CONTACT PRINT\nCSTR, CDIS\n*END STEP\n")
+    dat, proc = _run(text, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    blocks: dict = {}
+    cur = None
+    for line in dat.read_text().splitlines():
+        head = re.match(r"\s*(contact stress|relative contact displacement).*time\s+(\S+)", line)
+        if head:
+            cur = blocks.setdefault(float(head.group(2)), {}).setdefault(head.group(1), {}) if \
+                abs(float(head.group(2)) - 1.25) < 1e-9 else None
+        elif cur is not None and len(line.split()) == 4:
+            f = line.split()
+            cur[int(f[0])] = [float(v) for v in f[1:]]
+    press, gap = blocks[1.25]["contact stress"], blocks[1.25]["relative contact displacement"]
+    ref = np.array([_CCX_FRICTION[k] for k in sorted(_CCX_FRICTION)])
+    got = np.array([[press[k][0], press[k][1], gap[k][0], gap[k][1]] for k in sorted(_CCX_FRICTION)])
+    assert np.all(np.abs(got - ref) <= 1e-3 * np.abs(ref).max(axis=0)), got - ref
+    assert press[35][1] == pytest.approx(0.2 * press[35][0], rel=1e-6) and press[41][1] < 0.2 * press[41][0]
