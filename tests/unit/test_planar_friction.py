@@ -156,7 +156,7 @@ def vertex_residual(y, du0, t_n, sign, lam=0.0):
     R = np.zeros(6)
     K = np.zeros((6, 6))
     vertex_core(xv, xs, sign, EPS, lam, R, K)
-    Rf, Kf, T, st = vertex_friction(xv, xs, du0 + (xs - xv), t_n, sign, EPS, EPS_T, MU, lam)
+    Rf, Kf, T, _, st = vertex_friction(xv, xs, du0 + (xs - xv), t_n, sign, EPS, EPS_T, MU, lam)
     return R + Rf, K + Kf, T, st
 
 

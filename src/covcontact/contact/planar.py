@@ -39,6 +39,7 @@ from .element import CASE_A, CASE_B, CASE_C, CASE_D, CASE_EXACT  # noqa: F401  (
 # uses them too
 from .planar_kernels import (INSIDE_TOL, MAX_ITER, project_on_segment, segment_core, segment_point,  # noqa: E402,F401
                              segment_shapes, vertex_core)
+from .planar_search import FACET, VERTEX, closest_core  # noqa: E402
 from .selfcontact import FRONT_COS, HOLD_COS  # noqa: E402
 
 
@@ -49,13 +50,9 @@ class Curve:
         self.segments = np.ascontiguousarray(segments, dtype=np.int64)
         self.nen = self.segments.shape[1]
         corners = self.segments[:, :2]
-        self.vertex_segments: dict[int, list[int]] = {}
-        for s, (v0, v1) in enumerate(corners):
-            self.vertex_segments.setdefault(int(v0), []).append(s)
-            self.vertex_segments.setdefault(int(v1), []).append(s)
         self.corner_nodes = np.unique(corners)
-        # (the same as arrays for the compiled search: each corner's segments, in increasing order, by its place in
-        # corner_nodes)
+        # each corner's segments, in increasing order, by its place in corner_nodes: node_segs[node_ptr[k]:
+        # node_ptr[k + 1]] (the compiled search's arrays)
         pos = np.searchsorted(self.corner_nodes, corners.ravel())
         order = np.argsort(pos, kind="stable")
         self.node_segs = np.ascontiguousarray(np.repeat(np.arange(len(corners)), 2)[order], dtype=np.int64)
@@ -69,7 +66,6 @@ class Curve:
         return n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
 
 
-FACET, VERTEX = 1, 2
 #: self-contact: a projection counts as inside its segment up to this far beyond its ends in xi (a slave facing a node
 #: of the other wall of a flattened surface otherwise flips between its two segments and the vertex on round-off)
 SELF_TOL_INSIDE = 1e-4
@@ -88,8 +84,6 @@ def closest_points(curve: Curve, xe: np.ndarray, xs: np.ndarray, reach: float, k
     only if its normal makes a cosine below cos_max with the slave's own, a vertex only if the slave lies in front of
     it (within FRONT_COS of -own, seen from the vertex) and is not the slave's own node (docs/theory.md section 13)."""
     from scipy.spatial import cKDTree
-
-    from .planar_search import closest_core
 
     ns = len(xs)
     kind = np.zeros(ns, dtype=np.int64)
@@ -564,12 +558,9 @@ def _vertex_friction(p, c, s: int, segment: int, xi: float, v: int, sign: float,
         return np.zeros(6), np.zeros((6, 6))
     slave = p.slaves[s]
     du = (xe[slave] - x_commit[slave]) - (xe[v] - x_commit[v])
-    R, K, T, t.status[s] = vertex_friction(xe[v], xe[slave], du, traction_vector(c.hist[s]), sign, eps,
-                                           float(p.eps_t[s]), float(p.mu), lam)
-    d = xe[slave, :2] - xe[v, :2]
-    n = d / (sign * np.linalg.norm(d))
-    t.hist[s] = vertex_history(np.ascontiguousarray(xe[p.curve.segments[segment]]), xi,
-                               T * np.array([-n[1], n[0], 0.0]))
+    R, K, T, tau, t.status[s] = vertex_friction(xe[v], xe[slave], du, traction_vector(c.hist[s]), sign, eps,
+                                                float(p.eps_t[s]), float(p.mu), lam)
+    t.hist[s] = vertex_history(np.ascontiguousarray(xe[p.curve.segments[segment]]), xi, T * tau)
     return R, K
 
 

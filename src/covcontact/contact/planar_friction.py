@@ -188,18 +188,18 @@ def vertex_friction(xv, xs, du, t_n, sign: float, eps_n: float, eps_t: float, mu
     tangential force T^tr = tau . (t_n - eps_T du) with ``du`` the slave's displacement relative to the vertex node
     since the last commit and ``t_n`` the committed traction vector; stick: T = T^tr below the cone mu N (N = -eps
     g_e), slip: T = mu N sign(T^tr). The friction part of the residual, R_v = T tau, R_s = -T tau, and its exact
-    tangent, on (vertex, slave) as (6,) and (6, 6) (in-plane entries). Returns (R, K, T, state); the normal part is
-    :func:`.planar_kernels.vertex_core`'s."""
+    tangent, on (vertex, slave) as (6,) and (6, 6) (in-plane entries). Returns (R, K, T, tau, state); the normal part
+    is :func:`.planar_kernels.vertex_core`'s."""
     R = np.zeros(6)
     K = np.zeros((6, 6))
     d = np.asarray(xs[:2], dtype=float) - np.asarray(xv[:2], dtype=float)
     dist = float(np.hypot(d[0], d[1]))
     if dist == 0.0:
-        return R, K, 0.0, NEW
+        return R, K, 0.0, np.zeros(2), NEW
     g = sign * dist
     ge = g + lam_k / eps_n
     if not is_active(g, lam_k, eps_n):
-        return R, K, 0.0, OPEN
+        return R, K, 0.0, np.zeros(2), OPEN
     n = d / g
     tau = np.array([-n[1], n[0]])
     w = np.asarray(t_n[:2], dtype=float) - eps_t * np.asarray(du[:2], dtype=float)
@@ -219,7 +219,7 @@ def vertex_friction(xv, xs, du, t_n, sign: float, eps_n: float, eps_t: float, mu
     K[0:2, 0:2] = Kss
     K[3:5, 0:2] = -Kss
     K[0:2, 3:5] = -Kss
-    return R, K, T, state
+    return R, K, T, tau, state
 
 
 def vertex_history(xseg, xi: float, traction: np.ndarray) -> np.ndarray:

@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from ..fem.axes import calculix_axes
 from ..fem.quadrature import DEFAULT_RULE, gauss_1d, gauss_tensor
 from ..fem.shapes import NODES, shape_functions
 from ..materials.hyperelastic import Material
@@ -433,24 +434,19 @@ class SolidShellBody(ElementBody):
         t = np.linalg.norm(d, axis=2).mean(axis=1)
         e3 = d.mean(axis=1)
         e3 /= np.linalg.norm(e3, axis=1)[:, None]
-        near_x = 1.0 - np.abs(e3[:, 0]) < 1.5231e-6
-        axis = np.where(near_x[:, None], np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0]))
-        e1 = axis - (axis * e3).sum(axis=1)[:, None] * e3
-        e1 /= np.linalg.norm(e1, axis=1)[:, None]
-        frame = np.stack([e1, np.cross(e3, e1), e3], axis=1)
+        frame = np.stack([*calculix_axes(e3), e3], axis=1)
         i, j = np.array([0, 1, 2, 0, 1, 0]), np.array([0, 1, 2, 1, 2, 2])
         S = np.empty((ne, ng, 3, 3))
         S[..., i, j] = sig
         S[..., j, i] = sig
         local = np.einsum("eai,egij,ebj->egab", frame, S, frame)[..., i, j]   # (ne, ng, 6) in the frame
-        area = dv.sum(axis=1) / t
-        z = zeta[None, :] * (0.5 * t)[:, None]
-        N = np.einsum("eg,egk->ek", dv, local) / area[:, None]
-        M = np.einsum("eg,egk->ek", dv * z, local) / area[:, None]
-        mean = np.einsum("eg,egk->ek", dv, local) / dv.sum(axis=1)[:, None]
-        zc = zeta[None, :] - (dv * zeta[None, :]).sum(axis=1)[:, None] / dv.sum(axis=1)[:, None]
+        volume = dv.sum(axis=1)
+        mean = np.einsum("eg,egk->ek", dv, local) / volume[:, None]     # the volume average: N / t
+        N = mean * t[:, None]
+        M = np.einsum("eg,egk->ek", dv * zeta[None, :], local) * (0.5 * t * t / volume)[:, None]
+        zbar = (dv * zeta[None, :]).sum(axis=1) / volume
+        zc = zeta[None, :] - zbar[:, None]
         slope = np.einsum("eg,egk->ek", dv * zc, local) / (dv * zc * zc).sum(axis=1)[:, None]
-        zbar = (dv * zeta[None, :]).sum(axis=1) / dv.sum(axis=1)
         return {"frame": frame, "thickness": t, "N": N[:, [0, 1, 3]], "M": M[:, [0, 1, 3]], "Q": N[:, [5, 4]],
                 "bottom": mean + slope * (-1.0 - zbar)[:, None], "top": mean + slope * (1.0 - zbar)[:, None]}
 

@@ -223,13 +223,10 @@ def face_nodes(cell_type: str, face: int) -> list[int]:
 
 def ccx_tangents(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """CalculiX's tangential unit vectors of a contact normal n: t1 along x (along z when n is nearly x) projected off
-    n, t2 = n x t1."""
-    if 1.0 - abs(n[0]) < 1.5231e-6:
-        t1 = np.array([-n[2] * n[0], -n[2] * n[1], 1.0 - n[2] * n[2]])
-    else:
-        t1 = np.array([1.0 - n[0] * n[0], -n[0] * n[1], -n[0] * n[2]])
-    t1 /= np.linalg.norm(t1)
-    return t1, np.cross(n, t1)
+    n, t2 = n x t1 (:func:`covcontact.fem.axes.calculix_axes`)."""
+    from ..fem.axes import calculix_axes
+
+    return calculix_axes(n)
 
 
 def contact_energy(p, j: int, f: np.ndarray, n: np.ndarray, gap: float, multiplier: float) -> float:
