@@ -125,6 +125,7 @@ class ContactPair:
     self_surfaces: tuple | None = None  # self-contact: the (body, face set) surfaces merged into one
     tie_tolerance: float | None = None  # law "tied": largest distance of a tied point (None: 5 % facet size)
     adjust: float | str | None = None  # slave nodes moved onto the master before the first step: below this gap, or a node set
+    gap: str = "points"                # sts: the law on each Gauss point's gap, or on each slave node's weighted gap ("nodal")
 
     def penalty_factor(self) -> float:
         """The factor of ``penalty = "auto"``: ``auto_factor``, else 10 (100 for a tied pair: a tie has no active set

@@ -28,7 +28,11 @@ def _problem(tmp_path, extra: str = "", cell: str = "hex8"):
     ("smoothing = 0.004\nfriction = 0.2", "hex8"),
     ('method = "augmented"\ngap_tolerance = 1e-5', "hex8"),
     ("friction = 0.2", "hex27"),
-], ids=["frictionless", "coulomb", "two-pass-order3", "smoothed-coulomb", "augmented", "quad9-coulomb"])
+    ('gap = "nodal"', "hex8"),
+    ('gap = "nodal"\nsmoothing = 0.004', "hex8"),
+    ('gap = "nodal"', "hex27"),
+], ids=["frictionless", "coulomb", "two-pass-order3", "smoothed-coulomb", "augmented", "quad9-coulomb", "nodal",
+        "nodal-smoothed", "nodal-quad9"])
 def test_exact_tangent_against_differences(tmp_path, extra, cell):
     """A block pressed and pulled across another with segment-to-surface contact: the exact tangent matches
     central differences of the residual to 1e-6 (relative, every free column) at steps 1 and 3 (sticking and
@@ -40,8 +44,9 @@ def test_exact_tangent_against_differences(tmp_path, extra, cell):
         assert rep["relative_error"] <= 1e-6, (step, rep["relative_error"])
 
 
-def test_analytic_master(tmp_path):
-    """Segment-to-surface against a rigid sphere with friction: exact tangent to 1e-6."""
+@pytest.mark.parametrize("extra", ["friction = 0.2", 'gap = "nodal"'], ids=["coulomb", "nodal"])
+def test_analytic_master(tmp_path, extra):
+    """Segment-to-surface against a rigid sphere, with friction or on nodal gaps: exact tangent to 1e-6."""
     text = """
 [problem]
 name = "sts-sphere"
@@ -60,7 +65,7 @@ master = "ball"
 penalty = 1.0e4
 type = "sts"
 tangent = "exact"
-friction = 0.2
+EXTRA
 [[dirichlet]]
 set = "block.zmax"
 components = "xyz"
@@ -69,16 +74,18 @@ value = [0.02, 0.0, -0.03]
 count = 2
 """
     path = tmp_path / "s.toml"
-    path.write_text(text)
+    path.write_text(text.replace("EXTRA", extra))
     prob = load_problem(path)
     rep = check_tangent(prob, step=2, columns=None)
     assert rep["converged"] and rep["relative_error"] <= 1e-6, rep["relative_error"]
 
 
-def test_tangent_parts_keep_their_meaning(tmp_path):
+@pytest.mark.parametrize("extra", ["", 'gap = "nodal"'], ids=["points", "nodal"])
+def test_tangent_parts_keep_their_meaning(tmp_path, extra):
     """Per point the tangent splits as for a slave node: case a = main + rotational + curvature parts, case d =
-    the main part, and the parts differ from zero; expanded onto the facet nodes they keep that sum."""
-    prob = _problem(tmp_path)
+    the main part, and the parts differ from zero; expanded onto the facet nodes they keep that sum. On nodal gaps
+    the main part is the nodes' blocks, the others the points' at their interpolated forces."""
+    prob = _problem(tmp_path, extra)
     res = prob.run(out=tmp_path / "out")
     assert res.exit_code == 0
     model = res.model
@@ -146,6 +153,10 @@ def test_model_maps_points_to_nodes(tmp_path):
     ('weighting = "nodal"', "contact[0].weighting: type = \"sts\" integrates"),
     ('law = "tied"\nfriction = 0.2', "contact[0].friction: not used by law = \"tied\""),
     ('tie_tolerance = 0.1', "contact[0].tie_tolerance: tie_tolerance is for law = \"tied\""),
+    ('gap = "nodal"\nfriction = 0.2', "contact[0].gap: gap = \"nodal\": not with friction"),
+    ('gap = "nodal"\nmethod = "augmented"', "contact[0].gap: gap = \"nodal\": not with method = \"augmented\""),
+    ('gap = "nodal"\nlaw = "arctan"\ntension = 10.0', "contact[0].gap: gap = \"nodal\": not with law = \"arctan\""),
+    ('gap = "nodes"', "contact[0].gap: 'nodes' is not one of points, nodal"),
 ])
 def test_bad_input(tmp_path, extra, message):
     with pytest.raises(InputError) as err:
@@ -158,6 +169,7 @@ def test_bad_input(tmp_path, extra, message):
                                                     "faces, but 'punch.all' is a node set only"),
     ('type = "sts"', 'type = "nts"\norder = 2', "contact[0].order: the Gauss rule of the slave facets is for"),
     ('type = "sts"', 'type = "mortar"', "contact[0].type: 'mortar' is not one of nts, sts"),
+    ('type = "sts"', 'type = "nts"\ngap = "nodal"', "contact[0].gap: gap = \"nodal\": it is for type = \"sts\""),
     ('slave = "punch.zmin"\nmaster = "base.zmax"', 'self = "punch.zmin"\nslave = "punch.zmin"',
      "contact[0].slave: not used with self"),
     ('slave = "punch.zmin"\nmaster = "base.zmax"', 'self = "punch.all"', "contact[0].self: 'punch.all' is a node set"),

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import report
+from . import nodal_gap, report
 from .assembly import ElementBlocks
 from .driver import EDGE, FACET, VERTEX, project_slaves
 from .edge import edge_vertex_contact
@@ -216,6 +216,9 @@ class ContactManager:
         t.xi = np.where(ok[:, None], res.xi, 0.0)
         t.gap = np.where(ok, res.g, np.inf)
         t.hist_facet = t.facet.copy()
+        if p.nodal:
+            nodal_gap.mesh_pass(self, p, xe, res, case, t, want_K, want_parts, ev)
+            return
         nen = p.surface.nen
         nd = 3 * (nen + 1)
         eps, eps_t = p.eps, p.eps_t
@@ -420,6 +423,11 @@ class ContactManager:
 
     def _analytic_pass(self, p: Pass, xe, lam, case, c: PassState, t: PassState, want_K, want_parts,
                        ev: ContactEvaluation) -> None:
+        if p.nodal:
+            if self.reference and self._ref_of_pass[next(i for i, q in enumerate(self.passes) if q is p)] >= 0:
+                raise ValueError(f"contact {p.pair}: gap = \"nodal\" is not for a tool pressed with a force")
+            nodal_gap.analytic_pass(self, p, xe, lam, _CASE_NAME[case], t, want_K, want_parts, ev)
+            return
         xs = np.ascontiguousarray(xe[p.slaves])
         mult = t.multiplier if p.augmented else None
         ns = len(xs)
@@ -518,6 +526,8 @@ class ContactManager:
             return s.facet >= 0
         if self.passes[k].law is not None:
             return self.passes[k].law.traction(s.gap, self.passes[k].area)[0]
+        if self.passes[k].nodal:  # a point carries force where a node of its facet is active, whatever its own gap
+            return np.any(s.force != 0.0, axis=1)
         return is_active(s.gap, s.multiplier, self.passes[k].eps, self.passes[k].band)
 
     def active_count(self, state: ContactState) -> int:

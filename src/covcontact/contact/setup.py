@@ -61,6 +61,7 @@ class Pass:
     own_patch: np.ndarray | None = None    # sts self-contact: (ns,) each point's patch quadrilateral in surface
     law: object = None                     # a laws.PressureLaw evaluated in the Python layer (None: band's law)
     curve: object = None                   # planar bodies: the master curve of node-to-segment contact (.planar)
+    nodal: bool = False                    # sts: the law on the nodes' weighted gaps (.nodal_gap)
 
     @property
     def ns(self) -> int:
@@ -270,7 +271,8 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
     kw = {"eps_t": eps_t, "case": CASES[tangent or pair.tangent], "mu": float(pair.friction or 0.0),
           "augmented": pair.method == "augmented", "max_aug": pair.max_augmentations, "pair": pair.name,
           "slave_body": slave[0] if surfaces is None else "", "master_body": master[0] if surfaces is None else "",
-          "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own, "law": law}
+          "band": band, "kind": pair.type, "slave_faces": slave_faces, "slave_facet": own, "law": law,
+          "nodal": pair.gap == "nodal"}
     if surfaces is not None:
         quads, _ = quad_patches(slave_faces, num.points)  # tri3, tri6, quad8 facets as quadrilaterals
         surface = MeshSurface(quads, n_nodes=num.n_ext + num.points.count)

@@ -194,6 +194,7 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         enabled = c.get("enabled", "bool", True)
         smoothing = c.get("smoothing", "float", 0.0, nonnegative=True)
         adjust = _adjust(c, sets, slave, master, law, surfaces, rigid)
+        gap = _gap(c, ctype, law, method, mu, surfaces)
         c.done()
         if any(x.name == cname for x in contacts):
             c.fail(f"duplicate contact name {cname!r}", "name")
@@ -203,8 +204,23 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
                                     auto_factor=auto_factor, enabled=enabled, smoothing=smoothing, law=law,
                                     clearance=clearance, pressure=pressure, form=form, tension=tension,
                                     reach=reach, table=table, type=ctype, order=order,
-                                    self_surfaces=surfaces, tie_tolerance=tie_tol, adjust=adjust))
+                                    self_surfaces=surfaces, tie_tolerance=tie_tol, adjust=adjust, gap=gap))
     return contacts
+
+
+def _gap(c: Section, ctype: str, law: str, method: str, mu: float, surfaces) -> str:
+    """``gap``: segment-to-surface's law on each Gauss point's gap ("points") or on each slave node's weighted gap
+    ("nodal"; frictionless penalty pairs, smoothed or not, against another surface)."""
+    gap = c.get("gap", "str", "points", choices=("points", "nodal"))
+    if gap == "nodal":
+        why = ("it is for type = \"sts\"" if ctype != "sts" else
+               f"not with law = \"{law}\" (penalty only)" if law != "penalty" else
+               "not with method = \"augmented\"" if method != "penalty" else
+               "not with friction (frictionless pairs)" if mu > 0.0 else
+               "not for self-contact" if surfaces is not None else None)
+        if why:
+            c.fail(f"gap = \"nodal\": {why}", "gap")
+    return gap
 
 
 def _adjust(c: Section, sets: SetRefs, slave, master, law: str, surfaces, rigid) -> float | str | None:

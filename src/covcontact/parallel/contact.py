@@ -26,6 +26,8 @@ class DistributedContact(ContactManager):
         owner = system.owner
         local = []
         for p in self.passes:
+            if p.nodal and size > 1:  # (a node's weighted gap takes the points of all its facets, on any rank)
+                raise ValueError(f"contact {p.pair}: gap = \"nodal\" runs in one process: leave out --ranks")
             s = p.slaves
             own = np.empty(len(s), dtype=np.int64)
             deformable = s < self.N
