@@ -41,8 +41,9 @@ def test_merged_surfaces_equal_the_two_pass_pair(tmp_path, extra):
                                                              ref["contact1/reverse"]["contact_force"]), atol=1e-8)
 
 
-@pytest.mark.parametrize("extra", ["", "friction = 0.3", 'type = "sts"', 'type = "sts"\nfriction = 0.3'],
-                         ids=["nts", "nts-coulomb", "sts", "sts-coulomb"])
+@pytest.mark.parametrize("extra", ["", "friction = 0.3", 'type = "sts"', 'type = "sts"\nfriction = 0.3',
+                                   'type = "sts"\ngap = "nodal"'],
+                         ids=["nts", "nts-coulomb", "sts", "sts-coulomb", "sts-nodal"])
 def test_self_contact_tangent(tmp_path, extra):
     """The exact tangent of a self-contact matches central differences to 1e-6 at steps 1 and 3."""
     prob = _problem(tmp_path, MERGED, extra)

@@ -187,3 +187,48 @@ def test_bad_pairs(tmp_path, old, new, message):
     with pytest.raises(InputError) as err:
         load_problem(path)
     assert message in str(err.value) and "\n" not in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("cell", ["hex8", "hex27"])
+def test_nodal_gaps_on_a_plane_are_node_to_surface(tmp_path, cell):
+    """Against a flat master the gap is affine in the position, so the dual weights' average of the points' gaps is the
+    node's own gap and the node's area its tributary area (docs/theory.md section 16): gap = "nodal" gives node-to-surface
+    with area weighting, iteration by iteration, to round-off."""
+    text = """
+[problem]
+name = "nodal-plane"
+[[bodies]]
+name = "block"
+element = "CELL"
+material = { model = "neo-hooke", E = 100.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.25, nx = 3, ny = 2, nz = 1, origin = [-0.5, -0.5, 0.0] }
+[[rigid]]
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.3, 0.0, 1.0]
+[[contact]]
+slave = "block.zmin"
+master = "floor"
+penalty = 1.0e4
+PAIR
+[[dirichlet]]
+set = "block.zmax"
+components = "xyz"
+value = [0.05, 0.02, -0.03]
+[steps]
+count = 2
+"""
+    runs = {}
+    for name, pair in (("nts", 'type = "nts"\nweighting = "area"'), ("nodal", 'type = "sts"\ngap = "nodal"')):
+        path = tmp_path / f"{name}.toml"
+        path.write_text(text.replace("CELL", cell).replace("PAIR", pair))
+        runs[name] = load_problem(path).run(out=tmp_path / name)
+        assert runs[name].exit_code == 0
+    a, b = runs["nts"], runs["nodal"]
+    assert [s["iterations"] for s in a.summary["steps"]] == [s["iterations"] for s in b.summary["steps"]]
+    np.testing.assert_allclose(b.u, a.u, rtol=0, atol=1e-10 * np.abs(a.u).max())
+    fa = a.summary["steps"][-1]["pairs"]["contact1"]["contact_force"]
+    fb = b.summary["steps"][-1]["pairs"]["contact1"]["contact_force"]
+    np.testing.assert_allclose(fb, fa, rtol=1e-9, atol=1e-12)
+    assert abs(fa[2]) > 0.0

@@ -2,9 +2,11 @@
 
 The Gauss points of the slave facets measure the gap as in ordinary segment-to-surface contact, but the normal law
 acts on one weighted gap per slave node, g~_a = sum_g c_ag g_g with c_ag = w_ag / A_a, A_a = sum_g w_ag, over the
-points g of the facets around node a that have a contact point (w_ag = phi_a(xi_g) w_g J_g with phi_a = N_a on
-linear facets and N_a^2 / sum_b N_b^2 on quadratic ones, whose shape values change sign at the Gauss points: a
-positive partition of unity, so the nodes' areas A_a sum to the surface's). The energy is
+points g of the facets around node a that have a contact point. The weights w_ag = psi_a(xi_g) w_g J_g take the dual
+shape functions of the mortar methods, biorthogonal to the N_b under each facet's rule, so that A_a is the node's
+tributary area and against a flat master g~_a is the node's own gap; where a facet has no dual basis (tri6 and quad8
+corners, one point per facet) psi_a is a positive partition of unity instead (N_a on linear facets,
+N_a^2 / sum_b N_b^2 on quadratic ones). The energy is
 W = sum_a Phi_a(g~_a) with the pair's law per node (penalty eps_N A_a, smoothed or not): one constraint per slave node,
 as node-to-surface has, where the points alone over-constrain conforming faces (their active set cycles on flat
 contact). With the node's force F_a = -Phi_a' >= 0 and stiffness S_a = Phi_a'':
@@ -14,8 +16,8 @@ contact). With the node's force F_a = -Phi_a' >= 0 and stiffness S_a = Phi_a'':
 
 The second sum is each point's rotational, curvature and second-order parts at the force p_g, from the same kernels
 as a point of its own (their terms are linear in the law's force and slope: a law of slope E and unit force gives
-grad g_g and them per unit force plus E grad g_g (x) grad g_g, which is removed); the first couples every point of a node's facets, one block per
-active node over the nodes of those facets and of their points' masters.
+grad g_g and them per unit force plus E grad g_g (x) grad g_g, which is removed); the first couples every point of a
+node's facets, one block per active node over the nodes of those facets and of their points' masters.
 """
 
 from __future__ import annotations
@@ -28,13 +30,52 @@ from .kernels import contact_batch
 from .laws import is_active, linear_equivalents
 
 
-def node_weights(points, ids: np.ndarray, area: np.ndarray):
-    """(conn (m, nen) facet nodes, N (m, nen) shape values, w (m, nen) the weights w_ag) of slave points ``ids``."""
+def node_weights(points, ids: np.ndarray, area: np.ndarray, facet: np.ndarray | None = None):
+    """(conn (m, nen) facet nodes, N (m, nen) shape values, w (m, nen) the weights w_ag) of slave points ``ids``
+    (``facet``: each point's slave facet, for the dual weights)."""
     j = np.asarray(ids, dtype=np.int64) - points.offset
     nen = int(points.nen[j[0]])
     N = points.N[j, :nen]
+    conn = points.conn[j, :nen]
+    if facet is not None and nen in (3, 4, 9):
+        psi = dual_shapes(N, area, facet)
+        if psi is not None:
+            return conn, N, psi * area[:, None]
     phi = N if nen in (3, 4) else N * N / (N * N).sum(axis=1, keepdims=True)
-    return points.conn[j, :nen], N, phi * area[:, None]
+    return conn, N, phi * area[:, None]
+
+
+def dual_shapes(N: np.ndarray, w: np.ndarray, facet: np.ndarray) -> np.ndarray | None:
+    """The dual shape functions of each slave facet at its points, psi_a = sum_c (D M^-1)_ac N_c with
+    M_ab = sum_g N_a N_b w_g and D_ab = delta_ab sum_g N_a w_g over the facet's points, so that
+    sum_g psi_a N_b w_g = delta_ab D_a (biorthogonal under the facet's rule). None where a facet's M is singular (one
+    point per facet) or a D_a is not positive."""
+    nf = int(facet.max()) + 1
+    nen = N.shape[1]
+    M = np.zeros((nf, nen, nen))
+    np.add.at(M, facet, w[:, None, None] * N[:, :, None] * N[:, None, :])
+    D = np.zeros((nf, nen))
+    np.add.at(D, facet, w[:, None] * N)
+    if np.any(D <= 0.0):
+        return None
+    try:
+        A = D[:, :, None] * np.linalg.inv(M)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(A)) or np.linalg.cond(M).max() > 1e12:
+        return None
+    return np.einsum("gac,gc->ga", A[facet], N)
+
+
+def _static(p, points):
+    """The pass's weights and slave nodes (fixed by the reference configuration), worked out at its first evaluation."""
+    cached = getattr(p, "_nodal_static", None)
+    if cached is None:
+        conn, N, w = node_weights(points, p.slaves, p.area, p.slave_facet)
+        nodes, inv = np.unique(conn, return_inverse=True)
+        cached = (conn, N, w, nodes, inv.reshape(conn.shape))
+        p._nodal_static = cached
+    return cached
 
 
 def nodal_forces(p, points, g: np.ndarray, ok: np.ndarray):
@@ -43,10 +84,8 @@ def nodal_forces(p, points, g: np.ndarray, ok: np.ndarray):
     Returns (conn, N, c, nodes, inv, F, S, pg): each point's facet nodes and shape values, c (m, nen) the
     coefficients c_ag (zero where the point has no contact point), the slave nodes and each (point, node)'s index into
     them, per node the force F_a >= 0 and stiffness S_a (zero where inactive), and the point forces p_g."""
-    conn, N, w = node_weights(points, p.slaves, p.area)
+    conn, N, w, nodes, inv = _static(p, points)
     w = np.where(ok[:, None], w, 0.0)
-    nodes, inv = np.unique(conn, return_inverse=True)
-    inv = inv.reshape(conn.shape)
     A = np.bincount(inv.ravel(), w.ravel(), minlength=len(nodes))
     gz = np.where(ok, g, 0.0)
     has = A > 0.0
@@ -81,7 +120,7 @@ def main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
         return []
     q = ids.shape[1]
     nen = conn.shape[1]
-    k, b = np.nonzero((S[inv[pts]] > 0.0) & (c[pts] > 0.0))  # (point, node of its facet) with an active node
+    k, b = np.nonzero((S[inv[pts]] > 0.0) & (c[pts] != 0.0))  # (point, node of its facet) with an active node
     if not k.size:
         return []
     g = pts[k]
@@ -116,7 +155,7 @@ def mesh_pass(mgr, p, xe, res, case, t, want_K, want_parts, ev) -> None:
     """A nodal-gap pass against a meshed master (the projection ``res`` of every point done)."""
     ok = res.kind != 0
     conn, N, c, nodes, inv, F, S, pg = nodal_forces(p, mgr.points, res.g, ok)
-    pts = np.flatnonzero(ok & ((S[inv] > 0.0) & (c > 0.0)).any(axis=1))  # the points of the active nodes
+    pts = np.flatnonzero(ok & ((S[inv] > 0.0) & (c != 0.0)).any(axis=1))  # the points of the active nodes
     if not pts.size:
         return
     nen = p.surface.nen
@@ -174,7 +213,7 @@ def analytic_pass(mgr, p, xe, lam, case_name: str, t, want_K, want_parts, ev) ->
     ok = np.isfinite(probe.gap)
     conn, N, c, nodes, inv, F, S, pg = nodal_forces(p, mgr.points, probe.gap, ok)
     t.force = np.zeros((p.ns, 3))
-    pts = np.flatnonzero(ok & ((S[inv] > 0.0) & (c > 0.0)).any(axis=1))  # the points of the active nodes
+    pts = np.flatnonzero(ok & ((S[inv] > 0.0) & (c != 0.0)).any(axis=1))  # the points of the active nodes
     if not pts.size:
         return
     E, mult = _unit(probe.gap[pts], p.area[pts])

@@ -210,14 +210,13 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
 
 def _gap(c: Section, ctype: str, law: str, method: str, mu: float, surfaces) -> str:
     """``gap``: segment-to-surface's law on each Gauss point's gap ("points") or on each slave node's weighted gap
-    ("nodal"; frictionless penalty pairs, smoothed or not, against another surface)."""
+    ("nodal"; frictionless penalty pairs, smoothed or not)."""
     gap = c.get("gap", "str", "points", choices=("points", "nodal"))
     if gap == "nodal":
         why = ("it is for type = \"sts\"" if ctype != "sts" else
                f"not with law = \"{law}\" (penalty only)" if law != "penalty" else
                "not with method = \"augmented\"" if method != "penalty" else
-               "not with friction (frictionless pairs)" if mu > 0.0 else
-               "not for self-contact" if surfaces is not None else None)
+               "not with friction (frictionless pairs)" if mu > 0.0 else None)
         if why:
             c.fail(f"gap = \"nodal\": {why}", "gap")
     return gap
