@@ -31,6 +31,7 @@ VARIANTS = {
                  'eps0 = 0.01, n = 0.22 } }', 'material = { model = "neo-hooke", E = 210000.0, nu = 0.3 }'),
                 ("thickness_points = 5", "thickness_points = 2")],
     "smoothing": [("friction = 0.1", "friction = 0.1\nsmoothing = 0.05")],
+    "tangent-predictor": [("line_search = true", "line_search = true\npredictor = \"tangent\"")],
 }
 
 
