@@ -137,17 +137,14 @@ def main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
     a_u, id_u = a_all[key], id_all[key]
     v_u = np.add.reduceat(v_all, key, axis=0)
     starts = np.flatnonzero(np.r_[True, np.diff(a_u) != 0])
-    ends = np.r_[starts[1:], len(a_u)]
-    by_size: dict[int, list] = {}
-    for s0, s1 in zip(starts, ends):
-        by_size.setdefault(s1 - s0, []).append((a_u[s0], id_u[s0:s1], v_u[s0:s1].ravel()))
+    sizes = np.diff(np.r_[starts, len(a_u)])
     out = []
-    for n, group in by_size.items():
-        conn_b = np.array([ids_a for _, ids_a, _ in group], dtype=np.int64)
-        V = np.array([v for _, _, v in group])
-        Sa = np.array([S[a] for a, _, _ in group])
-        K = Sa[:, None, None] * V[:, :, None] * V[:, None, :]
-        out.append((conn_b, np.zeros((len(group), 3 * n)), K))
+    for n in np.unique(sizes):  # the nodes whose blocks have n entries, at once
+        first = starts[sizes == n]
+        idx = first[:, None] + np.arange(n)
+        V = v_u[idx].reshape(len(first), 3 * n)
+        K = S[a_u[first]][:, None, None] * V[:, :, None] * V[:, None, :]
+        out.append((id_u[idx], np.zeros((len(first), 3 * n)), K))
     return out
 
 
