@@ -3,7 +3,8 @@
 were given up and retried or cut back), iterations per increment, cutbacks, wall time.
 
 Variants: as written (line search on, friction 0.1), without the line search, without friction, an elastic strip
-(Neo-Hooke, frictionless), and with the pairs' contact smoothing of 0.05 mm (docs/input.md, "Smoothed contact").
+(Neo-Hooke, frictionless), with the pairs' contact smoothing of 0.05 mm (docs/input.md, "Smoothed contact"), and with
+the tangent predictor instead of the extrapolated start.
 
     python benchmarks/forming.py [--variants as-written,no-line-search] [--out forming.json]
 """
