@@ -202,32 +202,40 @@ def mesh_pass(mgr, p, xe, res, case, t, want_K, want_parts, ev) -> None:
             ev.parts[0].add(conn_b, Rb, Kb)
 
 
+#: the force of the one evaluation of an analytic pass's points (a law of unit slope per sqrt(area) and this
+#: multiplier: every point within 1e6 sqrt(area) of the surface is active with a positive force)
+_FAR = 1.0e6
+
+
 def analytic_pass(mgr, p, xe, lam, case_name: str, t, want_K, want_parts, ev) -> None:
-    """A nodal-gap pass against an analytic rigid surface (fixed or moved, not a force-controlled tool)."""
+    """A nodal-gap pass against an analytic rigid surface (fixed or moved, not a force-controlled tool). One evaluation
+    of every point gives its gap and, at the force f0 = _FAR - E g of a law every nearby point is active under, its
+    gradient and its other parts per unit force (all linear in the force)."""
     xs = np.ascontiguousarray(xe[p.slaves])
-    probe = p.analytic.evaluate(xs, p.eps, parts="d", lam=lam)
-    t.gap, t.xi = probe.gap, probe.xi
-    ok = np.isfinite(probe.gap)
-    conn, N, c, nodes, inv, F, S, pg = nodal_forces(p, mgr.points, probe.gap, ok)
+    E_all = 1.0 / np.sqrt(p.area)
+
+    def evaluate(name):
+        return p.analytic.evaluate(xs, E_all, parts=name, lam=lam, multiplier=-_FAR)
+
+    out = evaluate(case_name)
+    g = out.gap
+    t.gap, t.xi = g, out.xi
+    ok = np.isfinite(g)
+    conn, N, c, nodes, inv, F, S, pg = nodal_forces(p, mgr.points, g, ok)
     t.force = np.zeros((p.ns, 3))
-    pts = np.flatnonzero(ok & ((S[inv] > 0.0) & (c != 0.0)).any(axis=1))  # the points of the active nodes
+    f0 = _FAR - E_all * np.where(ok, g, 0.0)
+    pts = np.flatnonzero(ok & (f0 > 0.0) & ((S[inv] > 0.0) & (c != 0.0)).any(axis=1))  # the points of the active nodes
     if not pts.size:
         return
-    E, mult = _unit(probe.gap[pts], p.area[pts])
-    f = pg[pts]
-
-    def tangent(name):  # a part at the points' forces
-        return f[:, None, None] * p.analytic.evaluate(xs[pts], E, parts=name, lam=lam, multiplier=mult).tangent
-
-    out = p.analytic.evaluate(xs[pts], E, parts=case_name, lam=lam, multiplier=mult)
-    grads = -out.residual
-    R = f[:, None] * out.residual
-    K = f[:, None, None] * (out.tangent - E[:, None, None] * grads[:, :, None] * grads[:, None, :])
+    E, scale = E_all[pts], pg[pts] / f0[pts]
+    grads = -out.residual[pts] / f0[pts][:, None]
+    R = -pg[pts][:, None] * grads
+    K = scale[:, None, None] * (out.tangent[pts] - E[:, None, None] * grads[:, :, None] * grads[:, None, :])
     ids = p.slaves[pts][:, None]
     t.force[pts] = -R
     ev.blocks.add(ids, R, K if want_K else None)
     if want_parts:
-        d, cc, ex = (tangent(name) for name in ("d", "c", "exact"))
+        d, cc, ex = (scale[:, None, None] * evaluate(name).tangent[pts] for name in ("d", "c", "exact"))
         zero = np.zeros_like(R)
         ev.parts[2].add(ids, zero, cc - d)
         ev.parts[3].add(ids, zero, ex - cc)
