@@ -22,6 +22,34 @@ _STEPS = "\n[steps]\ncount = 2\n\n[output]\nevery = 1\n"
 
 _HEAD = '[problem]\nname = "{name}"\n\n'
 
+#: two hex8 bodies pressed and dragged: a punch on a base, a frictional pair with the exact tangent
+_TWO_HEX8 = """
+[[bodies]]
+name = "base"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-1.0, -1.0, -0.5] }
+[[bodies]]
+name = "punch"
+element = "hex8"
+material = { model = "svk", E = 1000.0, nu = 0.3 }
+mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
+[[contact]]
+slave = "punch.zmin"
+master = "base.zmax"
+penalty = 1.0e6
+weighting = "area"
+friction = 0.2
+tangent = "exact"
+[[dirichlet]]
+set = "base.zmin"
+components = "xyz"
+[[dirichlet]]
+set = "punch.zmax"
+components = "xyz"
+value = [0.01, 0.0, -0.02]
+"""
+
 #: (label, problem text): tiny problems, two load steps each, VTU output on.
 PROBLEMS: tuple[tuple[str, str], ...] = (
     ("hex8 on a plane with friction", """
@@ -89,32 +117,7 @@ set = "block.zmax"
 components = "xyz"
 value = [0.02, 0.0, -0.01]
 """),
-    ("two hex8 bodies, quad4 facets, friction", """
-[[bodies]]
-name = "base"
-element = "hex8"
-material = { model = "svk", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-1.0, -1.0, -0.5] }
-[[bodies]]
-name = "punch"
-element = "hex8"
-material = { model = "svk", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 3, ny = 3, nz = 1, origin = [-0.5, -0.5, 0.0] }
-[[contact]]
-slave = "punch.zmin"
-master = "base.zmax"
-penalty = 1.0e6
-weighting = "area"
-friction = 0.2
-tangent = "exact"
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.01, 0.0, -0.02]
-"""),
+    ("two hex8 bodies, quad4 facets, friction", _TWO_HEX8),
     ("rigid meshed ball into a hex27 plate, quad9 facets", """
 [[bodies]]
 name = "plate"
@@ -275,30 +278,8 @@ set = "up.ymax"
 components = "xy"
 value = [0.01, -0.01]
 """),
-    ("two hex8 bodies, segment-to-surface", """
-[[bodies]]
-name = "base"
-element = "hex8"
-material = { model = "svk", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 2.0, ly = 2.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-1.0, -1.0, -0.5] }
-[[bodies]]
-name = "punch"
-element = "hex8"
-material = { model = "svk", E = 1000.0, nu = 0.3 }
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 0.5, nx = 2, ny = 2, nz = 1, origin = [-0.5, -0.5, 0.0] }
-[[contact]]
-type = "sts"
-slave = "punch.zmin"
-master = "base.zmax"
-penalty = 1.0e6
-[[dirichlet]]
-set = "base.zmin"
-components = "xyz"
-[[dirichlet]]
-set = "punch.zmax"
-components = "xyz"
-value = [0.0, 0.0, -0.01]
-"""),
+    ("two hex8 bodies, segment-to-surface", _TWO_HEX8.replace('weighting = "area"\nfriction = 0.2\ntangent = "exact"',
+                                                                'type = "sts"')),
 )
 
 #: groups of warm-up problems that share their costly kernels (indices into PROBLEMS) with the seconds each group
