@@ -232,3 +232,30 @@ count = 2
     fb = b.summary["steps"][-1]["pairs"]["contact1"]["contact_force"]
     np.testing.assert_allclose(fb, fa, rtol=1e-9, atol=1e-12)
     assert abs(fa[2]) > 0.0
+
+
+def test_nodal_gaps_refused_where_they_cannot_run(tmp_path):
+    """gap = "nodal" against an analytic tool with a reference node, and in a run of several MPI ranks: one line each
+    (InputError, exit 2), before anything starts."""
+    from covcontact.solvers.choice import check_distributable
+
+    text = two_blocks(extra='type = "sts"\ngap = "nodal"')
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    with pytest.raises(InputError) as err:
+        check_distributable(load_problem(path), "petsc", 2)
+    assert "gap = \"nodal\" runs in one process" in str(err.value) and "\n" not in str(err.value)
+    check_distributable(load_problem(path), "pardiso", 1)  # one process: accepted
+    tool = text.replace('slave = "punch.zmin"\nmaster = "base.zmax"', 'slave = "punch.zmin"\nmaster = "ram"') + """
+[[rigid]]
+name = "ram"
+shape = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+free = ["z"]
+force = [0.0, 0.0, 1.0]
+"""
+    path.write_text(tool)
+    with pytest.raises(InputError) as err:
+        load_problem(path)
+    assert "contact[0].gap: gap = \"nodal\": not against 'ram'" in str(err.value) and "\n" not in str(err.value)

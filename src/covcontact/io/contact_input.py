@@ -194,7 +194,7 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
         enabled = c.get("enabled", "bool", True)
         smoothing = c.get("smoothing", "float", 0.0, nonnegative=True)
         adjust = _adjust(c, sets, slave, master, law, surfaces, rigid)
-        gap = _gap(c, ctype, law, method, mu, surfaces)
+        gap = _gap(c, ctype, law, method, mu, rigid, master)
         c.done()
         if any(x.name == cname for x in contacts):
             c.fail(f"duplicate contact name {cname!r}", "name")
@@ -208,15 +208,18 @@ def read_contacts(top: Section, sets: SetRefs, rigid: list) -> list[ContactPair]
     return contacts
 
 
-def _gap(c: Section, ctype: str, law: str, method: str, mu: float, surfaces) -> str:
+def _gap(c: Section, ctype: str, law: str, method: str, mu: float, rigid: list, master) -> str:
     """``gap``: segment-to-surface's law on each Gauss point's gap ("points") or on each slave node's weighted gap
-    ("nodal"; frictionless penalty pairs, smoothed or not)."""
+    ("nodal"; frictionless penalty pairs, smoothed or not, not against an analytic tool with a reference node)."""
     gap = c.get("gap", "str", "points", choices=("points", "nodal"))
     if gap == "nodal":
+        tool = next((r for r in rigid if r.name == master[0] and r.mesh is None and (r.free or r.attach)), None)
         why = ("it is for type = \"sts\"" if ctype != "sts" else
                f"not with law = \"{law}\" (penalty only)" if law != "penalty" else
                "not with method = \"augmented\"" if method != "penalty" else
-               "not with friction (frictionless pairs)" if mu > 0.0 else None)
+               "not with friction (frictionless pairs)" if mu > 0.0 else
+               f"not against {tool.name!r}, an analytic surface with free components or attached nodes (a reference "
+               f"node): mesh the tool, or use gap = \"points\"" if tool is not None else None)
         if why:
             c.fail(f"gap = \"nodal\": {why}", "gap")
     return gap

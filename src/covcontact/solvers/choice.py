@@ -153,6 +153,10 @@ def check_distributable(problem, linear: str, ranks: int) -> None:
     if distributes(linear) and (getattr(problem, "equations", None) or getattr(problem, "mpcs", None)):
         raise InputError(f"{where}: multi-point constraints ([[equation]], [[mpc]]) are not available with the distributed "
                          f"solver {linear!r} yet; use a serial solver (--solver pardiso or superlu)")
+    nodal = [c.name for c in problem.contacts if getattr(c, "gap", "points") == "nodal"]
+    if ranks > 1 and nodal:
+        raise InputError(f"{where}: contact {nodal[0]!r}: gap = \"nodal\" runs in one process (a node's weighted gap "
+                         f"takes the points of all its facets); leave out --ranks or use --ranks 1")
     if distributes(linear) and (getattr(problem, "springs", None) or getattr(problem, "dashpots", None)):
         raise InputError(f"{where}: springs and dashpots ([[spring]], [[dashpot]]) are not available with the "
                          f"distributed solver {linear!r} yet; use a serial solver (--solver pardiso or superlu)")
