@@ -35,6 +35,7 @@ class Summary(Observer):
                      "dofs": model.n_dofs, "free_dofs": int(model.free.sum()), "linear_solver": newton.linear.name,
                      **({"units": problem.units} if problem.units else {}),
                      "total_iterations": 0, "wall_time_s": 0.0, "steps": []}
+        self._steps = []
         if run.partition is not None:
             self.data["parallel"] = run.partition
 
