@@ -113,6 +113,10 @@ def _unit(g: np.ndarray, area: np.ndarray):
     return E, -1.0 - E * g
 
 
+#: entries of a node's gradient below this fraction of its largest are round-off of cancelling terms (main_blocks)
+ROUND_OFF = 1e-12
+
+
 def main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
     """The blocks S_a grad g~_a (x) grad g~_a of the active nodes: ``pts`` the points with a force, ``ids`` (k, q) the
     ids their gradient ``grads`` (k, 3 q) acts on (the point's own id last), each expanded onto its facet's nodes."""
@@ -136,6 +140,13 @@ def main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
     key = np.flatnonzero(np.r_[True, (np.diff(a_all) != 0) | (np.diff(id_all) != 0)])
     a_u, id_u = a_all[key], id_all[key]
     v_u = np.add.reduceat(v_all, key, axis=0)
+    # entries that cancel to round-off dropped: the dual weights make a node's slave entries delta_ab (against a flat
+    # master grad g~_a is the node's own normal alone, the others sum to 1e-16 of it)
+    size = np.abs(v_u).max(axis=1)
+    first = np.flatnonzero(np.r_[True, np.diff(a_u) != 0])
+    peak = np.maximum.reduceat(size, first)[np.cumsum(np.r_[True, np.diff(a_u) != 0]) - 1]
+    keep = size > ROUND_OFF * peak
+    a_u, id_u, v_u = a_u[keep], id_u[keep], v_u[keep]
     starts = np.flatnonzero(np.r_[True, np.diff(a_u) != 0])
     sizes = np.diff(np.r_[starts, len(a_u)])
     out = []
