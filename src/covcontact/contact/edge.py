@@ -29,6 +29,21 @@ def free_direction(xi: np.ndarray) -> int:
     return 0 if abs(abs(xi[1]) - 1.0) <= abs(abs(xi[0]) - 1.0) else 1
 
 
+def edge_vertex_batch(xe: np.ndarray, conn: np.ndarray, xi: np.ndarray, g: np.ndarray, vertex: np.ndarray,
+                      eps: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`edge_vertex_contact` of m points: ``conn`` (m, nen + 1) their facets' nodes then the slave, ``xi`` (m, 2)
+    their contact points, ``g`` their projections' signed gaps (the side), ``vertex`` (m,) vertex points, ``eps`` and
+    ``lam`` (m,) their laws. Returns residuals (m, 3 (nen + 1)), tangents and signed gaps."""
+    m, n1 = conn.shape
+    R = np.zeros((m, 3 * n1))
+    K = np.zeros((m, 3 * n1, 3 * n1))
+    gap = np.zeros(m)
+    for j in range(m):
+        R[j], K[j], gap[j] = edge_vertex_contact(xe[conn[j, :-1]], xi[j], xe[conn[j, -1]], 1.0 if g[j] >= 0.0 else -1.0,
+                                                 float(eps[j]), float(lam[j]), vertex=bool(vertex[j]))
+    return R, K, gap
+
+
 def edge_vertex_contact(xyz: np.ndarray, xi: np.ndarray, xs: np.ndarray, sign: float, eps: float,
                         lam: float = 0.0, vertex: bool = False) -> tuple[np.ndarray, np.ndarray, float]:
     """Residual (3 (nen + 1),), tangent and signed gap of one edge or vertex contact point.

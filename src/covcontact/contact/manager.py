@@ -18,7 +18,7 @@ import numpy as np
 from . import nodal_gap, report
 from .assembly import ElementBlocks
 from .driver import EDGE, FACET, VERTEX, project_slaves
-from .edge import edge_vertex_contact
+from .edge import edge_vertex_batch
 from .edgelock import FREE, RELEASED, edge_point, inconsistent, new_locks
 from .element import CASE_A, CASES
 from .friction import HIST_SIZE, analytic_friction_batch, friction_batch, start_history, transfer_history
@@ -273,12 +273,9 @@ class ContactManager:
         idx = np.flatnonzero(active & ((res.kind == EDGE) | (res.kind == VERTEX)))
         if idx.size:
             conn = np.hstack([p.surface.faces[res.facet[idx]], p.slaves[idx][:, None]])
-            R = np.zeros((idx.size, nd))
-            K = np.zeros((idx.size, nd, nd))
-            for j, s in enumerate(idx):
-                R[j], K[j], t.gap[s] = edge_vertex_contact(
-                    xe[conn[j, :nen]], res.xi[s], xe[p.slaves[s]], 1.0 if res.g[s] >= 0.0 else -1.0,
-                    float(eps_s[s]), float(lam_s[s]), vertex=bool(res.kind[s] == VERTEX))
+            R, K, t.gap[idx] = edge_vertex_batch(xe, conn, res.xi[idx], res.g[idx], res.kind[idx] == VERTEX,
+                                                 np.broadcast_to(eps_s, (p.ns,))[idx],
+                                                 np.broadcast_to(lam_s, (p.ns,))[idx])
             t.force[idx] = -R[:, -3:]
             self._add(ev.blocks, conn, R, K if want_K else None, xe)
             if want_parts:

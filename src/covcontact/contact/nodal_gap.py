@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .driver import EDGE, FACET, VERTEX
-from .edge import edge_vertex_contact
+from .driver import FACET, VERTEX
+from .edge import edge_vertex_batch
 from .kernels import contact_batch
 from .laws import is_active, linear_equivalents
 
@@ -81,9 +81,9 @@ def _static(p, points):
 def nodal_forces(p, points, g: np.ndarray, ok: np.ndarray):
     """The nodal law of pass ``p`` at the points' gaps ``g`` (``ok``: the points with a contact point).
 
-    Returns (conn, N, c, nodes, inv, F, S, pg): each point's facet nodes and shape values, c (m, nen) the
-    coefficients c_ag (zero where the point has no contact point), the slave nodes and each (point, node)'s index into
-    them, per node the force F_a >= 0 and stiffness S_a (zero where inactive), and the point forces p_g."""
+    Returns (conn, N, c, inv, S, pg): each point's facet nodes and shape values, c (m, nen) the coefficients c_ag
+    (zero where the point has no contact point), each (point, node)'s index among the slave nodes, per node the
+    stiffness S_a (zero where inactive), and the point forces p_g = sum_a c_ag F_a."""
     conn, N, w, nodes, inv = _static(p, points)
     w = np.where(ok[:, None], w, 0.0)
     A = np.bincount(inv.ravel(), w.ravel(), minlength=len(nodes))
@@ -102,7 +102,7 @@ def nodal_forces(p, points, g: np.ndarray, ok: np.ndarray):
         S[act] = e_s
     c = w / A_safe[inv]
     pg = (c * F[inv]).sum(axis=1)
-    return conn, N, c, nodes, inv, F, S, pg
+    return conn, N, c, inv, S, pg
 
 
 def _unit(g: np.ndarray, area: np.ndarray):
@@ -117,7 +117,7 @@ def _unit(g: np.ndarray, area: np.ndarray):
 ROUND_OFF = 1e-12
 
 
-def main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
+def main_blocks(inv, c, S, conn, N, pts, ids, grads):
     """The blocks S_a grad g~_a (x) grad g~_a of the active nodes: ``pts`` the points with a force, ``ids`` (k, q) the
     ids their gradient ``grads`` (k, 3 q) acts on (the point's own id last), each expanded onto its facet's nodes."""
     if not len(pts):
@@ -162,7 +162,7 @@ def main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
 def mesh_pass(mgr, p, xe, res, case, t, want_K, want_parts, ev) -> None:
     """A nodal-gap pass against a meshed master (the projection ``res`` of every point done)."""
     ok = res.kind != 0
-    conn, N, c, nodes, inv, F, S, pg = nodal_forces(p, mgr.points, res.g, ok)
+    conn, N, c, inv, S, pg = nodal_forces(p, mgr.points, res.g, ok)
     pts = np.flatnonzero(ok & ((S[inv] > 0.0) & (c != 0.0)).any(axis=1))  # the points of the active nodes
     if not pts.size:
         return
@@ -187,18 +187,16 @@ def mesh_pass(mgr, p, xe, res, case, t, want_K, want_parts, ev) -> None:
         R[fi], K[fi], g[fi] = Rf, Kf, gf
         if want_parts:
             P[fi] = Pf
-    for j in np.flatnonzero(~facet):  # edge and vertex points (their kernel has no parts: all in the main one)
-        s = pts[j]
-        kind = res.kind[s]
-        R[j], K[j], g[j] = edge_vertex_contact(xe[ids[j, :nen]], res.xi[s], xe[p.slaves[s]],
-                                               1.0 if res.g[s] >= 0.0 else -1.0, float(E[j]), float(lam[j]),
-                                               vertex=bool(kind == VERTEX))
-        assert kind in (EDGE, VERTEX)
+    ej = np.flatnonzero(~facet)  # edge and vertex points (their kernel has no parts: all in the main one)
+    if ej.size:
+        R[ej], K[ej], g[ej] = edge_vertex_batch(xe, ids[ej], res.xi[pts[ej]], res.g[pts[ej]],
+                                                res.kind[pts[ej]] == VERTEX, E[ej], lam[ej])
     grads = -R
     f = pg[pts]
     K = f[:, None, None] * (K - E[:, None, None] * grads[:, :, None] * grads[:, None, :])
     R = f[:, None] * R
-    P *= f[:, None, None, None] if want_parts else 1.0
+    if want_parts:
+        P *= f[:, None, None, None]
     t.gap[pts] = g
     t.force[pts] = -R[:, -3:]
     mgr._add(ev.blocks, ids, R, K if want_K else None, xe)
@@ -207,7 +205,7 @@ def mesh_pass(mgr, p, xe, res, case, t, want_K, want_parts, ev) -> None:
         for j in range(1, 4):
             ev.parts[j].add(ids[fi], zero[fi], P[fi, j])
         ev.parts[0].add(ids[~facet], zero[~facet], K[~facet])
-    for conn_b, Rb, Kb in main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
+    for conn_b, Rb, Kb in main_blocks(inv, c, S, conn, N, pts, ids, grads):
         mgr._add(ev.blocks, conn_b, Rb, Kb if want_K else None, xe)
         if want_parts:
             ev.parts[0].add(conn_b, Rb, Kb)
@@ -232,7 +230,7 @@ def analytic_pass(mgr, p, xe, lam, case_name: str, t, want_K, want_parts, ev) ->
     g = out.gap
     t.gap, t.xi = g, out.xi
     ok = np.isfinite(g)
-    conn, N, c, nodes, inv, F, S, pg = nodal_forces(p, mgr.points, g, ok)
+    conn, N, c, inv, S, pg = nodal_forces(p, mgr.points, g, ok)
     t.force = np.zeros((p.ns, 3))
     f0 = _FAR - E_all * np.where(ok, g, 0.0)
     pts = np.flatnonzero(ok & (f0 > 0.0) & ((S[inv] > 0.0) & (c != 0.0)).any(axis=1))  # the points of the active nodes
@@ -250,7 +248,7 @@ def analytic_pass(mgr, p, xe, lam, case_name: str, t, want_K, want_parts, ev) ->
         zero = np.zeros_like(R)
         ev.parts[2].add(ids, zero, cc - d)
         ev.parts[3].add(ids, zero, ex - cc)
-    for conn_b, Rb, Kb in main_blocks(p, nodes, inv, c, S, conn, N, pts, ids, grads):
+    for conn_b, Rb, Kb in main_blocks(inv, c, S, conn, N, pts, ids, grads):
         ev.blocks.add(conn_b, Rb, Kb if want_K else None)
         if want_parts:
             ev.parts[0].add(conn_b, Rb, Kb)
