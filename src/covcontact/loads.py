@@ -90,12 +90,14 @@ class NodalForce:
 
 @dataclass
 class Pressure:
-    """Dead pressure ``lam * value`` on a face set (positive pushes against the outward normal)."""
+    """Pressure ``lam * value`` on a face set (positive pushes against the outward normal): dead (on the reference
+    faces, nodal forces fixed) or, with ``follower``, on the current faces (``covcontact.elements.follower``)."""
 
     body: str
     set: str
     value: float
     name: str = ""
+    follower: bool = False
 
 
 @dataclass

@@ -91,18 +91,22 @@ def _sets(nodes, **where) -> str:
 
 # -- a CPE4 block under a pressure on its right edge -------------------------------------------------------------------
 def _svk_plane_strain(p: float) -> tuple[float, float]:
-    """Stretches (l1, l2) of a St. Venant-Kirchhoff block in plane strain under a dead pressure p on x = L (first
-    Piola-Kirchhoff P11 = -p, P22 = 0): S11 = -p / l1, S22 = 0 with S = lam tr(E) I + 2 mu E, E33 = 0."""
+    """Stretches (l1, l2) of a St. Venant-Kirchhoff block in plane strain under a pressure p on the current edge
+    x = L (a deck's pressure with NLGEOM follows the edge: Cauchy sigma11 = -p, sigma22 = 0, so S11 = -p l2 / l1,
+    S22 = 0 with S = lam tr(E) I + 2 mu E, E33 = 0)."""
     lam, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
 
-    def resid(l1):
+    def stretches(l1):
         e11 = 0.5 * (l1 ** 2 - 1)
         e22 = -lam * e11 / (lam + 2 * mu)   # (S22 = 0)
-        return lam * (e11 + e22) + 2 * mu * e11 + p / l1
+        return e11, e22, np.sqrt(1 + 2 * e22)
+
+    def resid(l1):
+        e11, e22, l2 = stretches(l1)
+        return lam * (e11 + e22) + 2 * mu * e11 + p * l2 / l1
 
     l1 = brentq(resid, 0.5, 1.5, xtol=1e-15)
-    e11 = 0.5 * (l1 ** 2 - 1)
-    return l1, np.sqrt(1 + 2 * (-lam * e11 / (lam + 2 * mu)))
+    return l1, stretches(l1)[2]
 
 
 def _cpe4_deck(tmp_path: Path, p: float = 100.0, t: float = 0.5) -> Path:
@@ -115,10 +119,10 @@ def _cpe4_deck(tmp_path: Path, p: float = 100.0, t: float = 0.5) -> Path:
 
 
 def test_cpe4_block_under_pressure_is_the_closed_form(tmp_path):
-    """CPE4, thickness 0.5 on *SOLID SECTION, P2 on the right edge: the uniform stretch of the plane strain block
-    (St. Venant-Kirchhoff under the dead pressure, to the .dat's 7 digits; the small-strain closed form u_x = -(1 - nu^2) p x / E,
-    u_y = nu (1 + nu) p y / E within 1e-3 of the largest, the
-    geometric nonlinearity); RF of the left edge p L_y t in total (the thickness's)."""
+    """CPE4, thickness 0.5 on *SOLID SECTION, P2 on the right edge (NLGEOM: on the current edge): the uniform
+    stretch of the plane strain block (St. Venant-Kirchhoff, Cauchy stress -p, to the .dat's 7 digits; the
+    small-strain closed form u_x = -(1 - nu^2) p x / E, u_y = nu (1 + nu) p y / E within 1e-3 of the largest, the
+    geometric nonlinearity); RF of the left edge p l2 L_y t in total (the current height's)."""
     p, t = 100.0, 0.5
     dat = _run(_cpe4_deck(tmp_path, p, t), tmp_path)
     U, RF = _last(dat, "displacements"), _last(dat, "forces")
@@ -128,7 +132,7 @@ def test_cpe4_block_under_pressure_is_the_closed_form(tmp_path):
         assert U[lab][:2] == pytest.approx([-(1 - NU ** 2) * p * x / E, NU * (1 + NU) * p * y / E],
                                            abs=1e-3 * p / E * 2)
         assert U[lab][2] == 0.0
-    assert RF[1][0] + RF[4][0] == pytest.approx(p * 1.0 * t, rel=1e-6)
+    assert RF[1][0] + RF[4][0] == pytest.approx(p * l2 * 1.0 * t, rel=1e-6)
     assert _last(dat, "total")[0][0] == pytest.approx(0.0, abs=1e-8)   # (all nodes: the loads balance)
 
 
@@ -151,9 +155,9 @@ def test_cpe4_deck_imports_as_a_plane_strain_body(tmp_path):
 
 # -- CPS8R: a plane stress plate ----------------------------------------------------------------------------------------
 def test_cps8r_plate_under_pressure_is_uniaxial_stress(tmp_path):
-    """CPS8R (quad8, reduced integration), thickness 0.2: uniaxial St. Venant-Kirchhoff stress under the dead
-    pressure (S11 = E E11 = -p / l1, E22 = -nu E11), to the .dat's 7 digits; RF p L_y t; the import says plane_stress,
-    reduced integration."""
+    """CPS8R (quad8, reduced integration), thickness 0.2: uniaxial St. Venant-Kirchhoff stress under the pressure
+    on the current edge (NLGEOM; its reference thickness: S11 = E E11 = -p l2 / l1, E22 = -nu E11), to the .dat's 7
+    digits; RF p l2 L_y t; the import says plane_stress, reduced integration, and notes the thickness."""
     p, t = 150.0, 0.2
     nodes, els = _grid(2, 2, 2.0, 1.0, quadratic=True)
     body = _sets(nodes, LEFT=lambda x, y: x == 0.0, BOTTOM=lambda x, y: y == 0.0)
@@ -162,14 +166,15 @@ def test_cps8r_plate_under_pressure_is_uniaxial_stress(tmp_path):
     deck.write_text(_deck("CPS8R", nodes, els, f"{t}\n", body, f"*DLOAD\nRIGHT, P2, {p}\n"))
     dat = _run(deck, tmp_path)
     U, RF = _last(dat, "displacements"), _last(dat, "forces")
-    l1 = brentq(lambda l: E * 0.5 * (l * l - 1) + p / l, 0.5, 1.5, xtol=1e-15)
+    l1 = brentq(lambda l: E * 0.5 * (l * l - 1) + p * np.sqrt(1 - NU * (l * l - 1)) / l, 0.5, 1.5, xtol=1e-15)
     l2 = np.sqrt(1 - NU * (l1 * l1 - 1))
     for n, x, y in nodes:
         assert U[n][:2] == pytest.approx([(l1 - 1) * x, (l2 - 1) * y], abs=1e-9)
     left = [n for n, x, y in nodes if x == 0.0]
-    assert sum(RF[n][0] for n in left) == pytest.approx(p * 1.0 * t, rel=1e-6)
+    assert sum(RF[n][0] for n in left) == pytest.approx(p * l2 * 1.0 * t, rel=1e-6)
     out = tmp_path / "imp" / "cps8r.toml"
-    assert _cli("import", deck, "--out", out).returncode == 0
+    proc = _cli("import", deck, "--out", out)
+    assert proc.returncode == 0 and "follows the plane stress edges on their reference thickness" in proc.stderr
     (b,) = tomllib.loads(out.read_text())["bodies"]
     assert (b["formulation"], b["thickness"], b["options"]) == ("plane_stress", 0.2, {"integration": "reduced"})
 

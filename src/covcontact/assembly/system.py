@@ -302,9 +302,11 @@ class System:
         return (weight[:, None] * value[None, :]).ravel()
 
     def _build_loads(self) -> None:
+        """f_ext: the dead loads at their own values (follower pressures act on the current faces: the Model's)."""
         f = np.zeros(self.n_dofs)
         for load in self.loads:
-            f += self.load_vector(load)
+            if not getattr(load, "follower", False):
+                f += self.load_vector(load)
         self.f_ext = f
 
     # -- Dirichlet ------------------------------------------------------------------------------

@@ -97,8 +97,9 @@ def read_loads(top: Section, sets: SetRefs) -> tuple[list, list, list]:
         sets.deformable(p, "set", bname)
         value = p.get("value", "float")
         pname = p.get("name", "str", "")
+        follower = p.get("follower", "bool", False)
         p.done()
-        pressures.append(Pressure(bname, sname, value, pname))
+        pressures.append(Pressure(bname, sname, value, pname, follower))
 
     tractions = []
     for t in top.get("traction", "array", []):

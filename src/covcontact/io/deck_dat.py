@@ -382,7 +382,7 @@ class _Now:
         if self._forces is None:
             model, run, lam = self.model, self.run, self.inc.lam
             R, _, _ = model.evaluate(run.u, lam, run.state, want_K=False, raw=True)
-            forces = (R + model.external(lam)).reshape(-1, 3)
+            forces = (R + model.applied(run.u, lam)).reshape(-1, 3)
             refs = {ref.name: ref for ref in model.system.reference}
             rigid = self.info.get("rigid", {})
             if any(lab is not None for labels in rigid.values() for lab in labels):  # (the constraints hand R over)

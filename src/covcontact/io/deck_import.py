@@ -22,7 +22,7 @@ from .deck_mesh import Parts, body_content, body_meshio, body_text, surface_refs
 from .deck_mesh import safe_name as _name
 from .deck_toml import _table
 from .deck_contacts import ContactMapping
-from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Load, read_model
+from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Load, nlgeom_steps, read_model
 from .deck_coupling import DeckCouplings
 from .deck_planar import contact_print_labels, element_names, is_planar_type, planar_body, planar_dof3
 from .deck_rigid import DeckRigid
@@ -65,6 +65,7 @@ class _Writer(ContactMapping):
         self.m, self.deck, self.out, self.dialect = m, deck, out, dialect
         self.unsupported = list(m.unsupported)
         self.notes: list[str] = list(m.notes)
+        self.body_forms: dict[int, str] = {}  # body index -> its formulation ("solid" for volume elements)
         if not m.blocks and not m.shell_blocks:  # (the types it has, at their *ELEMENT lines: the first is said)
             first = m.skipped_blocks[0][1] if m.skipped_blocks else str(deck)
             found = f"the deck's elements are {m.element_types()}" if m.skipped_blocks else "the deck has no *ELEMENT"
@@ -216,6 +217,7 @@ class _Writer(ContactMapping):
             entries: dict = {"name": name, "mesh": {"file": self.mesh_path.with_suffix(f".{k + 1}.inp").name}}
             entries["material"] = self._material(secs[0][1], secs[0][2])
             entries.update(planar_body(self, k, name, types, secs, labels))  # (CPE, CPS, CAX: deck_planar)
+            self.body_forms[k] = entries.get("formulation", "solid")
             if len(secs) > 1:
                 entries["materials"] = {_name(s): self._material(mat, w) for s, mat, w in secs[1:]}
             if hybrid and "formulation" in entries:  # (planar: the planar F-bar)
@@ -322,6 +324,7 @@ class _Writer(ContactMapping):
             for key, v in self._boundary_keys(b, where).items():
                 model[key] = (v, amp)
         total = 0.0
+        nlgeom = nlgeom_steps(m.steps)
         for s, step in enumerate(m.steps):
             period = step.increments[1]
             # (start value, end magnitude, amplitude) of every condition and load in force in this step
@@ -434,7 +437,7 @@ class _Writer(ContactMapping):
                         continue
                     if key not in names:
                         names[key] = f"{ {'cload': 'f', 'dload': 'p'}.get(key[0], 'g') }{len(names) + 1}"
-                        first[key] = self._load_entry(key, names[key], v if (s, j) == (0, 0) else 0.0)
+                        first[key] = self._load_entry(key, names[key], v if (s, j) == (0, 0) else 0.0, nlgeom[s])
                         if (s, j) != (0, 0):
                             targets[names[key]] = self._load_value(key, v)
                     elif v != prev_l[key]:
@@ -608,7 +611,18 @@ class _Writer(ContactMapping):
                 self.extra_surfaces[name] = [(ld.elements[bodies == body], ld.dof)]
                 yield ("dload", int(body), name, ld.dof)
 
-    def _load_entry(self, key: tuple, name: str, v: float) -> dict:
+    def _load_entry(self, key: tuple, name: str, v: float, nlgeom: bool = False) -> dict:
+        """A load's entry; a face pressure given in a geometrically nonlinear step follows the faces (CalculiX and
+        Abaqus apply pressures on the deformed faces with NLGEOM)."""
+        if key[0] == "dload" and nlgeom:
+            if self.body_forms.get(key[1]) == "plane_stress":
+                note = (f"{self.deck}: body {self.body_names[key[1]]}: a pressure with NLGEOM follows the plane stress "
+                        f"edges on their reference thickness (CalculiX's expanded elements: on the current one, a "
+                        f"difference of the order of nu times the strain)")
+                if note not in self.notes:
+                    self.notes.append(note)
+            return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v),
+                    "follower": True}
         if key[0] == "grav":
             return {"name": name, "body": self.body_names[key[1]], "cells": key[2],
                     "acceleration": self._load_value(key, v)}

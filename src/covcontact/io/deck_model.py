@@ -54,7 +54,7 @@ class Step:
     """One *STEP ... *END STEP."""
 
     where: str
-    nlgeom: bool
+    nlgeom: bool | None       # NLGEOM (=YES) / NLGEOM=NO / not given (kept from the step before: nlgeom_steps)
     increments: tuple[float, float, float | None, float | None]   # initial, period, min, max
     direct: bool
     dynamic: bool = False     # *DYNAMIC (implicit): the increments are times
@@ -210,6 +210,16 @@ class DeckModel:
         return idx
 
 
+def nlgeom_steps(steps: list[Step]) -> list[bool]:
+    """Whether each step is geometrically nonlinear: NLGEOM, once given, holds in the later steps until NLGEOM=NO
+    (CalculiX's manual, *STEP)."""
+    out, on = [], False
+    for st in steps:
+        on = on if st.nlgeom is None else st.nlgeom
+        out.append(on)
+    return out
+
+
 def _article(word: str) -> str:
     """'a' or 'an' before an element type as it is said (an S8R, an SPRINGA, a CPS6, a C3D15)."""
     return "an" if word[:1].upper() in "AEFHILMNORSX" else "a"
@@ -359,7 +369,7 @@ class _Reader(LoadCards, MaterialCards):
                 inc = c.param("INC")
                 if inc is not None and not inc.strip().isdigit():
                     raise c.fail(f"INC must be a whole number, got {inc!r}")
-                self.step = Step(c.where(), "NLGEOM" in c.params and c.params["NLGEOM"].upper() != "NO",
+                self.step = Step(c.where(), None if "NLGEOM" not in c.params else c.params["NLGEOM"].upper() != "NO",
                                  (1.0, 1.0, None, None), False, frequency=self.frequency)
             elif c.name in ("STATIC", "DYNAMIC"):
                 st = self._in_step(c)

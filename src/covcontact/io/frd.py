@@ -245,7 +245,7 @@ class FrdFile(Observer):
         model = run.model
         U = run.u.reshape(-1, 3)
         R, _, _ = model.evaluate(run.u, lam, run.state, want_K=False, raw=True)
-        F = (R + model.external(lam)).reshape(-1, 3)  # internal and contact forces at each node
+        F = (R + model.applied(run.u, lam)).reshape(-1, 3)  # internal and contact forces at each node
         labels, disp, forc, stress, strain, pe = [], [], [], [], [], []
         plastic = False
         for blk, _, est, nlab, _ in self._bodies(run):

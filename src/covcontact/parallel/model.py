@@ -369,6 +369,9 @@ class DistributedModel(Model):
         self.contact = DistributedContact(problem, self.system, tangent, comm)
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
         self.stages = StagePlan(problem, self.system)
+        self.followers = follower_set(self.stages, self.system)  # (every rank has them; rank 0 assembles them)
+        if self.followers is not None:
+            self.symmetric = False
         #: whether a stage is dynamic: ``evaluate`` then keeps the contact forces' share of the residual
         #: (``last_contact_residual``, summed over the ranks) for the energy account
         self.dynamic = hasattr(problem, "stage_dynamics") and any(
@@ -396,6 +399,13 @@ class DistributedModel(Model):
         rc = ev.blocks.residual()
         r += rc
         Kc = ev.blocks.csr() if want_K else None
+        if self.followers is not None and self.rank == 0:  # (the follower pressures' blocks: once, on rank 0)
+            fb = ElementBlocks(self.system.n_nodes)
+            for blk in self.followers.blocks(self.positions(u), self.loading.follower_values(lam), want_K):
+                fb.add(*blk)
+            r += fb.residual()
+            if want_K:
+                Kc = Kc + fb.csr()
         t2 = time.perf_counter()
         if self.dynamic:  # (the dynamic energy account reads the contact forces' share, summed alike)
             r, self.last_contact_residual = sum_all(self.comm, np.stack([r, rc]))

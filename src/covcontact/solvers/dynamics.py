@@ -150,7 +150,7 @@ class DynamicModel:
             if K is not None and self.model.system.reference:
                 self.model._check_restrained(K)
         # the work of the applied forces and of the contact forces on the bodies over the step (trapezoidal rule)
-        f = applied_forces(self.model, Rd, lam)
+        f = applied_forces(self.model, Rd, lam, u)
         du = u - d["u"]
         work = float(d["work"]) + 0.5 * float((d["f"] + f) @ du)
         rc = getattr(self.model, "last_contact_residual", None)
@@ -182,10 +182,10 @@ class DynamicModel:
         return f
 
 
-def applied_forces(model, Rd: np.ndarray, lam: float) -> np.ndarray:
-    """The forces on the bodies from outside: the external loads and, on constrained dofs, the supports' (the
-    dynamic residual there)."""
-    f = model.external(lam).copy()
+def applied_forces(model, Rd: np.ndarray, lam: float, u: np.ndarray) -> np.ndarray:
+    """The forces on the bodies from outside at displacement ``u``: the external loads (follower pressures on the
+    current faces) and, on constrained dofs, the supports' (the dynamic residual there)."""
+    f = model.applied(u, lam).copy()
     c = ~model.free
     cons = getattr(model, "constraints", None)
     if cons is not None:  # (the dofs a constraint eliminates are no supports: its forces do no work in all)
@@ -307,7 +307,7 @@ class Dynamic(QuasiStatic):
             R = R if fd is None else R + fd
             a, Rd = self._equilibrium(R, self.model.free)
             dyn = dict(state.dynamics)
-            dyn.update(a=a, r=R, rd=Rd, f=applied_forces(self.model, Rd, state.lam))
+            dyn.update(a=a, r=R, rd=Rd, f=applied_forces(self.model, Rd, state.lam, u))
             if fd is not None:
                 dyn["fd"] = fd
             return state.but(dynamics=dyn)
@@ -327,7 +327,7 @@ class Dynamic(QuasiStatic):
         a, Rd = self._equilibrium(R, free)  # (Rd: the supports' forces at rest or with the initial velocities' inertia)
         rc = getattr(model, "last_contact_residual", None)
         dyn = {"u": u.copy(), "u0": u.copy(), "v": v, "a": a, "r": R, "rd": Rd, "time": np.array(self.t_start),
-               "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam),
+               "work": np.array(0.0), "f": applied_forces(model, Rd, state.lam, u),
                "rc": np.zeros_like(R) if rc is None else rc.copy(), "wc": np.array(0.0)}
         if fd is not None:
             dyn.update(fd=fd, wd=np.array(0.0))
@@ -349,7 +349,7 @@ class Dynamic(QuasiStatic):
         # (the rigid bodies' free dofs are held here: whether the tangent restrains them is not asked)
         kw = {"check": False} if getattr(model.system, "reference", None) else {}
         R, K, _ = model.evaluate(u, state.lam, state, **kw)
-        ref = max(float(np.linalg.norm(model.external(state.lam))), float(np.linalg.norm(R[~m & model.free])),
+        ref = max(float(np.linalg.norm(model.applied(u, state.lam))), float(np.linalg.norm(R[~m & model.free])),
                   1e-300)
         for _ in range(BALANCE_ITERATIONS):
             if float(np.linalg.norm(R[m])) <= BALANCE_TOLERANCE * ref:

@@ -13,6 +13,7 @@ import numpy as np
 from ..assembly.system import System
 from ..contact.assembly import CouplingPattern
 from ..contact.manager import ContactManager
+from ..elements.follower import follower_set
 from ..elements.springs import add_blocks, spring_set
 from .stages import Loading, StagePlan
 from .state import State
@@ -40,6 +41,8 @@ class Model:
 
     #: multi-point constraints (``covcontact.solvers.constraints``: linear equations, rigid links), None without
     constraints = None
+    #: follower pressures (``covcontact.elements.follower.FollowerSet``), None without
+    followers = None
 
     def __init__(self, problem, tangent: str | None = None):
         self.problem = problem
@@ -63,6 +66,10 @@ class Model:
             self.symmetric = self.symmetric and self.springs.symmetric
         self.coupling = CouplingPattern(self.system.n_nodes, blocks, pattern=self.system.pattern)
         self.stages = StagePlan(problem, self.system)
+        #: follower pressures (``covcontact.elements.follower``), None without: blocks on the bodies' faces
+        self.followers = follower_set(self.stages, self.system)
+        if self.followers is not None:
+            self.symmetric = False  # (the load stiffness of a pressure on an open surface is not symmetric)
         self.constraints = self._constraints(problem)
         if self.constraints is not None and not self.constraints.symmetric:
             self.symmetric = False  # (attached nodes: the rotation's second-order part is not symmetric)
@@ -160,6 +167,14 @@ class Model:
         f = self.loading.external(lam)
         return f + self.weight if self.weight is not None else f
 
+    def applied(self, u: np.ndarray, lam: float) -> np.ndarray:
+        """All external forces at displacement u and load factor lam: ``external(lam)`` and the follower pressures'
+        forces on the current faces."""
+        f = self.external(lam)
+        if self.followers is not None:
+            f = f + self.followers.force(self.positions(u), self.loading.follower_values(lam))
+        return f
+
     @property
     def weight(self) -> np.ndarray | None:
         """The bodies' weight under ``problem.gravity``: int rho N_a g dV0 = M (g at every node), None without
@@ -244,6 +259,8 @@ class Model:
             CouplingPattern.scatter(K.data, pattern, triples)
         if self.springs is not None:
             add_blocks(self.springs.spring_blocks(x, u.reshape(-1, 3), want_K), r, K, pattern)
+        if self.followers is not None:
+            add_blocks(self.followers.blocks(x, self.loading.follower_values(lam), want_K), r, K, pattern)
         t3 = time.perf_counter()
         if timing is not None:
             timing["assembly"] += t2 - t1

@@ -397,7 +397,8 @@ class Newton:
         K = m.eliminate(K)
         self.timing["bc"] += time.perf_counter() - t0
         r0 = float(np.linalg.norm(rhs))
-        scale = max(float(np.linalg.norm(m.external(lam_b))), float(np.linalg.norm(R)), r0, self.scale_seen,
+        f_b = m.applied(u, lam_b) if hasattr(m, "applied") else m.external(lam_b)  # (with follower pressures)
+        scale = max(float(np.linalg.norm(f_b)), float(np.linalg.norm(R)), r0, self.scale_seen,
                     1e-300)
         out.residual_norms.append(r0)
         out.records.append(IterationRecord(0, r0, 0.0, m.active_count(trial)))

@@ -103,6 +103,9 @@ class StageSpec:
     applied_names: tuple[str, ...] = ()
     #: the loads go linearly to their targets (False: they take them at once, a step load)
     ramp: bool = True
+    #: follower pressures (on the current faces, not in load_start / load_target): load key -> (value at lam = 0,
+    #: at lam = 1)
+    followers: dict = field(default_factory=dict)
 
     @property
     def lam_end(self) -> float:
@@ -126,6 +129,8 @@ class StagePlan:
             loads[key] = load
             values[key] = np.zeros_like(np.atleast_1d(np.asarray(load.value, dtype=float)))
         targets = {k: np.atleast_1d(np.asarray(ld.value, dtype=float)) for k, ld in loads.items()}
+        #: the follower pressures by load key (their values per stage: StageSpec.followers)
+        self.followers = {k: ld for k, ld in loads.items() if getattr(ld, "follower", False)}
 
         conds: list[_Condition] = []
         late: dict[str, list[_Condition]] = {}  # stage name -> the conditions that start there
@@ -197,7 +202,11 @@ class StagePlan:
         sysm = self.system
         f0 = np.zeros(sysm.n_dofs)
         f1 = np.zeros(sysm.n_dofs)
+        followers = {}
         for key, load in loads.items():
+            if getattr(load, "follower", False):
+                followers[key] = (float(start[key][0]), float(target[key][0]))
+                continue
             f0 += sysm.load_vector(load, start[key])
             f1 += sysm.load_vector(load, target[key])
         conds = list(conds)
@@ -228,7 +237,7 @@ class StagePlan:
         released = released[~constrained[released]] if released.size else released
         return StageSpec(index, name, tuple(factors), conds, released, f0, f1, motions, contacts, names,
                          constrained, parked=parked, parked_names=tuple(parked_names), parked_moves=parked_moves,
-                         released_pairs=tuple(released_pairs))
+                         released_pairs=tuple(released_pairs), followers=followers)
 
     def __len__(self) -> int:
         return len(self.stages)
@@ -332,6 +341,11 @@ class Loading:
         if s.released.size or s.released_pairs or np.any(self.held):
             f = f + max(0.0, 1.0 - lam) * self.release + self.held
         return f
+
+    def follower_values(self, lam: float) -> dict:
+        """The follower pressures' values at lam (load key -> pressure), ramped as the other loads are."""
+        w = lam if self.spec.ramp else 1.0
+        return {k: p0 + w * (p1 - p0) for k, (p0, p1) in self.spec.followers.items()}
 
     def rigid_load(self, name: str, lam: float) -> tuple[np.ndarray, np.ndarray]:
         """The applied force and moment of reference body ``name`` at lam."""
