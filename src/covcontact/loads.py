@@ -98,6 +98,9 @@ class Pressure:
     value: float
     name: str = ""
     follower: bool = False
+    #: (c, gx, gy, gz): the pressure at a point of the faces is value (c + g . X), X its reference position (None:
+    #: value everywhere)
+    profile: tuple[float, float, float, float] | None = None
 
 
 @dataclass

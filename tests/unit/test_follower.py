@@ -66,6 +66,66 @@ def test_edge_load_stiffness_is_exact(nfn, form):
     assert err < 1e-8
 
 
+@pytest.mark.parametrize("nfn", [4, 9, 6])
+def test_load_stiffness_of_a_varying_pressure_is_exact(nfn):
+    """A pressure varying over the faces (``profile``: value (c + g . X) at the reference point X of each integration
+    point): the same tangent check, faces and axisymmetric edges."""
+    from covcontact.elements.follower import point_factors
+
+    x = _distorted(nfn, 11)
+    faces = np.arange(2 * nfn).reshape(2, nfn)
+    factor = point_factors(x, faces, (0.5, 1.0, -2.0, 3.0))
+    err = _fd_error(lambda y: face_blocks(y, faces, 1.3, factor=factor), x, faces)
+    assert err < 1e-8
+    edges = np.array([[0, 1, 2]])
+    xe = np.array([[1.0, 0.0, 0.0], [2.0, 0.3, 0.0], [1.5, 0.2, 0.0]])
+    factor = point_factors(xe, edges, (1.0, 0.0, 4.0, 0.0), planar=True)
+    err = _fd_error(lambda y: edge_blocks(y, edges, 0.7, "axisymmetric", 1.0, factor=factor), xe, edges)
+    assert err < 1e-8
+
+
+def test_dead_profile_is_the_follower_at_the_reference():
+    """A dead pressure with a profile gets the nodal forces the follower pressure has at the reference positions; a
+    linear profile through the thickness of an end face is a pure couple (zero force, moment value x 1)."""
+    from covcontact.assembly.system import System
+    from covcontact.loads import Pressure
+    from covcontact.materials import SaintVenantKirchhoff
+    from covcontact.mesh.generators import plate
+    from covcontact.problem import Body
+
+    h = 0.1
+    mesh = plate(2.0, 1.0, h, 2, 1, cell="hex8")
+    prof = (-6.0 / h ** 2, 0.0, 0.0, 12.0 / h ** 3)
+    load = Pressure("s", "xmax", 5.0, profile=prof)
+    sysm = System([Body("s", mesh, SaintVenantKirchhoff(E=1.0, nu=0.0), "solid-shell", {})], loads=[load])
+    f = sysm.load_vector(load).reshape(-1, 3)
+    faces = mesh.face_sets["xmax"]
+    from covcontact.elements.follower import point_factors
+
+    R, _ = face_blocks(mesh.points, faces, 5.0, False, point_factors(mesh.points, faces, prof))
+    g = np.zeros_like(f)
+    np.add.at(g, faces.ravel(), -R.reshape(-1, 3))
+    assert np.allclose(f, g, atol=1e-12)
+    assert np.allclose(f.sum(axis=0), 0.0, atol=1e-12)
+    moment = np.sum(np.cross(mesh.points - [2.0, 0.5, h / 2], f), axis=0)
+    assert moment == pytest.approx([0.0, -5.0, 0.0], abs=1e-12)
+
+
+def test_profile_key_is_read_and_checked(tmp_path):
+    """``profile = { constant, gradient }`` reaches the load; an unknown key in it is one line naming it."""
+    from covcontact.io.loader import load_problem
+    from covcontact.io.validate import InputError
+
+    loads = '[[pressure]]\nset = "c.xmax"\nvalue = 2.0\nfollower = true\nprofile = { constant = 0.5, gradient = [0.0, 0.0, 1.0] }\n'
+    path = tmp_path / "p.toml"
+    path.write_text(_CUBE.replace("CELL", "hex8").replace("LOADS", loads))
+    (pressure,) = load_problem(path).pressures
+    assert pressure.follower and pressure.profile == (0.5, 0.0, 0.0, 1.0)
+    path.write_text(_CUBE.replace("CELL", "hex8").replace("LOADS", loads.replace("gradient", "gradiant")))
+    with pytest.raises(InputError, match=r"pressure\[0\]\.profile.*gradiant.*gradient"):
+        load_problem(path)
+
+
 @pytest.mark.parametrize("nfn", [4, 8, 9, 3, 6])
 def test_reference_faces_give_the_dead_load_vector(nfn):
     """At the reference positions the follower forces are the dead pressure's (covcontact.assembly.system's

@@ -37,34 +37,54 @@ def _skew(a: np.ndarray) -> np.ndarray:
     return S
 
 
-def face_blocks(x: np.ndarray, faces: np.ndarray, p: float, want_K: bool = True):
-    """Residual blocks (nf, 3 nfn) and tangents (nf, 3 nfn, 3 nfn) or None of the pressure ``p`` on the current
-    faces ``faces`` (node ids into the current positions ``x``; quad4, quad8, quad9, tri3, tri6)."""
+def _rule(nfn: int, planar: bool):
+    """(N, dN, weights) of a face (3D) or an edge (planar) of ``nfn`` nodes: the rules of the dead loads."""
+    if not planar:
+        return any_face(nfn)
+    from ..fem.planar_cells import line_shapes
+    from ..fem.quadrature import gauss_1d
+
+    s, w = gauss_1d(2 if nfn == 2 else 3)
+    N, dN = line_shapes(nfn, s)
+    return N, dN, w
+
+
+def point_factors(X: np.ndarray, faces: np.ndarray, profile, planar: bool = False) -> np.ndarray | None:
+    """The factor c + g . X_g of a pressure's ``profile`` (c, gx, gy, gz) at each integration point of the faces
+    (or edges), X_g the point's reference position; None without a profile (a uniform pressure)."""
+    if profile is None:
+        return None
+    N = _rule(faces.shape[1], planar)[0]
+    Xg = np.einsum("pa,fai->fpi", N, X[faces])
+    return float(profile[0]) + Xg @ np.asarray(profile[1:], dtype=float)
+
+
+def face_blocks(x: np.ndarray, faces: np.ndarray, p: float, want_K: bool = True, factor: np.ndarray | None = None):
+    """Residual blocks (nf, 3 nfn) and tangents (nf, 3 nfn, 3 nfn) or None of the pressure ``p`` (times ``factor``
+    (nf, n_points) where it varies over the faces) on the current faces ``faces`` (node ids into the current
+    positions ``x``; quad4, quad8, quad9, tri3, tri6)."""
     N, dN, w = any_face(faces.shape[1])
     xf = x[faces]  # (nf, nfn, 3)
     t1 = np.einsum("pa,fai->fpi", dN[:, :, 0], xf)
     t2 = np.einsum("pa,fai->fpi", dN[:, :, 1], xf)
-    n = np.cross(t1, t2) * w[None, :, None]
     nf, nfn = faces.shape
-    R = (p * np.einsum("pa,fpi->fai", N, n)).reshape(nf, 3 * nfn)
+    pw = p * np.broadcast_to(w[None, :] if factor is None else w[None, :] * factor, (nf, len(w)))
+    R = np.einsum("pa,fp,fpi->fai", N, pw, np.cross(t1, t2)).reshape(nf, 3 * nfn)
     if not want_K:
         return R, None
-    pw = p * w
-    A = np.einsum("p,pa,pb,fpij->faibj", pw, N, dN[:, :, 1], _skew(t1))
-    A -= np.einsum("p,pa,pb,fpij->faibj", pw, N, dN[:, :, 0], _skew(t2))
+    A = np.einsum("fp,pa,pb,fpij->faibj", pw, N, dN[:, :, 1], _skew(t1))
+    A -= np.einsum("fp,pa,pb,fpij->faibj", pw, N, dN[:, :, 0], _skew(t2))
     return R, A.reshape(nf, 3 * nfn, 3 * nfn)
 
 
 def edge_blocks(x: np.ndarray, edges: np.ndarray, p: float, formulation: str, thickness: float,
-                want_K: bool = True):
+                want_K: bool = True, factor: np.ndarray | None = None):
     """The same for the current edges of a planar body (2 or 3 nodes): per unit thickness times ``thickness``
     (plane strain, plane stress) or over the full circumference at the current radius (axisymmetric)."""
-    from ..fem.planar_cells import line_shapes
-    from ..fem.quadrature import gauss_1d
-
     ne, nfn = edges.shape
-    s, w = gauss_1d(2 if nfn == 2 else 3)
-    N, dN = line_shapes(nfn, s)
+    N, dN, w = _rule(nfn, True)
+    if factor is not None:
+        w = w[None, :] * factor
     xe = x[edges]
     tang = np.einsum("pa,eai->epi", dN, xe)
     Qt = np.stack([tang[..., 1], -tang[..., 0], np.zeros_like(tang[..., 0])], axis=2)  # (ne, np, 3)
@@ -72,16 +92,17 @@ def edge_blocks(x: np.ndarray, edges: np.ndarray, p: float, formulation: str, th
     if axisym:
         c = 2.0 * np.pi * np.einsum("pa,ea->ep", N, xe[:, :, 0])
     else:
-        c = np.full((ne, len(w)), float(thickness))
-    R = (p * np.einsum("pa,ep,epi->eai", N, c * w[None, :], Qt)).reshape(ne, 3 * nfn)
+        c = np.full((ne, N.shape[0]), float(thickness))
+    w = np.broadcast_to(w, c.shape)
+    R = (p * np.einsum("pa,ep,epi->eai", N, c * w, Qt)).reshape(ne, 3 * nfn)
     if not want_K:
         return R, None
     Q = np.zeros((3, 3))
     Q[0, 1], Q[1, 0] = 1.0, -1.0
-    A = np.einsum("pa,ep,pb,ij->eaibj", N, p * c * w[None, :], dN, Q)
+    A = np.einsum("pa,ep,pb,ij->eaibj", N, p * c * w, dN, Q)
     if axisym:
         er = np.array([1.0, 0.0, 0.0])
-        A += np.einsum("pa,p,pb,epi,j->eaibj", N, p * 2.0 * np.pi * w, N, Qt, er)
+        A += np.einsum("pa,ep,pb,epi,j->eaibj", N, p * 2.0 * np.pi * w, N, Qt, er)
     return R, A.reshape(ne, 3 * nfn, 3 * nfn)
 
 
@@ -93,21 +114,23 @@ class FollowerSet:
     def __init__(self, system, loads: dict):
         from ..assembly.system import is_planar
 
-        self.items = []  # (key, global face nodes, planar formulation or "", thickness)
+        self.items = []  # (key, global face nodes, planar formulation or "", thickness, point factors or None)
         for key, load in loads.items():
             body = system.bodies[load.body]
-            faces = body.mesh.face_sets[load.set] + system.offset(load.body)
+            local = body.mesh.face_sets[load.set]
             form = body.formulation if is_planar(body) else ""
-            self.items.append((key, np.ascontiguousarray(faces, dtype=np.int64), form,
-                               float(body.options.get("thickness", 1.0)) if form else 1.0))
+            factor = point_factors(body.mesh.points, local, getattr(load, "profile", None), bool(form))
+            self.items.append((key, np.ascontiguousarray(local + system.offset(load.body), dtype=np.int64), form,
+                               float(body.options.get("thickness", 1.0)) if form else 1.0, factor))
 
     def blocks(self, x: np.ndarray, values: dict, want_K: bool = True) -> list:
         out = []
-        for key, faces, form, t in self.items:
+        for key, faces, form, t, factor in self.items:
             p = float(values.get(key, 0.0))
             if p == 0.0:
                 continue
-            R, K = edge_blocks(x, faces, p, form, t, want_K) if form else face_blocks(x, faces, p, want_K)
+            R, K = (edge_blocks(x, faces, p, form, t, want_K, factor) if form
+                    else face_blocks(x, faces, p, want_K, factor))
             out.append((faces, R, K))
         return out
 

@@ -98,8 +98,13 @@ def read_loads(top: Section, sets: SetRefs) -> tuple[list, list, list]:
         value = p.get("value", "float")
         pname = p.get("name", "str", "")
         follower = p.get("follower", "bool", False)
+        profile = None
+        if p.has("profile"):
+            prof = p.get("profile", "table")
+            profile = (prof.get("constant", "float", 1.0), *prof.get("gradient", "vector", (0.0, 0.0, 0.0)))
+            prof.done()
         p.done()
-        pressures.append(Pressure(bname, sname, value, pname, follower))
+        pressures.append(Pressure(bname, sname, value, pname, follower, profile))
 
     tractions = []
     for t in top.get("traction", "array", []):
