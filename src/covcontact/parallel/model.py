@@ -18,7 +18,9 @@ from numba import njit
 
 from ..assembly.pattern import Pattern
 from ..assembly.system import BodyBlock, InvertedElementError, System, make_solid
+from ..contact.assembly import ElementBlocks
 from ..elements.base import SolidStress
+from ..elements.follower import follower_set
 from ..solvers.model import Model, adjust_once
 from ..solvers.stages import StagePlan
 from ..solvers.state import State
