@@ -854,8 +854,9 @@ class _Writer(ContactMapping):
             path.write_text(text)
             self.meshes[path] = mesh
             # (a split triangle's three cells: the deck's label, then labels after the deck's largest)
-            per_cell = info["elements"] if info["cell"] != "tri3" else np.repeat(info["elements"], 3)
-            if info["cell"] == "tri3":
+            split = info["cell"] in ("tri3", "tri6")
+            per_cell = np.repeat(info["elements"], 3) if split else info["elements"]
+            if split:
                 extra = np.ones(per_cell.size, dtype=bool)
                 extra[::3] = False
                 per_cell = per_cell.copy()

@@ -160,7 +160,7 @@ class DeckModel:
     notes: list[str] = field(default_factory=list)
     #: "abaqus" where the deck has keywords only Abaqus reads (*PART, *ASSEMBLY, *INSTANCE), else "calculix"
     dialect: str = "calculix"
-    #: shell elements (S3, S4, S4R, S8, S8R; covcontact.io.deck_shells): (deck type, surface cell type, labels,
+    #: shell elements (S3, S4, S4R, S6, S8, S8R; covcontact.io.deck_shells): (deck type, surface cell type, labels,
     #: connectivity as node labels) per *ELEMENT card, and where each card is
     shell_blocks: list[tuple[str, str, np.ndarray, np.ndarray]] = field(default_factory=list)
     shell_where: list[str] = field(default_factory=list)

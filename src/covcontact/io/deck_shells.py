@@ -7,7 +7,7 @@ of shell elements a body of solid-shells from its mid-surface (``covcontact.mesh
 node becomes a bottom and a top node on its director. What the deck says of a shell node is said of those two:
 
 - the reader's part (:func:`read_shell_elements`, :func:`read_shell_card`, :func:`shell_surface_row`): the elements
-  (S4, S4R -> quad4, S8, S8R -> quad8, S3 -> tri3; S6 is refused), *SHELL SECTION (ELSET, MATERIAL, OFFSET, the
+  (S4, S4R -> quad4, S8, S8R -> quad8, S3 -> tri3, S6 -> tri6), *SHELL SECTION (ELSET, MATERIAL, OFFSET, the
   thickness on its data line), *NODAL THICKNESS, and the shell faces of *SURFACE (SPOS and SNEG, CalculiX's S2 and
   S1 on shells);
 - the import's part (:class:`DeckShells`): the bodies, their surface mesh files and ``shell = { ... }`` tables,
@@ -23,22 +23,19 @@ import numpy as np
 from .deck import Card, DeckError, numbers
 
 #: the shell elements read: deck type -> the surface cell type of its mid-surface
-SHELL_ELEMENTS = {"S3": "tri3", "S4": "quad4", "S4R": "quad4", "S8": "quad8", "S8R": "quad8"}
+SHELL_ELEMENTS = {"S3": "tri3", "S4": "quad4", "S4R": "quad4", "S6": "tri6", "S8": "quad8", "S8R": "quad8"}
 #: the element type written in a shell body's surface mesh file (what the mesh reader's meshio takes)
-SURFACE_TYPE = {"tri3": "S3", "quad4": "S4", "quad8": "S8R"}
-_NNODE = {"tri3": 3, "quad4": 4, "quad8": 8}
+#: the surface file's element type of each cell type (a six-node triangle as STRI65, the name meshio reads)
+SURFACE_TYPE = {"tri3": "S3", "quad4": "S4", "quad8": "S8R", "tri6": "STRI65"}
+_NNODE = {"tri3": 3, "quad4": 4, "quad8": 8, "tri6": 6}
 SHELL_CARDS = ("SHELL SECTION", "NODAL THICKNESS")
 #: the shells refused, with why
-REFUSED = {"S6": "six-node triangles have no solid-shell here (S3, S4, S4R, S8, S8R are read): mesh the shell with "
-                 "S8R quadrilaterals or S3 triangles",
-           "S9R5": "covcontact reads S3, S4, S4R, S8, S8R", "S4R5": "covcontact reads S3, S4, S4R, S8, S8R",
-           "S8R5": "covcontact reads S3, S4, S4R, S8, S8R", "S3R": "covcontact reads S3, S4, S4R, S8, S8R",
-           "STRI65": "covcontact reads S3, S4, S4R, S8, S8R"}
+REFUSED = {k: "covcontact reads S3, S4, S4R, S6, S8, S8R" for k in ("S9R5", "S4R5", "S8R5", "S3R", "STRI65")}
 
 
 # -- reading ---------------------------------------------------------------------------------------------------------
 def read_shell_elements(reader, c: Card, etype: str) -> None:
-    """*ELEMENT, TYPE=S3 / S4 / S4R / S8 / S8R: a shell block (its labels and nodes)."""
+    """*ELEMENT, TYPE=S3 / S4 / S4R / S6 / S8 / S8R: a shell block (its labels and nodes)."""
     cell = SHELL_ELEMENTS[etype]
     n = _NNODE[cell]
     a = numbers(c, 1 + n, f"a {etype} element (label and {n} nodes)", integer=True)
@@ -243,7 +240,7 @@ class DeckShells:
                 a = int(labels[mine][types[mine] == cell_types[0]][0])
                 b = int(labels[mine][types[mine] == cell_types[1]][0])
                 raise DeckError(f"{where[mine[0]]}: shell elements {a} ({cell_types[0]}) and {b} ({cell_types[1]}) "
-                                f"meet in one part: a shell body's mid-surface is of one cell type here (S3, S4/S4R or "
+                                f"meet in one part: a shell body's mid-surface is of one cell type here (S3, S4/S4R, S6 or "
                                 f"S8/S8R); mesh the part with one of them")
             cell = cell_types[0]
             cmat = np.vstack([conn_rows[e] for e in mine])
@@ -346,11 +343,12 @@ class DeckShells:
     @staticmethod
     def _flipped(cell: str, cells: np.ndarray) -> np.ndarray:
         """Which surface cells extrude_surface turns (their normal against the first cell's of their part)."""
-        from ..mesh.shell import _orient, _quad8_to_quad9, _split_triangles
+        from ..mesh.shell import _orient, _quad8_to_quad9, _split_tri6, _split_triangles
 
-        if cell == "tri3":
+        if cell in ("tri3", "tri6"):
             pts = np.zeros((int(cells.max()) + 1, 3))
-            _, _, quads, of = _split_triangles(pts, np.ones(pts.shape[0]), cells)
+            split = _split_triangles if cell == "tri3" else _split_tri6
+            _, _, quads, of = split(pts, np.ones(pts.shape[0]), cells)
             turned = np.any(_orient(quads, "quad4") != quads, axis=1)
             return np.bincount(of, weights=turned, minlength=cells.shape[0]) > 0
         if cell == "quad8":

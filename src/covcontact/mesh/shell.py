@@ -16,7 +16,9 @@ real surfaces; :func:`extrude_surface` makes them:
 - quad4 cells become hex8 (the four bottom nodes, then the four top nodes), quad9 cells hex18 (a quad9 at the
   bottom, then one at the top); a quad8 gets its centre node (the serendipity surface's point at the cell centre,
   -1/4 of the corners plus 1/2 of the mid-side nodes) and becomes a quad9; a tri3 is split into three quad4 (its
-  corners, the mid-points of its edges, shared with the neighbours, and its centroid).
+  corners, the mid-points of its edges, shared with the neighbours, and its centroid); a tri6 likewise, into three
+  quad4 of its corners, its mid-side nodes and the point of its quadratic surface at the centroid (-1/9 of the
+  corners plus 4/9 of the mid-side nodes).
 
 Sets: the surface's element sets (a split triangle's three quads in its sets); each node set of the surface holds
 its nodes of both layers; node and face sets "top" and "bottom" (outward: the top's along the directors, the
@@ -32,10 +34,10 @@ import numpy as np
 
 from .mesh import Mesh
 
-#: the solid-shell cell of each surface cell type (after quad8 -> quad9 and tri3 -> quad4)
+#: the solid-shell cell of each surface cell type (after quad8 -> quad9 and tri3, tri6 -> quad4)
 SOLID_OF = {"quad4": "hex8", "quad9": "hex18"}
 #: the surface cell types :func:`extrude_surface` takes
-SURFACE_CELLS = ("quad4", "quad8", "quad9", "tri3")
+SURFACE_CELLS = ("quad4", "quad8", "quad9", "tri3", "tri6")
 #: offsets by name (the given surface's place in the shell, Abaqus's OFFSET)
 OFFSETS = {"middle": 0.0, "top": 0.5, "bottom": -0.5}
 
@@ -77,6 +79,22 @@ def _split_triangles(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
                       np.stack([cells[:, 1], mid[:, 1], centre, mid[:, 0]], axis=1),
                       np.stack([cells[:, 2], mid[:, 2], centre, mid[:, 1]], axis=1)], axis=1).reshape(-1, 4)
     return new(points), new(t), quads, np.repeat(np.arange(cells.shape[0]), 3)
+
+
+def _split_tri6(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
+    """Each tri6 (corners, then the mid-side nodes of edges 0-1, 1-2, 2-0) into three quad4 (corner, mid-side node of
+    the next edge, centre, mid-side node of the previous edge), the centre the point of the quadratic triangle at its
+    centroid (shape functions -1/9 at the corners, 4/9 at the mid-side nodes); the points, the thicknesses
+    (interpolated alike), the quads and the triangle of each quad."""
+    def centre(v):
+        return -v[cells[:, :3]].sum(axis=1) / 9.0 + 4.0 * v[cells[:, 3:6]].sum(axis=1) / 9.0
+
+    c = points.shape[0] + np.arange(cells.shape[0])
+    quads = np.stack([np.stack([cells[:, 0], cells[:, 3], c, cells[:, 5]], axis=1),
+                      np.stack([cells[:, 1], cells[:, 4], c, cells[:, 3]], axis=1),
+                      np.stack([cells[:, 2], cells[:, 5], c, cells[:, 4]], axis=1)], axis=1).reshape(-1, 4)
+    return (np.vstack([points, centre(points)]), np.concatenate([t, centre(t)]), quads,
+            np.repeat(np.arange(cells.shape[0]), 3))
 
 
 def _orient(cells: np.ndarray, cell_type: str) -> np.ndarray:
@@ -207,6 +225,9 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     elif cell_type == "tri3":
         points, t, cells, cell_of = _split_triangles(points, t, cells)
         cell_type = "quad4"
+    elif cell_type == "tri6":
+        points, t, cells, cell_of = _split_tri6(points, t, cells)
+        cell_type = "quad4"
     given = cells
     cells = _orient(cells, cell_type)
     turned = np.any(cells != given, axis=1)  # (cells whose top is the side against their own normal)
@@ -335,7 +356,7 @@ def _side_halves(cells: np.ndarray, points: np.ndarray) -> np.ndarray:
 
 
 #: meshio's surface cell types and ours
-_FROM_MESHIO = {"quad": "quad4", "quad8": "quad8", "quad9": "quad9", "triangle": "tri3"}
+_FROM_MESHIO = {"quad": "quad4", "quad8": "quad8", "quad9": "quad9", "triangle": "tri3", "triangle6": "tri6"}
 
 
 def read_surface(path) -> tuple[np.ndarray, str, np.ndarray, dict, dict]:
