@@ -364,3 +364,22 @@ def test_model_tangent_with_follower_pressures_is_exact(tmp_path):
     path.write_text(_CUBE.replace("CELL", "hex8").replace("LOADS", _hydrostatic(150.0, True)))
     rep = check_tangent(load_problem(path), step=2, columns=None)
     assert rep["converged"] and rep["relative_error"] <= 1e-6, rep["relative_error"]
+
+
+def test_dynamic_energy_account_counts_the_follower_work(tmp_path):
+    """A dynamic stage (Newmark's trapezoidal rule, dt = 0.002 over 0.1) of the cube under the three follower
+    pressures: the external work, counted on the current faces, equals the kinetic and strain energy at every step
+    (balance error within 1e-4 of the energies; measured 5e-5)."""
+    from covcontact.io.loader import load_problem
+
+    text = _CUBE.replace("CELL", "hex8").replace("LOADS", _hydrostatic(100.0, True))
+    text = text.replace('name = "cube"\n', 'name = "cube"\nprocedure = "dynamic"\ndt = 0.002\nt_end = 0.1\n'
+                        'method = "newmark"\n').replace("nu = 0.3 }", "nu = 0.3, density = 1.0 }")
+    text = text.replace("[steps]\ncount = 4\n", "")
+    path = tmp_path / "dyn.toml"
+    path.write_text(text)
+    res = load_problem(path).run(out=tmp_path / "o", quiet=True)
+    assert res.exit_code == 0
+    steps = res.summary["steps"]
+    assert len(steps) == 50 and steps[-1]["energy"]["external_work"] > 1.0
+    assert max(abs(s["energy"]["balance_error"]) for s in steps) < 1e-4
