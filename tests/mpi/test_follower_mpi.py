@@ -6,57 +6,21 @@ Needs the ``mpi`` extra (mpi4py, petsc4py) and ``mpiexec``: skipped without them
 
 from __future__ import annotations
 
-import os
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
-from test_dynamics import MISSING, _mpiexec
+from test_dynamics import _mpiexec, _need_mpi  # noqa: F401  (the fixture skips without the MPI extra)
 
 from covcontact.io.loader import load_problem
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "unit"))
+from test_follower import _CUBE, _hydrostatic  # noqa: E402
 
-@pytest.fixture(autouse=True)
-def _need_mpi():
-    if MISSING:
-        if os.environ.get("COVCONTACT_REQUIRE_MPI") == "1":
-            pytest.fail(f"COVCONTACT_REQUIRE_MPI=1 but the MPI extra is missing: {MISSING}")
-        pytest.skip(f"MPI extra not installed ({MISSING}); bash tools/install-mpi.sh installs it (PETSc from source)")
-
-
-CUBE = """
-[problem]
-name = "cube"
-[[bodies]]
-name = "c"
-element = "hex8"
-mesh = { generator = "block", lx = 1.0, ly = 1.0, lz = 1.0, nx = 4, ny = 4, nz = 4 }
-material = { model = "svk", E = 1000.0, nu = 0.3 }
-[[dirichlet]]
-set = "c.xmin"
-components = "x"
-[[dirichlet]]
-set = "c.ymin"
-components = "y"
-[[dirichlet]]
-set = "c.zmin"
-components = "z"
-[[pressure]]
-set = "c.xmax"
-value = 150.0
-follower = true
-[[pressure]]
-set = "c.ymax"
-value = 150.0
-follower = true
-[[pressure]]
-set = "c.zmax"
-value = 150.0
-follower = true
-[steps]
-count = 3
-[output]
-vtu = false
-"""
+#: the unit test's cube on a 4 x 4 x 4 mesh, three steps, no VTU
+CUBE = (_CUBE.replace("CELL", "hex8").replace("nx = 2, ny = 2, nz = 2", "nx = 4, ny = 4, nz = 4")
+        .replace("LOADS", _hydrostatic(150.0, True)).replace("count = 4", "count = 3\n[output]\nvtu = false"))
 
 
 def test_follower_pressure_two_ranks(tmp_path):
