@@ -32,12 +32,14 @@ class Dirichlet:
 
 @dataclass
 class Equation:
-    """A linear multi-point constraint sum_k c_k u(node_k, component_k) = 0 (docs/theory.md, "Multi-point
+    """A linear multi-point constraint sum_k c_k u(node_k, component_k) = lam * value (docs/theory.md, "Multi-point
     constraints"): ``terms`` are (body, node set of one node, component 0..2, coefficient c_k); the first term's
-    dof is the dependent one, eliminated in favour of the others."""
+    dof is the dependent one, eliminated in favour of the others. The right-hand side goes from 0 to ``value`` over
+    the first stage (stage targets move it on, as a Dirichlet condition's)."""
 
     terms: list[tuple[str, str, int, float]]
     name: str = ""
+    value: float = 0.0
 
 
 #: the kinds of nonlinear multi-point constraints (``MPC``), and how many defining nodes each takes before the

@@ -127,6 +127,7 @@ def read_equations(top: Section, sets: SetRefs, dirichlet: list[Dirichlet]) -> l
     for e in top.get("equation", "array", []):
         raw = e.get("terms", "any")
         name = e.get("name", "str", "")
+        value = e.get("value", "float", 0.0)
         e.done()
         if not isinstance(raw, list) or not raw:
             e.fail("must be a non-empty array of [\"body.set\", \"x\" | \"y\" | \"z\", coefficient]", "terms")
@@ -154,7 +155,7 @@ def read_equations(top: Section, sets: SetRefs, dirichlet: list[Dirichlet]) -> l
             elif dof == first:
                 e.fail(f"{t[0]} {t[1]} is this equation's eliminated (first) term: it appears once", key)
             terms.append((bname, sname, comp, float(t[2])))
-        out.append(Equation(terms, name))
+        out.append(Equation(terms, name, value))
         refs[first] = [(b, int(sets.mesh(b).node_sets[sn][0]), c) for b, sn, c, _ in terms[1:]]
     state: dict[tuple, int] = {}  # a cycle of eliminations (u_a = u_b, u_b = u_a) has no solution for them
 

@@ -104,6 +104,10 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
             top.fail(f"no later stage named {bc.stage!r}{suggest(bc.stage, later)} (the stages after the first: "
                      f"{', '.join(later) or 'none'})", f"dirichlet[{i}].stage")
     dynamic = dynamics is not None or any(st.dynamics is not None for st in stages)
+    for i, eq in enumerate(equations):  # (a right-hand side's rate would be missing from the eliminated velocity)
+        if dynamic and (eq.value != 0.0 or any(eq.name and eq.name in st.targets for st in stages)):
+            top.fail("a right-hand side (value, or a stage's target) in a problem with dynamic stages: not available "
+                     "yet; keep the equation homogeneous there", f"equation[{i}].value")
     if dynamic or gravity is not None:
         check_densities(top, bodies, "a dynamic stage" if dynamic else "gravity")
         for i, r in enumerate(rigid):  # a free rigid body moves by its mass and inertia

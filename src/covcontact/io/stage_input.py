@@ -86,8 +86,8 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
     tsec = st.get("targets", "table", None)
     if tsec is not None:
         for n in list(tsec.data):
-            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction", "body_force", "rigid"),
-                                   "Dirichlet condition or load")
+            kind, obj = check_name(tsec, n, n, ("dirichlet", "force", "pressure", "traction", "body_force", "rigid",
+                                                "equation"), "Dirichlet condition, load or equation")
             if n in release or n in remove:
                 tsec.fail(f"{n!r} is {'released' if n in release else 'removed'} and given a target in the "
                           f"same stage", n)
@@ -95,7 +95,7 @@ def stage(st: Section, named: dict, dirichlet, rigid, contacts, earlier: list, f
                 if obj.motion is not None:
                     tsec.fail(f"{n!r} prescribes a motion; give it a new one in 'motions'", n)
                 targets[n] = dirichlet_values(tsec, n, len(obj.components))
-            elif kind == "pressure":
+            elif kind in ("pressure", "equation"):  # (an equation's target: its right-hand side)
                 targets[n] = tsec.get(n, "float")
             elif kind == "body_force" and obj.axis is not None:  # a spin: its new angular velocity omega
                 omega = tsec.get(n, "float", nonnegative=True)

@@ -31,9 +31,13 @@ class LinearConstraints:
     #: T^T K T keeps K's symmetry
     symmetric = True
 
-    def __init__(self, equations, system):
+    def __init__(self, equations, system, indices=None):
         n = system.n_dofs
         dep, rows, cols, vals = [], [], [], []
+        #: each equation's place in the problem's list (the right-hand sides come by it) and its first coefficient
+        self.n = n
+        self.indices = np.arange(len(equations)) if indices is None else np.asarray(indices, dtype=np.int64)
+        self.first = np.array([eq.terms[0][3] for eq in equations], dtype=float)
         for eq in equations:
             (b0, s0, c0, k0), *rest = eq.terms
             d = 3 * int(system.global_nodes(b0, s0)[0]) + c0
@@ -49,10 +53,12 @@ class LinearConstraints:
         # chains (an eliminated dof among another equation's terms): substitute until no row refers to one (the input
         # has no cycles, so this ends within as many rounds as there are equations)
         drop = sp.diags(np.where(self.mask, 0.0, 1.0))
+        self._chain = []  # the substitutions made, for the right-hand sides' offsets (set_rhs)
         for _ in range(len(dep) + 1):
             B = A[:, self.dependent]
             if B.nnz == 0:
                 break
+            self._chain.append(B.tocsr())
             A = (A @ drop + B @ A[self.dependent]).tocsr()
             A.eliminate_zeros()
         keep = np.where(self.mask, 0.0, 1.0)
@@ -60,10 +66,20 @@ class LinearConstraints:
         self.Tt = self.T.T.tocsr()
         self.rows = A[self.dependent].tocsr()
         self.unit = unit_diagonal(self.mask, system)
+        self.offset = np.zeros(len(dep))  # u_d = rows u + offset: the right-hand sides' share (set_rhs)
+
+    def set_rhs(self, rhs: np.ndarray) -> None:
+        """The right-hand sides b of the problem's equations (by their place in its list): the dependent dofs get
+        b / c_d beside the others' share, passed on through the chains as the terms are."""
+        o = np.zeros(self.n)
+        o[self.dependent] = np.asarray(rhs, dtype=float)[self.indices] / self.first
+        for B in self._chain:
+            o = o + B @ o[self.dependent]
+        self.offset = o[self.dependent]
 
     def complete(self, u: np.ndarray) -> None:
-        """Set the dependent dofs of ``u`` (in place) from the others."""
-        u[self.dependent] = self.rows @ u
+        """Set the dependent dofs of ``u`` (in place) from the others (and the right-hand sides)."""
+        u[self.dependent] = self.rows @ u + self.offset
 
     def mass(self, M):
         """T^T M T: the mass of the independent dofs."""
@@ -215,6 +231,11 @@ class ChainedConstraints:
     def complete(self, u: np.ndarray) -> None:
         for c in self.layers:
             c.complete(u)
+
+    def set_rhs(self, rhs: np.ndarray) -> None:
+        for c in self.layers:
+            if hasattr(c, "set_rhs"):
+                c.set_rhs(rhs)
 
     def transform(self, R: np.ndarray, K):
         for c in reversed(self.layers):

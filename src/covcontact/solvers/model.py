@@ -88,8 +88,9 @@ class Model:
             self._mpcs = NonlinearMPCs(problem.mpcs, self.system)
         removed = frozenset(n for st in list(getattr(problem, "stages", []))[:stage] for n in st.remove)
         if removed not in self._constraint_sets:
-            eqs = [e for e in getattr(problem, "equations", None) or [] if not (e.name and e.name in removed)]
-            linear = LinearConstraints(eqs, self.system) if eqs else None
+            kept = [(i, e) for i, e in enumerate(getattr(problem, "equations", None) or [])
+                    if not (e.name and e.name in removed)]
+            linear = LinearConstraints([e for _, e in kept], self.system, [i for i, _ in kept]) if kept else None
             layers = [c for c in (self._rigid_links, self._mpcs, linear) if c is not None]
             self._constraint_sets[removed] = (ChainedConstraints(*layers) if len(layers) > 1
                                               else layers[0] if layers else None)
@@ -242,6 +243,8 @@ class Model:
         guess = committed if guess is None else guess
         t0 = time.perf_counter()
         if self.constraints is not None:  # (the dependent dofs follow the others: u is set in place)
+            if self.stages.equation_values:  # (equations with right-hand sides: theirs at lam)
+                self.constraints.set_rhs(self.loading.equation_rhs(lam))
             self.constraints.complete(u)
         x = self.positions(u)
         ev, ctrial = self.contact.evaluate(x, lam, committed.contact, guess.contact, want_K)

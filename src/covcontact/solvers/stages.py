@@ -106,6 +106,8 @@ class StageSpec:
     #: follower pressures (on the current faces, not in load_start / load_target): load key -> (value at lam = 0,
     #: at lam = 1)
     followers: dict = field(default_factory=dict)
+    #: the right-hand sides of the problem's equations (in its order) at lam = 0 and at lam = 1
+    equations: tuple = (np.zeros(0), np.zeros(0))
 
     @property
     def lam_end(self) -> float:
@@ -154,6 +156,12 @@ class StagePlan:
                                       loads, values, targets, motions, contacts, ()))
         self.stages[0].friction = {c.name: c.friction for c in problem.contacts if c.friction > 0.0}
         self.stages[0].ramp = bool(getattr(problem, "ramp", True))
+        eqs = list(getattr(problem, "equations", None) or [])
+        eq_start, eq_target = np.zeros(len(eqs)), np.array([float(getattr(e, "value", 0.0)) for e in eqs])
+        self.stages[0].equations = (eq_start, eq_target)
+        #: whether an equation has a right-hand side in some stage (the model then sets them at every evaluation)
+        self.equation_values = bool(np.any(eq_target)) or any(
+            e.name and e.name in st.targets for st in problem.stages for e in eqs)
         zero = np.zeros(3)
         self.stages[0].rigid_loads = {ref.name: (zero, ref.force, zero, ref.moment)
                                       for ref in getattr(system, "reference", [])}
@@ -194,6 +202,10 @@ class StagePlan:
             spec.friction = {**prev.friction, **getattr(st, "friction", {})}
             spec.applied_names = tuple(c.name for c in starting)
             spec.ramp = bool(getattr(st, "ramp", True))
+            eq_start = eq_start + lam_end * (eq_target - eq_start)
+            eq_target = np.array([float(st.targets[e.name]) if e.name and e.name in st.targets else eq_start[i]
+                                  for i, e in enumerate(eqs)])
+            spec.equations = (eq_start, eq_target)
             self.stages.append(spec)
         self.n_dofs = n_dofs
 
@@ -341,6 +353,12 @@ class Loading:
         if s.released.size or s.released_pairs or np.any(self.held):
             f = f + max(0.0, 1.0 - lam) * self.release + self.held
         return f
+
+    def equation_rhs(self, lam: float) -> np.ndarray:
+        """The right-hand sides of the problem's equations at lam (ramped as the loads are)."""
+        w = lam if self.spec.ramp else 1.0
+        b0, b1 = self.spec.equations
+        return b0 + w * (b1 - b0)
 
     def follower_values(self, lam: float) -> dict:
         """The follower pressures' values at lam (load key -> pressure), ramped as the other loads are."""
