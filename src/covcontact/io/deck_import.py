@@ -353,8 +353,8 @@ class _Writer(ContactMapping):
             # conditions on dofs free before (new ones, or released in an earlier step): they start in this step
             # from the displacement their dofs have then (FIXED: keep it)
             late = {key for key in bspec if s > 0 and (key not in names or key not in active)
-                    and (key[0] != "rigid" or key not in active)}
-            release = [names[key] for key in active if key not in bspec and key[0] != "rigid"]
+                    and (key[0] != "rigid" or key not in active) and key[0] != "shellsum"}
+            release = [names[key] for key in active if key not in bspec and key[0] not in ("rigid", "shellsum")]
             if any(key not in bspec and key[0] == "rigid" for key in active):
                 self.unsupported.append(f"{step.where}: *BOUNDARY, OP=NEW drops a rigid body's prescribed component")
             breaks = {period}
@@ -392,6 +392,14 @@ class _Writer(ContactMapping):
                 stage_name = f"step{s + 1}" + (f"_{j + 1}" if len(breaks) > 1 else "")
                 rigid_v, rigid_l, dist_l = {}, {}, {}
                 for key, spec in bspec.items():
+                    if key[0] == "shellsum":  # a shell node's mean (its equation's right-hand side 2 v: deck_shells)
+                        v = at(spec)
+                        if (s, j) == (0, 0):
+                            self.shells.sum_values[key[1:]] = 2.0 * v
+                        elif v != prev_b[key]:
+                            targets[f"shell{key[1]}_{_COMP[key[2]]}"] = 2.0 * v
+                        prev_b[key] = v
+                        continue
                     if key[0] == "rigid":  # a rigid body's REF or ROT node: its motion (DeckRigid)
                         if key in late or spec[1] is None:
                             self.unsupported.append(f"{where[key]}: a *BOUNDARY on a rigid body's REF or ROT node "
@@ -516,6 +524,11 @@ class _Writer(ContactMapping):
                 name = self._shell_set(labs)
                 for body, set_name in self._node_targets(name, labs, b.where):
                     key = (body, set_name, c)
+                    where.setdefault(key, b.where)
+                    out[key] = 0.0 if b.value is None else b.value
+            for lab in b.nodes[self.shells.is_shell(b.nodes)].tolist():  # (the means: their equations' values)
+                for c in (d - 1 for d in b.dofs if d <= 3 and d - 1 in self.shells.plan.get(lab, ((), ()))[1]):
+                    key = ("shellsum", lab, c)
                     where.setdefault(key, b.where)
                     out[key] = 0.0 if b.value is None else b.value
             if plain.size == 0:

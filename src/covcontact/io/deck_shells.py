@@ -194,6 +194,8 @@ class DeckShells:
         self._drilled: set = set()
         self._unused: set = set()
         self.equation_nodes: dict[int, set] = {}
+        #: (shell node label, component) -> the right-hand side 2 v of its mean's equation at the first stage's end
+        self.sum_values: dict[tuple, float] = {}
         if not m.shell_blocks:
             self.n = 0
             return
@@ -377,7 +379,8 @@ class DeckShells:
         over the run) onto its two layers, after CalculiX's gen3dboun (static steps, no knot):
 
         - a translation c of the shell node prescribes the mean of its expanded nodes (u_1 + u_3 = 2 u(n)): the mean
-          of the bottom and top node, u_b,c + u_t,c = 2 v;
+          of the bottom and top node, an equation u_b,c + u_t,c = 2 v whose right-hand side follows the deck's values
+          over the steps (``sum_values``: its first stage's, the later ones as stage targets);
         - a rotation about a tangent axis a fixes the mean rotation of the line of expanded nodes about a; with both
           tangent rotations fixed (a clamp) the line keeps its direction: the tangential components of u_t - u_b
           vanish (exact at any rotation), its thickness change stays free as in CalculiX; the drilling rotation
@@ -386,8 +389,9 @@ class DeckShells:
           along global axes and the translation normal to the plane fixed: then both layers hold that translation.
 
         Where the pair's component is held alike (a clamped or symmetric tangential component) both layers get the
-        *BOUNDARY (any value, amplitudes, later steps); the rest are homogeneous [[equation]]s, so their values must
-        be zero and they must hold from the first step on. Everything else is one line (DeckError)."""
+        *BOUNDARY (any value, amplitudes, later steps); the rest are [[equation]]s holding from the first step on:
+        the means with the deck's values, the rotations' differences at zero. Everything else is one line
+        (DeckError)."""
         m = self.m
         first = list(m.model_boundary) + (list(m.steps[0].boundary) if m.steps else [])
         dofs: dict[int, set] = {}
@@ -408,9 +412,11 @@ class DeckShells:
         for st in m.steps[1:]:
             for b in st.boundary:
                 for lab in b.nodes[self.is_shell(b.nodes)].tolist():
-                    both = self.plan.get(lab, (set(),))[0]
+                    both, sums = self.plan.get(lab, (set(), []))[:2]
                     extra = [d for d in b.dofs if d > 3 or d - 1 not in both]
-                    if extra and (set(b.dofs) - dofs.get(lab, set()) or b.value not in (None, 0.0) or b.fixed):
+                    valued = [d for d in extra if d > 3 or d - 1 not in sums]  # (a mean takes any value)
+                    if extra and (set(b.dofs) - dofs.get(lab, set()) or b.fixed
+                                  or (valued and b.value not in (None, 0.0))):
                         raise DeckError(f"{b.where}: *BOUNDARY on dof {extra[0]} of shell node {lab} in a later step: "
                                         f"a shell node's rotations and the translations its two layers share through "
                                         f"an equation are held from the first step on (model data or the first step), "
@@ -470,11 +476,6 @@ class DeckShells:
             sums = [c for c in T if c != i]
         else:
             sums = list(T)
-        bad = [c for c in sums if (lab, c + 1) in nonzero]
-        if bad:
-            raise DeckError(f"{nonzero[(lab, bad[0] + 1)]}: *BOUNDARY: a non-zero value on dof {bad[0] + 1} of shell "
-                            f"node {lab}: it prescribes the mean of the node's two layers, an inhomogeneous equation "
-                            f"covcontact does not have (zero, or with the node's rotations fixed, maps)")
         for row in diffs:
             if np.count_nonzero(np.abs(row) > 1e-14) > 1 and any((lab, c + 1) in nonzero for c in T):
                 raise DeckError(f"{where}: *BOUNDARY: non-zero values on shell node {lab} of a curved shell: not "
@@ -502,7 +503,9 @@ class DeckShells:
             body = int(self.label_body[lab])
             b, t = ref(body, f"_SN{lab}_b"), ref(body, f"_SN{lab}_t")
             for c in sums:
-                out.append({"name": f"shell{lab}_{comps[c]}", "terms": [[t, comps[c], 1.0], [b, comps[c], 1.0]]})
+                value = self.sum_values.get((lab, c), 0.0)
+                out.append({"name": f"shell{lab}_{comps[c]}", "terms": [[t, comps[c], 1.0], [b, comps[c], 1.0]]}
+                           | ({"value": value} if value else {}))
             rows = [np.asarray(r, dtype=float) for r in diffs]
             if len(rows) == 2:  # (two rows, their dependents distinct: eliminated with pivoting)
                 c1 = int(np.argmax(np.abs(rows[0])))
