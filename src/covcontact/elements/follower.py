@@ -112,13 +112,13 @@ class FollowerSet:
     pressure)."""
 
     def __init__(self, system, loads: dict):
-        from ..assembly.system import is_planar
+        from .planar import FORMULATIONS
 
         self.items = []  # (key, global face nodes, planar formulation or "", thickness, point factors or None)
         for key, load in loads.items():
             body = system.bodies[load.body]
             local = body.mesh.face_sets[load.set]
-            form = body.formulation if is_planar(body) else ""
+            form = body.formulation if getattr(body, "formulation", "solid") in FORMULATIONS else ""
             factor = point_factors(body.mesh.points, local, getattr(load, "profile", None), bool(form))
             self.items.append((key, np.ascontiguousarray(local + system.offset(load.body), dtype=np.int64), form,
                                float(body.options.get("thickness", 1.0)) if form else 1.0, factor))
