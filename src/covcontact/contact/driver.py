@@ -68,10 +68,11 @@ def _kkt_ok(d, t, sgn, tol):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol_first, min_cos, max_hops, use_dir, ndir, xyz,
-          rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge):  # fmt: skip
+def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol_first, tol_bnd, min_cos, max_hops, use_dir, ndir,
+          xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge):  # fmt: skip
     """Project on f, hand over across edges; returns (accepted facet or -1, g, nvis, nedge). f accepts a point up to
-    tol_first outside it, the facets handed over to up to tol_in.
+    tol_first outside it, and up to tol_bnd outside it across edges of the surface's boundary (no facet beyond); the
+    facets handed over to up to tol_in.
 
     Records every edge a projection left through in ``edges`` (for the blind-spot rule). Arrays come one by one,
     not in tuples: unpacking a tuple of arrays costs reference counts in this hottest loop.
@@ -90,7 +91,13 @@ def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol_first, min
         o1 = abs(xi[0]) - 1.0
         o2 = abs(xi[1]) - 1.0
         tol = tol_first if hop == 0 else tol_in
-        if o1 <= tol and o2 <= tol:
+        ea = 1 if xi[0] > 0.0 else 3  # edges 1 / 3 lie at xi1 = +1 / -1, edges 2 / 0 at xi2 = +1 / -1
+        eb = 2 if xi[1] > 0.0 else 0
+        inside = o1 <= tol and o2 <= tol
+        if not inside and hop == 0 and tol_bnd > tol:  # (beyond the boundary by less than tol_bnd: kept)
+            inside = (o1 <= tol or (o1 <= tol_bnd and nbr_facet[f, ea] < 0)) and \
+                (o2 <= tol or (o2 <= tol_bnd and nbr_facet[f, eb] < 0))
+        if inside:
             if status != 0 or not (g > -gmax[f]):
                 return -1, 0.0, nvis, nedge
             if use_dir:
@@ -98,8 +105,6 @@ def _walk(f, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol_first, min
                 if nrm[0] * ndir[0] + nrm[1] * ndir[1] + nrm[2] * ndir[2] < min_cos:
                     return -1, 0.0, nvis, nedge
             return f, g, nvis, nedge
-        ea = 1 if xi[0] > 0.0 else 3  # edges 1 / 3 lie at xi1 = +1 / -1, edges 2 / 0 at xi2 = +1 / -1
-        eb = 2 if xi[1] > 0.0 else 0
         for e, o in ((ea, o1), (eb, o2)):
             if o > tol and nedge < edges.shape[0]:
                 dup = False
@@ -281,10 +286,11 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
     xi_out (2,), n_out (3,). kind -1: no facet accepts the point, the caller tries the blind spot (``edges``).
 
     xi holds the previous contact point on pf on entry (when pf >= 0); fprm = (tol_inside, hysteresis, min_cos,
-    tol_keep): the previous facet accepts a projection up to tol_keep outside it.
+    tol_keep, tol_boundary): the previous facet accepts a projection up to tol_keep outside it, and up to
+    tol_boundary across the surface's boundary.
     At most 30 arguments: beyond that Python passes them as a tuple, which numba cannot inline.
     """
-    tol_in, hyst, min_cos, tol_keep = fprm
+    tol_in, hyst, min_cos, tol_keep, tol_bnd = fprm
     nvis = 0
     nedge = 0
     best_f = -1
@@ -321,8 +327,9 @@ def _project_one(xs, x, faces, nbr_facet, nbr_edge, lo, hi, cand_fac, c0, c1, pf
                     continue
             planar_start(x, faces, f0, xs, xi)
         tol = tol_keep if m < c0 else tol_in
-        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol, min_cos, max_hops, use_dir,
-                                  ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
+        tb = max(tol_bnd, tol) if m < c0 else tol_in
+        f, g, nvis, nedge = _walk(f0, xi, xs, x, faces, nbr_facet, nbr_edge, gmax, tol_in, tol, tb, min_cos, max_hops,
+                                  use_dir, ndir, xyz, rho, t1, t2, nrm, pc, pG, vis, nvis, edges, nedge)  # fmt: skip
         if f >= 0 and (best_f < 0 or abs(g) < abs(best_g)):
             best_f, best_g = f, g
             xi_out[0] = xi[0]
@@ -355,13 +362,13 @@ def project_slaves_kernel(xs, x, topo, lo, hi, cand_ptr, cand_fac, prev_facet, p
         xs: (ns, 3) slaves. x: (n, 3) nodes. topo: (faces, nbr_facet, nbr_edge, node_on_boundary,
             node_ptr, node_facets) of the surface. lo, hi: (nf, 3) facet boxes. cand_ptr, cand_fac:
             candidate CSR. prev_facet (ns,), prev_xi (ns, 2): last converged contact point, facet -1 for none.
-        prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops, tol_keep).
+        prm: (gmax (nf,), tol_inside, hysteresis, min_cos, max_hops, tol_keep, tol_boundary).
         nchunk: slaves are processed in nchunk parallel chunks (scratch allocated per chunk).
     """
     ns = xs.shape[0]
     faces, nbr_facet, nbr_edge = topo[0], topo[1], topo[2]
-    gmax, tol_in, hyst, min_cos, max_hops, tol_keep = prm
-    fprm = (tol_in, hyst, min_cos, tol_keep)
+    gmax, tol_in, hyst, min_cos, max_hops, tol_keep, tol_bnd = prm
+    fprm = (tol_in, hyst, min_cos, tol_keep, tol_bnd)
     nen = faces.shape[1]
     for ch in prange(nchunk):
         xyz = np.empty((nen, 3))
@@ -500,6 +507,7 @@ def project_slaves(
     max_hops: int = 4,
     boxes: tuple[np.ndarray, np.ndarray] | None = None,
     tol_keep: float | None = None,
+    tol_boundary: float | None = None,
 ) -> ProjectionResult:
     """Contact point of each slave on the whole master surface.
 
@@ -519,6 +527,9 @@ def project_slaves(
         max_hops: largest number of hand-overs across edges per walk.
         tol_keep: the previous facet accepts a projection up to this much outside it (element coordinates; default
             ``tol_inside``): a slave that sits on an edge keeps its facet while Newton moves it across by less.
+        tol_boundary: the previous facet accepts a projection up to this much outside it across an edge of the
+            surface's boundary (default ``tol_keep``): a slave resting on the master's free edge stays in contact
+            while Newton moves it across by less (else it drops out and comes back, and Newton cycles).
         boxes: facet boxes (lo, hi) if already computed for these positions.
     """
     x = np.ascontiguousarray(x_nodes, dtype=np.float64)
@@ -555,8 +566,9 @@ def project_slaves(
         surface.node_ptr,
         surface.node_facets,
     )
-    prm = (gm, float(tol_inside), float(hysteresis), float(min_cos), int(max_hops),
-           float(tol_inside if tol_keep is None else tol_keep))
+    keep = float(tol_inside if tol_keep is None else tol_keep)
+    prm = (gm, float(tol_inside), float(hysteresis), float(min_cos), int(max_hops), keep,
+           keep if tol_boundary is None else float(tol_boundary))
     cp = np.ascontiguousarray(cand_ptr, np.int64)
     cf = np.ascontiguousarray(cand_facets, np.int64)
     lo, hi = np.ascontiguousarray(lo), np.ascontiguousarray(hi)
