@@ -235,6 +235,28 @@ def test_thin_plate_keeps_the_penetrated_side():
     assert warm.facet[0] < 4 and warm.g[0] == pytest.approx(-0.7 * t)  # the side it came from
 
 
+def test_previous_facet_kept_just_beyond_the_free_edge():
+    """A slave in contact with a facet at the surface's free edge that Newton moves beyond it by less than
+    tol_boundary (element coordinates; the manager's 0.02) keeps that facet, its contact point on the facet's
+    continuation; beyond the band, or without a previous facet, or with tol_boundary 0 (the default), it has none.
+    Across an interior edge the neighbour takes over as before."""
+    x, faces = grid(np.linspace(0, 1, 3), np.linspace(0, 1, 3), lambda X, Y: 0 * X)
+    s = MeshSurface(faces)
+    h = 0.5  # (facet size: xi 1 + d means a distance d h / 2 beyond the edge x = 1)
+    xs = np.array([[1.0 + 0.005 * h / 2, 0.25, -0.01], [1.0 + 0.03 * h / 2, 0.25, -0.01]])
+    ptr, fac = candidates(x, s, xs, 0.5)
+    prev, pxi = np.array([2, 2]), np.array([[1.0, 0.0], [1.0, 0.0]])
+    r = project_slaves(x, s, xs, ptr, fac, prev, pxi, tol_boundary=0.02)
+    assert r.facet[0] == 2 and r.kind[0] == FACET and r.g[0] == pytest.approx(-0.01)
+    assert r.xi[0, 0] == pytest.approx(1.005) and r.kind[1] == NO_CONTACT
+    assert np.all(project_slaves(x, s, xs, ptr, fac, prev, pxi).kind == NO_CONTACT)
+    assert np.all(project_slaves(x, s, xs, ptr, fac, tol_boundary=0.02).kind == NO_CONTACT)
+    inner = np.array([[0.5 + 0.005 * h / 2, 0.25, -0.01]])  # past the interior edge between facets 0 and 2
+    ptr, fac = candidates(x, s, inner, 0.5)
+    r = project_slaves(x, s, inner, ptr, fac, np.array([0]), np.array([[1.0, 0.0]]), tol_boundary=0.02)
+    assert r.facet[0] == 2 and r.xi[0, 0] == pytest.approx(-0.995)
+
+
 def test_hysteresis_on_shared_edge():
     x, faces = grid(np.linspace(0, 1, 3), np.linspace(0, 1, 3), lambda X, Y: 0 * X)
     s = MeshSurface(faces)
