@@ -420,7 +420,7 @@ def test_resume_across_stages_is_exact(tmp_path, monkeypatch, stop_at):
     ('[[stages]]\nname = "a"\nrelease = ["pull"]\n[[stages]]\nname = "b"\ntargets = { pull = 0.1 }\n',
      "'pull' was released in stage 'a'"),
     ('[[stages]]\nname = "a"\nrelease = ["pull"]\ntargets = { pull = 0.1 }\n', "released and given a target"),
-    ('[[stages]]\nname = "a"\ntargets = { pul = 0.1 }\n', "no Dirichlet condition or load named 'pul'"),
+    ('[[stages]]\nname = "a"\ntargets = { pul = 0.1 }\n', "no Dirichlet condition, load or equation named 'pul'"),
     ('[[stages]]\nname = "a"\nmotions = { pull = { translation = [1.0, 0.0, 0.0] } }\n',
      "no rigid body or Dirichlet condition with a motion named 'pull'"),
     ('[[stages]]\nname = "pull"\n', "duplicate stage name 'pull'"),

@@ -40,6 +40,9 @@ _CASE_NAME = {v: k for k, v in CASES.items()}
 SELF_TOL_INSIDE = 1e-4
 #: frictional passes: how far outside its facet of the last Newton iterate (element coordinates) a slave keeps it
 KEEP_BAND = 0.02
+#: how far (element coordinates) beyond the master surface's free edge a slave keeps its facet of the last iterate:
+#: enough for a slave resting on that edge, which Newton moves across by a hair, far less than a slave sliding off
+BOUNDARY_BAND = 1e-3
 
 
 @dataclass
@@ -206,10 +209,11 @@ class ContactManager:
             # a frictional slave keeps its facet of the last iterate up to KEEP_BAND outside it (self-contact too): across a master edge
             # the friction history moves to the other facet's frame, and a slave resting on the edge (conforming meshes
             # pressed together) would cycle between the two (frictionless slaves have the edge locks instead)
-            # and every slave keeps its facet up to KEEP_BAND beyond the master's free edge: one resting on that edge
-            # (a tool as long as the sheet it presses) otherwise drops out and comes back, and Newton cycles
+            # and every slave keeps its facet up to BOUNDARY_BAND beyond the master's free edge: one resting on that
+            # edge (a tool as long as the sheet it presses) otherwise drops out and comes back, and Newton cycles
             res = project_slaves(xe, p.surface, xe[p.slaves], cand[0], cand[1], g0.facet, g0.xi,
-                                 tol_keep=KEEP_BAND if p.mu > 0.0 else None, tol_boundary=KEEP_BAND)
+                                 tol_keep=KEEP_BAND if p.mu > 0.0 else None,
+                                 tol_boundary=KEEP_BAND if p.mu > 0.0 else BOUNDARY_BAND)
         self.timing["projection"] += time.perf_counter() - t0
         if p.mu == 0.0 and not p.self_contact:
             t.edge_lock = self._hold(p, xe, res, g0)
