@@ -237,9 +237,9 @@ def test_thin_plate_keeps_the_penetrated_side():
 
 def test_previous_facet_kept_just_beyond_the_free_edge():
     """A slave in contact with a facet at the surface's free edge that Newton moves beyond it by less than
-    tol_boundary (element coordinates; the manager uses 1e-3, 0.02 with friction) keeps that facet, its contact point on the facet's
-    continuation; beyond the band, or without a previous facet, or with tol_boundary 0 (the default), it has none.
-    Across an interior edge the neighbour takes over as before."""
+    tol_boundary (element coordinates; the manager uses 1e-3, 0.02 with friction) keeps that facet, its contact point
+    on the facet's continuation; beyond the band, or without a previous facet, or with tol_boundary 0 (the default),
+    it has none. Across an interior edge the neighbour takes over as before."""
     x, faces = grid(np.linspace(0, 1, 3), np.linspace(0, 1, 3), lambda X, Y: 0 * X)
     s = MeshSurface(faces)
     h = 0.5  # (facet size: xi 1 + d means a distance d h / 2 beyond the edge x = 1)
