@@ -28,7 +28,9 @@ grouped by its keyword, e.g. ``*ELEMENT, TYPE=S8R`` or ``*BOUNDARY on dof 6``), 
 crashes (3: a bug; the last frame of traceback.txt) or timeout. For a deck that runs, the ``.dat`` blocks that both
 print at the same time are compared as benchmarks/ccx_decks.py compares them (its ``dat_blocks`` and matching): the
 largest difference over the block's largest CalculiX value, of U and of RF (where the deck prints none to the
-``.dat``: DISP and FORC of the two ``.frd`` files at the ends of the steps). covcontact is always geometrically
+``.dat``: DISP and FORC of the two ``.frd`` files at the ends of the steps, on the deck's own nodes: both codes
+number the expanded nodes of shells anew, each its own way; a deck of shells alone, whose files share no own node,
+on every label). covcontact is always geometrically
 nonlinear: a deck with a linear step (no NLGEOM) that differs by more than 1e-2 is run by CalculiX once more with
 NLGEOM added to its steps and compared with that run too.
 
@@ -477,9 +479,11 @@ def classify(code: int | None, err: str, run: Path, types: list[str] = ()) -> di
     return {"result": "other", "reason": f"exit {code}: " + (lines[-1] if lines else "")[:300]}
 
 
-def frd_blocks(path: Path) -> dict:
+def frd_blocks(path: Path, upto: int | None = None) -> dict:
     """The DISP and FORC blocks of an ASCII .frd (CalculiX's or covcontact's) in the form of ccx_decks' .dat blocks:
-    ("displacements" / "forces", "FRD", time) -> node label -> (3,)."""
+    ("displacements" / "forces", "FRD", time) -> node label -> (3,); with ``upto`` the nodes of labels up to it alone
+    (the deck's own: both codes number the expanded nodes of shells and planar elements after the deck's largest
+    label, each in its own way, so those labels name different nodes in the two files)."""
     from covcontact.io.frd import read_frd
 
     if not path.is_file():
@@ -487,10 +491,34 @@ def frd_blocks(path: Path) -> dict:
     try:
         sets = read_frd(path).sets
     except Exception:  # noqa: BLE001 (a file whose elements covcontact's reader does not know: its DISP blocks)
-        return frd_displacements(path.read_text(errors="replace"))
-    kinds = {"DISP": "displacements", "FORC": "forces"}
-    return {(kinds[s.name], "FRD", s.time): {k: np.asarray(v)[:3] for k, v in s.values.items()}
-            for s in sets if s.name in kinds}
+        blocks = frd_displacements(path.read_text(errors="replace"))
+    else:
+        kinds = {"DISP": "displacements", "FORC": "forces"}
+        blocks = {(kinds[s.name], "FRD", s.time): {k: np.asarray(v)[:3] for k, v in s.values.items()}
+                  for s in sets if s.name in kinds}
+    if upto is None:
+        return blocks
+    return {key: {k: v for k, v in b.items() if int(k) <= upto} for key, b in blocks.items()}
+
+
+def frd_compare(mine: Path, ref: Path, upto: int | None) -> list[dict]:
+    """compare_blocks of the two .frd files on the deck's own nodes (labels up to ``upto``); where they share none
+    (a deck of shells alone: both files hold only the expanded nodes), on every label, marked ``expanded``."""
+    blocks = compare_blocks(frd_blocks(mine, upto), frd_blocks(ref, upto)) if upto is not None else []
+    if blocks:
+        return blocks
+    return [dict(b, expanded=True) for b in compare_blocks(frd_blocks(mine), frd_blocks(ref))]
+
+
+def deck_labels_end(deck: Path) -> int | None:
+    """The largest node label the deck itself defines (None where covcontact's reader cannot read it)."""
+    from covcontact.io.deck_model import read_model
+
+    try:
+        labels = read_model(deck).node_labels
+    except Exception:  # noqa: BLE001 (refused decks: their .frd comparison does not happen)
+        return None
+    return int(labels.max()) if labels.size else None
 
 
 def _summarise_blocks(blocks: list[dict]) -> dict:
@@ -550,9 +578,9 @@ def run_deck(info: dict, root: Path, work_root: Path, args) -> dict:
     if dat.is_file() and row["result"] != "refused":
         blocks = compare(dat.read_text(errors="replace"), ref.read_text(errors="replace"))
         lacking = {"displacements", "forces"} - {b["kind"] for b in blocks}
+        upto = deck_labels_end(work / deck.name)
         if lacking:   # (U or RF not printed to the .dat: those of the .frd files, at the ends of the deck's steps)
-            blocks += [b for b in compare_blocks(frd_blocks(out / f"{job}.frd"), frd_blocks(work / f"{job}.frd"))
-                       if b["kind"] in lacking]
+            blocks += [b for b in frd_compare(out / f"{job}.frd", work / f"{job}.frd", upto) if b["kind"] in lacking]
         row["blocks"] = len(blocks)
         row["diff"] = _summarise_blocks(blocks)
         worst = max([v["rel_diff"] for k, v in row["diff"].items() if k in ("displacements", "forces")], default=None)
@@ -569,8 +597,7 @@ def run_deck(info: dict, root: Path, work_root: Path, args) -> dict:
             if c2["finishes"]:
                 nb = compare(dat.read_text(errors="replace"), (nl / f"{job}.dat").read_text(errors="replace"))
                 lacking = {"displacements", "forces"} - {b["kind"] for b in nb}
-                nb += [b for b in compare_blocks(frd_blocks(out / f"{job}.frd"), frd_blocks(nl / f"{job}.frd"))
-                       if b["kind"] in lacking]
+                nb += [b for b in frd_compare(out / f"{job}.frd", nl / f"{job}.frd", upto) if b["kind"] in lacking]
                 row["diff_vs_ccx_nlgeom"] = _summarise_blocks(nb)
     return row
 
