@@ -64,6 +64,13 @@ def _quad8_to_quad9(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
     return np.vstack([points, centre(points)]), np.concatenate([t, centre(t)]), np.hstack([cells, ids[:, None]])
 
 
+def _three_quads(corners: np.ndarray, mids: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """The three quad4 of each triangle (``corners`` (n, 3), ``mids`` (n, 3) the mid-points of its edges 0-1, 1-2,
+    2-0, ``centre`` (n,)): corner, mid-point of the next edge, centre, mid-point of the previous edge; (3 n, 4)."""
+    return np.stack([np.stack([corners[:, k], mids[:, k], centre, mids[:, (k + 2) % 3]], axis=1) for k in range(3)],
+                    axis=1).reshape(-1, 4)
+
+
 def _split_triangles(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
     """Each tri3 into three quad4 (corner, mid-point of the next edge, centroid, mid-point of the previous edge);
     the points, the thicknesses (interpolated linearly), the quads and the triangle of each quad."""
@@ -75,10 +82,7 @@ def _split_triangles(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
     def new(v):
         return np.concatenate([v, 0.5 * (v[unique[:, 0]] + v[unique[:, 1]]), v[cells].mean(axis=1)])
 
-    quads = np.stack([np.stack([cells[:, 0], mid[:, 0], centre, mid[:, 2]], axis=1),
-                      np.stack([cells[:, 1], mid[:, 1], centre, mid[:, 0]], axis=1),
-                      np.stack([cells[:, 2], mid[:, 2], centre, mid[:, 1]], axis=1)], axis=1).reshape(-1, 4)
-    return new(points), new(t), quads, np.repeat(np.arange(cells.shape[0]), 3)
+    return new(points), new(t), _three_quads(cells, mid, centre), np.repeat(np.arange(cells.shape[0]), 3)
 
 
 def _split_tri6(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
@@ -89,10 +93,7 @@ def _split_tri6(points: np.ndarray, t: np.ndarray, cells: np.ndarray):
     def centre(v):
         return -v[cells[:, :3]].sum(axis=1) / 9.0 + 4.0 * v[cells[:, 3:6]].sum(axis=1) / 9.0
 
-    c = points.shape[0] + np.arange(cells.shape[0])
-    quads = np.stack([np.stack([cells[:, 0], cells[:, 3], c, cells[:, 5]], axis=1),
-                      np.stack([cells[:, 1], cells[:, 4], c, cells[:, 3]], axis=1),
-                      np.stack([cells[:, 2], cells[:, 5], c, cells[:, 4]], axis=1)], axis=1).reshape(-1, 4)
+    quads = _three_quads(cells[:, :3], cells[:, 3:6], points.shape[0] + np.arange(cells.shape[0]))
     return (np.vstack([points, centre(points)]), np.concatenate([t, centre(t)]), quads,
             np.repeat(np.arange(cells.shape[0]), 3))
 
