@@ -627,15 +627,13 @@ class _Writer(ContactMapping):
     def _load_entry(self, key: tuple, name: str, v: float, nlgeom: bool = False) -> dict:
         """A load's entry; a face pressure given in a geometrically nonlinear step follows the faces (CalculiX and
         Abaqus apply pressures on the deformed faces with NLGEOM)."""
-        if key[0] == "dload" and nlgeom:
-            if self.body_forms.get(key[1]) == "plane_stress":
-                note = (f"{self.deck}: body {self.body_names[key[1]]}: a pressure with NLGEOM follows the plane stress "
-                        f"edges on their reference thickness (CalculiX's expanded elements: on the current one, a "
-                        f"difference of the order of nu times the strain)")
-                if note not in self.notes:
-                    self.notes.append(note)
-            return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v),
-                    "follower": True}
+        follower = key[0] == "dload" and nlgeom
+        if follower and self.body_forms.get(key[1]) == "plane_stress":
+            note = (f"{self.deck}: body {self.body_names[key[1]]}: a pressure with NLGEOM follows the plane stress "
+                    f"edges on their reference thickness (CalculiX's expanded elements: on the current one, a "
+                    f"difference of the order of nu times the strain)")
+            if note not in self.notes:
+                self.notes.append(note)
         if key[0] == "grav":
             return {"name": name, "body": self.body_names[key[1]], "cells": key[2],
                     "acceleration": self._load_value(key, v)}
@@ -643,7 +641,7 @@ class _Writer(ContactMapping):
             return {"name": name, "body": self.body_names[key[1]], "cells": key[2],
                     "centrifugal": {"omega": self._load_value(key, v), "axis": list(key[3]), "center": list(key[4])}}
         return {"name": name, "set": self._ref(key[1], key[2]), "value": self._load_value(key, v)} | (
-            {"distribution": "per_node"} if key[0] == "cload" else {})
+            {"distribution": "per_node"} if key[0] == "cload" else {}) | ({"follower": True} if follower else {})
 
     def _load_value(self, key: tuple, v: float):
         if key[0] == "centrif":  # a stage target of a spin is its angular velocity

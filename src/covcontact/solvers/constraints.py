@@ -34,8 +34,8 @@ class LinearConstraints:
     def __init__(self, equations, system, indices=None):
         n = system.n_dofs
         dep, rows, cols, vals = [], [], [], []
-        #: each equation's place in the problem's list (the right-hand sides come by it) and its first coefficient
         self.n = n
+        #: each equation's place in the problem's list (the right-hand sides come by it) and its first coefficient
         self.indices = np.arange(len(equations)) if indices is None else np.asarray(indices, dtype=np.int64)
         self.first = np.array([eq.terms[0][3] for eq in equations], dtype=float)
         for eq in equations:
