@@ -503,11 +503,41 @@ def frd_blocks(path: Path, upto: int | None = None) -> dict:
 
 def frd_compare(mine: Path, ref: Path, upto: int | None) -> list[dict]:
     """compare_blocks of the two .frd files on the deck's own nodes (labels up to ``upto``); where they share none
-    (a deck of shells alone: both files hold only the expanded nodes), on every label, marked ``expanded``."""
+    (a deck of shells alone: both files hold only the expanded nodes, numbered each in its own way), on the nodes
+    whose reference positions coincide (both codes expand a shell node along the same normal to its bottom and top
+    layer), marked ``expanded``."""
     blocks = compare_blocks(frd_blocks(mine, upto), frd_blocks(ref, upto)) if upto is not None else []
     if blocks:
         return blocks
-    return [dict(b, expanded=True) for b in compare_blocks(frd_blocks(mine), frd_blocks(ref))]
+    return [dict(b, expanded=True) for b in compare_blocks(*by_position(mine, ref))]
+
+
+def by_position(mine: Path, ref: Path) -> tuple[dict, dict]:
+    """(mine, ref) blocks of frd_blocks on the nodes of ``ref`` that have a node of ``mine`` at their reference
+    position (within 1e-6 of the model's size), mine's values under ref's labels; positions that two nodes of
+    ``ref`` share (a cut, a knot's layers) are left out."""
+    from scipy.spatial import cKDTree
+
+    from covcontact.io.frd import read_frd
+
+    a, b = frd_blocks(mine), frd_blocks(ref)
+    if not a or not b:
+        return {}, {}
+    try:
+        xa, xb = read_frd(mine).nodes, read_frd(ref).nodes
+    except Exception:  # noqa: BLE001 (elements the reader does not know: no positions)
+        return {}, {}
+    la, lb = np.array(sorted(xa)), np.array(sorted(xb))
+    pa, pb = np.array([xa[k] for k in la]), np.array([xb[k] for k in lb])
+    tol = 1e-6 * float(np.ptp(pb, axis=0).max())
+    dist, near = cKDTree(pa).query(pb)
+    shared = np.zeros(lb.size, dtype=bool)
+    pairs = cKDTree(pb).query_pairs(tol, output_type="ndarray")
+    shared[pairs.ravel()] = True
+    ok = (dist <= tol) & ~shared
+    match = dict(zip(lb[ok].tolist(), la[near[ok]].tolist()))
+    mapped = {key: {k: blk[v] for k, v in match.items() if v in blk} for key, blk in a.items()}
+    return mapped, {key: {k: v for k, v in blk.items() if k in match} for key, blk in b.items()}
 
 
 def deck_labels_end(deck: Path) -> int | None:

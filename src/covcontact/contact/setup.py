@@ -302,11 +302,15 @@ def make_pass(num: Numbering, name: str, slave, master, pair, tangent: str | Non
         xs = Xe[slaves] if pair.type == "sts" else X[slaves]
         p.tie_facet, p.tie_N = tie(Xe, p.surface, xs, pair.tie_tolerance)
         if not (p.tie_facet >= 0).any():
-            raise ValueError(f"contact {pair.name}: no slave point lies within the tie tolerance of the master "
+            raise ContactSetupError(f"contact {pair.name}: no slave point lies within the tie tolerance of the master "
                              f"surface; the surfaces do not meet: check the geometry or raise tie_tolerance")
     if p.augmented:
         p.gap_tol = pair.gap_tolerance if pair.gap_tolerance is not None else pair.gap_tolerance_relative * h
     return p
+
+
+class ContactSetupError(ValueError):
+    """A contact pair that cannot be set up as the input gives it (the model says it as an input error)."""
 
 
 def make_passes(num: Numbering, problem, tangent: str | None = None) -> list[Pass]:

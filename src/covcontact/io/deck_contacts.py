@@ -37,12 +37,18 @@ class ContactMapping:
                 raise DeckError(f"{where}: the master surface {master} must be an element surface (faces)")
             if self._on_skipped([master, slave], where):
                 continue
-            if quadratic_edges(self.m, master):
-                self.unsupported.append(f"{where}: the master surface {master} holds edges of S8/S8R elements: the side "
-                                        f"faces of their solid-shells have six nodes, a facet type covcontact has for "
-                                        f"slave surfaces only (swap slave and master, or use S4 elements there); with "
-                                        f"--ignore-unsupported the pair is left out")
+            edges = quadratic_edges(self.m, master)
+            if edges == "curved":
+                self.unsupported.append(f"{where}: the master surface {master} holds curved edges of S8/S8R elements: "
+                                        f"the side faces of their solid-shells have six nodes, a facet type covcontact "
+                                        f"has for slave surfaces only (swap slave and master, or use S4 elements "
+                                        f"there); with --ignore-unsupported the pair is left out")
                 continue
+            if edges == "straight":
+                self.notes.append(f"{where}: the master surface {master} holds straight edges of S8/S8R elements: "
+                                  f"each side face of their solid-shells is its two 4-node halves, exact in the "
+                                  f"reference configuration, the displacement along each half linear (the element's "
+                                  f"is quadratic along the edge)")
             mb = self._surface_body(master, mrefs, where)
             sk, sref = self.m.surfaces[slave]
             sts = kind in ("SURFACE TO SURFACE", "TIE") and sk == "ELEMENT"

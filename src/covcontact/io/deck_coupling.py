@@ -311,6 +311,7 @@ class DeckCouplings:
         self.stage_loads: list[dict] = []
         self._restate()
         kin = {int(cp.ref) for cp in _couplings(m) if cp.kind == "kinematic"}
+        kin |= {lab for lab, _ in rigid.knots.values()}  # (a knot's dofs 4-6 are its rotation in CalculiX too)
         self.rigid_refs = {lab for lab, (_, off) in rigid.by_label.items() if off == 0 and lab not in kin}
 
     def _restate(self) -> None:

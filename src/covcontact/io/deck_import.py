@@ -75,7 +75,7 @@ class _Writer(ContactMapping):
         self.notes += self.shells.notes
         self.unsupported += self.shells.unsupported
         self.body_names = self._body_names()
-        self.rigid = DeckRigid(m, self.b)
+        self.rigid = DeckRigid(m, self.b, self.shells)
         self.couplings = DeckCouplings(m, self.b, self.rigid, self.unsupported, self.notes, dialect)
         self._eq_removed: set[str] = set()   # the equations stages removed so far
         self.extra_nsets: dict[str, np.ndarray] = {}
@@ -84,7 +84,8 @@ class _Writer(ContactMapping):
         cell_of = np.concatenate([np.full(len(b[2]), b[1], dtype=object) for b in m.blocks] + [np.zeros(0, object)])
         faces = [(els, face, where, "S") for kind, refs in m.surfaces.values() if kind == "ELEMENT"
                  for els, face, where in refs]
-        faces += [(ld.elements, ld.dof, ld.where, "P") for st in m.steps for ld in st.loads if ld.kind == "dload"]
+        faces += [(ld.elements, ld.edge or ld.dof, ld.where, "EDNOR" if ld.edge else "P") for st in m.steps
+                  for ld in st.loads if ld.kind == "dload"]
         faces = [(els[self.shells.elements_body(els) < 0], face, where, letter) for els, face, where, letter in faces]
         for els, face, where, letter in faces:  # a face the element does not have: the line that names it
             idx = self.b.el_index[els[(els >= 0) & (els < self.b.el_index.size)]]
@@ -98,6 +99,9 @@ class _Writer(ContactMapping):
                     continue
                 raise DeckError(f"{where}: {'*SURFACE' if letter == 'S' else '*DLOAD'}: element {bad[0]} is not "
                                 f"defined")
+            if letter == "EDNOR" and idx.size:
+                raise DeckError(f"{where}: *DLOAD EDNOR{face} on element {int(els[0])}, a {cell_of[idx[0]]} element: "
+                                f"edge loads act on the edges of shell elements")
             for cell in set(cell_of[idx]):
                 if not 1 <= face <= NFACES[cell]:
                     raise DeckError(f"{where}: {letter}{face}: {cell} elements have the faces {letter}1..{letter}"
@@ -562,11 +566,21 @@ class _Writer(ContactMapping):
                             f"(CalculiX turns it into a mean rotation of the node's expansion)")
         if ld.kind == "dload" and self.shells.n and np.any(self.shells.elements_body(ld.elements) >= 0):
             sb = self.shells.elements_body(ld.elements)
-            side = self.shells.pressure_side(ld.dof, ld.where)
+            side = f"EDGE{ld.edge}" if ld.edge else self.shells.pressure_side(ld.dof, ld.where)
             for body in np.unique(sb[sb >= 0]):
-                name = f"_P{_name(ld.target)}_{side}"
-                self.shell_faces[name] = [(ld.elements[sb == body], side)]
-                yield ("dload", int(body), name, ld.dof)
+                els = ld.elements[sb == body]
+                if not ld.edge:
+                    name = f"_P{_name(ld.target)}_{side}"
+                    self.shell_faces[name] = [(els, side)]
+                    yield ("dload", int(body), name, ld.dof)
+                    continue
+                # (an edge load, force per length: the pressure on the solid-shell's side face is it over the
+                # thickness, CalculiX's replacement by a pressure on its expanded element's side)
+                t = self.shells.edge_thickness(els, ld.where)
+                for k, value in enumerate(np.unique(t)):
+                    name = f"_P{_name(ld.target)}_{side}" + (f"_{k + 1}" if k else "")
+                    self.shell_faces[name] = [(els[t == value], side)]
+                    yield ("dload", int(body), name, ld.dof, 1.0 / float(value))
             ld = replace(ld, elements=ld.elements[sb < 0])
             if not ld.elements.size:
                 return
@@ -648,6 +662,8 @@ class _Writer(ContactMapping):
             return float(np.sqrt(max(v, 0.0)))
         if key[0] == "grav":
             return [float(v) * d for d in key[3]]
+        if key[0] == "dload" and len(key) > 4:  # (a shell edge's load over the thickness)
+            return float(v) * key[4]
         if key[0] == "cload":
             vec = [0.0, 0.0, 0.0]
             vec[key[3]] = float(v) * (0.5 if key[1] >= self.b.n else 1.0)  # (a shell node: half on each layer)
@@ -703,17 +719,20 @@ class _Writer(ContactMapping):
     def write(self) -> Imported:
         self.mesh_path = self.out.with_suffix(".mesh.inp")
         self.shell_faces: dict = {}
-        for nodes, _, _, where in self.m.rigid_bodies:
-            if self.shells.n and np.any(self.shells.is_shell(nodes)):
-                raise DeckError(f"{where}: *RIGID BODY on shell node {int(nodes[self.shells.is_shell(nodes)][0])}: "
-                                f"not supported (a shell node is two nodes here, bottom and top)")
+        knot_labels = {lab for lab, _ in self.shells.knots.values()}
+        for r, (nodes, _, _, where) in enumerate(self.m.rigid_bodies):
+            hit = [int(n) for n in nodes if int(n) in knot_labels] if r not in self.shells.knots else []
+            if hit:
+                raise DeckError(f"{where}: *RIGID BODY on shell node {hit[0]}, a knot of the shell expansion (a rigid "
+                                f"body of its own): not supported")
         bodies = self._bodies_toml()
         self.shells.plan_boundaries()
         self.notes += [n for n in self.shells.notes if n not in self.notes]
         conds, stages = self._conditions()
         contacts = self._contacts() + self._equations()
-        bodies += self._shell_bodies_toml()
         rigid = "".join(_table("[[rigid]]", e) for e in self.rigid.entries(self.extra_nsets, self._ref))
+        bodies += self._shell_bodies_toml()  # (after the rigid bodies: their sets of shell nodes)
+        self.notes += self.rigid.notes
         springs = "".join(_table(kind, e) for kind, e in DeckSprings(self).entries())  # (SPRINGA, ..., DASHPOTA)
         springs += "".join(_table("[[mpc]]", e) for e in DeckMPCs(self).entries())  # (*MPC: deck_mpc)
         conds += "".join(_table("[[force]]", e) for e in self.couplings.entries(self.extra_nsets, self._ref))
@@ -810,6 +829,10 @@ class _Writer(ContactMapping):
             self.notes.append(f"{where}: *SECTION PRINT, SURFACE={name}: edges of planar elements ({', '.join(planar)}): "
                               f"not printed in the .dat (the reactions and contact forces are in covcontact's own "
                               f"results)")
+            return False
+        if name in self.m.shell_surfaces:  # (its faces are the solid-shells' faces of no deck element)
+            self.notes.append(f"{where}: *SECTION PRINT, SURFACE={name}: faces of shell elements: not printed in the "
+                              f".dat (the reactions and contact forces are in covcontact's own results)")
             return False
         return True
 

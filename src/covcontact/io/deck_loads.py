@@ -42,6 +42,7 @@ class Load:
     direction: tuple[float, float, float] | None = None   # GRAV: the unit direction (value: the magnitude)
     point: tuple[float, float, float] | None = None       # CENTRIF: a point of the axis (direction: the axis)
     delay: float = 0.0   # TIME DELAY: the amplitude read at t - delay
+    edge: int = 0        # EDNORk on shell elements: their edge k (force per length normal to it, in the shell)
 
 
 class LoadCards:
@@ -168,13 +169,16 @@ class LoadCards:
                     continue
                 if lab == "P":  # (a shell's pressure, without a face number: deck_shells; refused on solids)
                     lab = "P0"
+                edge = 0
+                if lab[:5] == "EDNOR" and lab[5:] in ("1", "2", "3", "4"):  # (a shell edge's load: deck_shells)
+                    edge, lab = int(lab[5:]), "P0"
                 if not (lab.startswith("P") and lab[1:].isdigit()):
-                    self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (face pressures P1..P6, GRAV and "
-                                              f"CENTRIF are read)")
+                    self.m.unsupported.append(f"{c.where(k)}: *DLOAD type {row[1]} (face pressures P1..P6, shell edge "
+                                              f"loads EDNOR1..EDNOR4, GRAV and CENTRIF are read)")
                     continue
                 ref = row[0].upper()
                 els = np.array([int(ref)], dtype=np.int64) if ref.isdigit() else self.m.element_set(ref)
                 if els is None:
                     raise c.fail(f"{row[0]!r} is neither an element label nor an *ELSET defined above", k)
                 st.loads.append(Load("dload", ref, int(lab[1:]), c.number(k, 2, row, "the magnitude"), c.where(k),
-                                     elements=els, amplitude=c.param("AMPLITUDE"), delay=self._delay(c)))
+                                     elements=els, amplitude=c.param("AMPLITUDE"), delay=self._delay(c), edge=edge))

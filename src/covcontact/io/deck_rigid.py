@@ -23,8 +23,10 @@ _NAMES = ("x", "y", "z", "rx", "ry", "rz")
 class DeckRigid:
     """The rigid bodies of a deck, their prescribed components and loads per covcontact stage."""
 
-    def __init__(self, m, parts):
-        self.m, self.b = m, parts
+    def __init__(self, m, parts, shells=None):
+        self.m, self.b, self.shells = m, parts, shells
+        #: the knots of shell expansions among the bodies (deck_shells): body -> (shell node label, drilling component)
+        self.knots = dict(shells.knots) if shells is not None else {}
         self.by_label: dict[int, tuple[int, int]] = {}   # REF / ROT node label -> (body, 0 or 3)
         index = m.node_index()
         for r, (nodes, ref, rot, where) in enumerate(m.rigid_bodies):
@@ -38,13 +40,17 @@ class DeckRigid:
                                     f"rigid body; give each body its own")
                 self.by_label[lab] = (r, off)
         # (a *COUPLING with *KINEMATIC: named after its CONSTRAINT NAME; its nodes may follow some components only)
-        self.names = coupling_names(m, [f"RIGID{r + 1}" for r in range(len(m.rigid_bodies))])
+        self.names = coupling_names(m, [f"KNOT{self.knots[r][0]}" if r in self.knots else f"RIGID{r + 1}"
+                                        for r in range(len(m.rigid_bodies))])
         self.components = coupled_components(m)
         # (a *KINEMATIC coupling of some dofs: the translations its nodes do not follow move nothing, they are held
         # where nothing prescribes them, as CalculiX leaves such a dof out)
         self.idle = {r: [c for c in range(3) if c not in comps] for r, comps in self.components.items()}
         for r in planar_couplings(m):  # (on planar elements: in the plane; tz is idle already, no node follows it)
             self.idle[r] = sorted(set(self.idle.get(r, [])) | {3, 4})
+        for r, (_, drill) in self.knots.items():  # (a knot on one line: its rotation about the line moves nothing)
+            if drill is not None:
+                self.idle[r] = [3 + drill]
         # each body's reference point: its REF NODE, or (without one: its translation can be neither prescribed nor
         # loaded) the centroid of its nodes
         self.origins = [m.X[index[ref]] if ref is not None else m.X[index[nodes]].mean(axis=0)
@@ -52,6 +58,7 @@ class DeckRigid:
         self.stage_values: list[dict] = []   # per covcontact stage: {(r, comp): prescribed value at its end}
         self.stage_loads: list[dict] = []    # per covcontact stage: {(r, comp): force or moment at its end}
         self.unsupported: list[str] = []
+        self.notes: list[str] = []
 
     def split(self, labels: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int]]]:
         """(the labels that are no rigid body's REF or ROT node, [(body, 0 or 3)] of those that are)."""
@@ -99,8 +106,11 @@ class DeckRigid:
                     break
             attach = []
             bodies = self.b.nodes_body(nodes)
-            own = nodes[(bodies >= 0) & ~np.isin(nodes, list(self.by_label))]
-            for k in np.unique(self.b.nodes_body(own)):
+            if self.shells is not None and self.shells.n:  # (a shell node: both its layers)
+                bodies = np.where(bodies >= 0, bodies, self.shells.nodes_body(nodes))
+            mine = (bodies >= 0) & ~np.isin(nodes, list(self.by_label))
+            own = nodes[mine]
+            for k in np.unique(bodies[mine]):
                 set_name = f"_RB{r + 1}"
                 node_sets[set_name] = own
                 attach.append(ref(int(k), set_name))
@@ -118,7 +128,11 @@ class DeckRigid:
             if free:
                 entry["free"] = free
             loads = [first_l.get((r, c), 0.0) for c in range(6)]
-            if any((r, c) in v for v in self.stage_loads for c in idle):
+            if r in self.knots and any((r, c) in v and v[(r, c)] for v in self.stage_loads for c in idle):
+                self.notes.append(f"{where}: a drilling moment (about the normal) on shell node {self.knots[r][0]}: "
+                                  f"dropped, as CalculiX drops it")
+                loads = [0.0 if c in idle else v for c, v in enumerate(loads)]
+            elif any((r, c) in v for v in self.stage_loads for c in idle):
                 self.unsupported.append(f"{where}: a *CLOAD on a translation of the REF NODE that the *KINEMATIC "
                                         f"coupling's nodes do not follow (it moves nothing)")
                 loads = [0.0 if c in idle else v for c, v in enumerate(loads)]

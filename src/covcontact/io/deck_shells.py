@@ -107,14 +107,31 @@ def read_shell_card(reader, c: Card) -> None:
     m.shell_sections.append((elset, material, thickness, _offset(c), c.where()))
 
 
-def quadratic_edges(m, name: str) -> bool:
+def quadratic_edges(m, name: str) -> str | None:
     """Whether the shell surface ``name`` holds edges (S3..S6) of S8 or S8R elements: the side faces of their 18-node
     solid-shells have six nodes, each taken as its two 4-node halves (mesh.shell), which serve slave surfaces (nodes
-    and their tributary areas), not masters (the halves' chords are not the edge's curve)."""
+    and their tributary areas). As a master they are exact where the edge is straight (its mid-side node on the chord
+    of its corners: "straight", the halves then are the side face's two halves, their displacement linear along the
+    edge where the element's is quadratic) and chords of a curved edge ("curved"); None: no such edges."""
     rows = m.shell_surfaces.get(name, [])
-    eight = [labs for t, _, labs, _ in m.shell_blocks if t in ("S8", "S8R")]
-    return any(side.startswith("EDGE") and any(np.intersect1d(labs, els).size for labs in eight)
-               for els, side, _ in rows)
+    eight = [(labs, c) for t, _, labs, c in m.shell_blocks if t in ("S8", "S8R")]
+    out = None
+    index = m.node_index()
+    for els, side, _ in rows:
+        if not side.startswith("EDGE"):
+            continue
+        k = int(side[4:]) - 1
+        for labs, conn in eight:
+            rows_here = conn[np.isin(labs, els)]
+            if not rows_here.size:
+                continue
+            out = "straight"
+            x = m.X[index[rows_here[:, [k, (k + 1) % 4, 4 + k]]]]   # (corner a, corner b, the mid-side node)
+            chord = x[:, 1] - x[:, 0]
+            off = np.cross(x[:, 2] - x[:, 0], chord)
+            if np.any(np.linalg.norm(off, axis=1) > 1e-6 * np.einsum("ij,ij->i", chord, chord)):
+                return "curved"
+    return out
 
 
 def shell_surface_row(reader, c: Card, k: int, row: list[str], name: str) -> bool:
@@ -181,7 +198,7 @@ class DeckShells:
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
 
-        from ..mesh.shell import ShellMeshError, _orient, extrude_surface, knots
+        from ..mesh.shell import ShellMeshError, extrude_surface
 
         self.m, self.parts, self.first, self.dialect = m, parts, parts.n, dialect
         self.notes: list[str] = []
@@ -194,8 +211,14 @@ class DeckShells:
         self._drilled: set = set()
         self._unused: set = set()
         self.equation_nodes: dict[int, set] = {}
+        self._thickness: dict[int, float | None] = {}
         #: (shell node label, component) -> the right-hand side 2 v of its mean's equation at the first stage's end
         self.sum_values: dict[tuple, float] = {}
+        #: knots (covcontact.io.deck_rigid): rigid body (its place in m.rigid_bodies) -> (the shell node's label, the
+        #: drilling component 0..2 held where the expansions lie on one line along a global axis, else None)
+        self.knots: dict[int, tuple[int, int | None]] = {}
+        #: the labels the knots' expansions get (after the deck's largest node label)
+        self._next = int(m.node_labels.max()) + 1 if m.node_labels.size else 1
         if not m.shell_blocks:
             self.n = 0
             return
@@ -234,6 +257,8 @@ class DeckShells:
         of_element = np.searchsorted(kinds, comp[:ne])
         self.n = kinds.size
         sections = self._sections(labels)
+        self._thickness = {e: sec[2] for e, sec in sections.items()}  # (element label -> its section's thickness)
+        forced = self._forced_knots(labels.size and np.unique(np.concatenate([c.ravel() for c in conn])))
         conn_rows = [row for c in conn for row in c]
         for j in range(self.n):
             mine = np.flatnonzero(of_element == j)
@@ -253,42 +278,26 @@ class DeckShells:
                 raise DeckError(f"{where[mine[0]]}: the shell part of element {int(labels[mine[0]])} has sections of "
                                 f"different OFFSETs ({', '.join(f'{o:g}' for o in sorted(offs))}): CalculiX makes knots "
                                 f"where they meet, covcontact's shell bodies have one offset")
-            t = np.zeros(nodes.size)
-            t_src: dict[int, str] = {}
-            for e, row in zip(mine, cells):
+            tc = np.zeros(cells.shape)  # (the thickness of each element at each of its nodes)
+            for r, (e, row) in enumerate(zip(mine, cells)):
                 sec = sections[int(labels[e])]
-                for i in row:
+                for q, i in enumerate(row):
                     lab = int(nodes[i])
                     if sec[2] is None:  # (NODAL THICKNESS on the section: the nodes' own, as CalculiX and Abaqus)
                         if lab not in m.nodal_thickness:
                             raise DeckError(f"{sec[4]}: *SHELL SECTION, NODAL THICKNESS: node {lab} of element "
                                             f"{int(labels[e])} has no *NODAL THICKNESS")
-                        t[i] = m.nodal_thickness[lab][0]
+                        tc[r, q] = m.nodal_thickness[lab][0]
                         continue
                     if lab in m.nodal_thickness and sec[4] not in self._unused:
                         self._unused.add(sec[4])
                         self.notes.append(f"{m.nodal_thickness[lab][1]}: *NODAL THICKNESS of node {lab}: its "
                                           f"elements' *SHELL SECTION ({sec[4]}) has no NODAL THICKNESS parameter, so "
                                           f"its thickness {sec[2]:g} holds (as in CalculiX and Abaqus)")
-                    if t[i] > 0.0 and t[i] != sec[2]:
-                        raise DeckError(f"{sec[4]}: node {lab} lies in shell sections of thickness {t[i]:g} "
-                                        f"({t_src[i]}) and {sec[2]:g}: CalculiX makes a knot there, covcontact's "
-                                        f"shells have one thickness per node (give it with *NODAL THICKNESS)")
-                    t[i], t_src[i] = sec[2], sec[4]
+                    tc[r, q] = sec[2]
             points = m.X[index[nodes]]
-            try:
-                found = knots(points, _orient(cells, cell), cell)
-            except ShellMeshError:
-                found = []  # (a surface that cannot be oriented is said by extrude_surface below)
-            if found:  # (CalculiX's knot: a rigid body of the node's expansions, one per normal; not here)
-                i, a, b, angle = found[0]
-                self.unsupported.append(
-                    f"{where[mine[a]]}: shell elements {int(labels[mine[a]])} and {int(labels[mine[b]])} meet at node "
-                    f"{int(nodes[i])} at {angle:.0f} degrees ({len(found)} such node{'s' if len(found) > 1 else ''}: a "
-                    f"junction or a crease beyond CalculiX's 20): CalculiX expands the node once per normal and joins "
-                    f"the expansions by a knot, covcontact's solid-shells have one director per node (the mean), which "
-                    f"bends such a junction; with --ignore-unsupported the mean is used. Mesh the junction with solid "
-                    f"elements, or refine a curved shell below 20 degrees between neighbours")
+            nodes, cells, points, t, knots_here = self._split_knots(nodes, cells, points, tc, cell, labels[mine],
+                                                                    forced)
             try:
                 mesh0 = extrude_surface(points, cell, cells, t, offs.pop())
             except ShellMeshError as exc:
@@ -296,6 +305,17 @@ class DeckShells:
             half = mesh0.points.shape[0] // 2
             d = mesh0.points[half: half + nodes.size] - mesh0.points[: nodes.size]
             d /= np.linalg.norm(d, axis=1)[:, None]
+            for lab, copies in knots_here:
+                self._knot(lab, nodes[copies], d[copies], forced.get(lab, where[mine[0]]))
+            if knots_here:
+                spread = sum(1 for lab, c in knots_here if c.size > 1)
+                self.notes.append(
+                    f"{where[mine[0]]}: {len(knots_here)} knot{'s' if len(knots_here) > 1 else ''} in the shell part "
+                    f"of element {int(labels[mine[0]])} ({spread} where its elements' normals differ by more than 20 "
+                    f"degrees or their thicknesses differ, {len(knots_here) - spread} for a moment or a non-zero "
+                    f"rotation): as in CalculiX each such node is expanded once per normal and the expansions are "
+                    f"joined by a rigid body whose reference is the node (its dofs 1-6 the body's translation and "
+                    f"rotation); CalculiX's knot may also expand uniformly, covcontact's holds the thickness there")
             flipped = self._flipped(cell, cells)
             if flipped.any():
                 if sections[int(labels[mine[0]])][3] != 0.0:
@@ -314,10 +334,91 @@ class DeckShells:
             self.bodies.append({"elements": labels[mine], "cell": cell, "cells": cells, "nodes": nodes,
                                 "points": points, "t": t, "offset": sections[int(labels[mine[0]])][3],
                                 "n": half, "d": d, "flipped": flipped, "sections": secs, "where": where[mine[0]]})
+            self._grow(int(nodes.max()) + 1)
             self.label_body[nodes] = self.first + j
             self.label_index[nodes] = np.arange(nodes.size)
             for e in labels[mine]:
                 self.el_body[int(e)] = self.first + j
+
+    def _grow(self, size: int) -> None:
+        """The label maps long enough for labels below ``size`` (the knots' expansions)."""
+        if size > self.label_body.size:
+            extra = size - self.label_body.size
+            self.label_body = np.concatenate([self.label_body, np.full(extra, -1, dtype=np.int64)])
+            self.label_index = np.concatenate([self.label_index, np.full(extra, -1, dtype=np.int64)])
+
+    def _forced_knots(self, shell_nodes: np.ndarray) -> dict[int, str]:
+        """Shell node label -> the card that gives it a non-zero rotation (*BOUNDARY, dofs 4-6) or a moment (*CLOAD,
+        dofs 4-6) in some step: a knot (CalculiX's dynamic steps make one; its static ones a mean rotation, which
+        leaves the thickness there free)."""
+        m = self.m
+        out: dict[int, str] = {}
+        for b in list(m.model_boundary) + [b for st in m.steps for b in st.boundary]:
+            if b.value not in (None, 0.0) and any(d >= 4 for d in b.dofs):
+                for lab in np.intersect1d(b.nodes, shell_nodes).tolist():
+                    out.setdefault(int(lab), b.where)
+        for st in m.steps:
+            for ld in st.loads:
+                if ld.kind == "cload" and ld.dof >= 4 and ld.value != 0.0:
+                    for lab in np.intersect1d(ld.nodes, shell_nodes).tolist():
+                        out.setdefault(int(lab), ld.where)
+        return out
+
+    def _split_knots(self, nodes, cells, points, tc, cell, rank, forced):
+        """The part's surface with every knot node expanded once per subset of its elements (normal within 20
+        degrees, the same thickness: mesh.shell.normal_clusters) and once at a node of ``forced``: (its node labels,
+        the expansions after the deck's with labels of their own; cells; points; thicknesses; [(knot label, its
+        expansions' places)])."""
+        from ..mesh.shell import _REVERSE, ShellMeshError, _orient, normal_clusters
+
+        try:
+            oriented = _orient(cells, cell)
+        except ShellMeshError:  # (extrude_surface says so)
+            t = np.zeros(nodes.size)
+            t[cells.ravel()] = tc.ravel()
+            return nodes, cells, points, t, []
+        turned = np.flatnonzero(np.any(oriented != cells, axis=1))
+        perm = _REVERSE[cell]
+        key = tc.copy()
+        key[turned] = tc[turned][:, perm]
+        sub = normal_clusters(points, oriented, cell, rank=rank, key=key)
+        given = sub.copy()
+        given[np.ix_(turned, perm)] = sub[turned]
+        knot = np.zeros(nodes.size, dtype=bool)
+        knot[cells[given > 0]] = True
+        knot |= np.isin(nodes, list(forced))
+        kept = np.flatnonzero(~knot)
+        node, subset = cells.ravel(), given.ravel()
+        at_knot = knot[node]
+        S = int(given.max()) + 1
+        pairs, inverse = np.unique(node[at_knot] * S + subset[at_knot], return_inverse=True)
+        new = np.full(nodes.size, -1, dtype=np.int64)
+        new[kept] = np.arange(kept.size)
+        flat = new[node]
+        flat[at_knot] = kept.size + inverse.ravel()
+        source = np.concatenate([kept, pairs // S])
+        labels = np.concatenate([nodes[kept], self._next + np.arange(pairs.size)])
+        self._next += pairs.size
+        t = np.zeros(source.size)
+        t[flat] = tc.ravel()
+        found = [(int(nodes[i]), kept.size + np.flatnonzero(pairs // S == i)) for i in np.flatnonzero(knot)]
+        return labels, flat.reshape(cells.shape), points[source], t, found
+
+    def _knot(self, lab: int, copies: np.ndarray, d: np.ndarray, where: str) -> None:
+        """Shell node ``lab`` as a knot: a rigid body (appended to the deck's *RIGID BODYs) of its expansions
+        ``copies`` (labels; ``d`` their directors) with the node as REF NODE. Expansions on one line leave the
+        rotation about it to nothing: held where the line is a global axis, else listed."""
+        drill = None
+        if np.all(np.linalg.norm(np.cross(d, d[0]), axis=1) < 1e-6):
+            k = int(np.argmax(np.abs(d[0])))
+            if abs(d[0][k]) < 1.0 - 1e-9:
+                self.unsupported.append(f"{where}: a moment or a non-zero rotation on shell node {lab}, whose normal "
+                                        f"{_vec(d[0])} is no global axis: its knot (a rigid body of the node's "
+                                        f"expansion along the normal) cannot hold the rotation about the normal; "
+                                        f"not supported")
+            drill = k
+        self.knots[len(self.m.rigid_bodies)] = (lab, drill)
+        self.m.rigid_bodies.append((np.asarray(copies, dtype=np.int64), lab, None, where))
 
     def _sections(self, labels: np.ndarray) -> dict:
         """element label -> its *SHELL SECTION (elset, material, thickness, offset, where); one line for an element
@@ -529,6 +630,17 @@ class DeckShells:
         return out
 
     # -- pressures ------------------------------------------------------------------------------------------------
+    def edge_thickness(self, elements: np.ndarray, where: str) -> np.ndarray:
+        """The thickness of each shell element of an edge load (its section's; NODAL THICKNESS: one line)."""
+        out = np.zeros(len(elements))
+        for k, e in enumerate(np.asarray(elements).tolist()):
+            t = self._thickness.get(int(e))
+            if t is None:
+                raise DeckError(f"{where}: *DLOAD EDNOR on shell element {e}, whose *SHELL SECTION has NODAL "
+                                f"THICKNESS: an edge load needs the element's thickness; give the section one")
+            out[k] = t
+        return out
+
     def pressure_side(self, face: int, where: str) -> str:
         """The face of a *DLOAD Pn on shells: CalculiX's P and P1 the negative face (pushing along the normal), P2
         the positive one; Abaqus' P the positive face (positive against the normal)."""
@@ -615,6 +727,7 @@ class DeckShells:
         """Labels of every shell body's mesh nodes in the .frd (CalculiX numbers its expanded nodes anew): from
         ``start`` on."""
         out = []
+        start = max(start, self._next)  # (after the knots' expansions)
         for info in self.bodies:
             out.append(start + np.arange(2 * info["n"]))
             start += 2 * info["n"]

@@ -162,22 +162,28 @@ def _directors(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndar
     return acc / np.where(size > 0.0, size, 1.0)[:, None]
 
 
+def _node_normals(points: np.ndarray, cells: np.ndarray, cell_type: str) -> np.ndarray:
+    """(ne, nen, 3): the unit normals of the cells at each of their nodes (x_xi x x_eta; a quad8 by its serendipity
+    surface, a triangle by the plane of its corners)."""
+    if cell_type == "quad8":  # (its serendipity surface, as quad9 with the centre node)
+        p9, _, c9 = _quad8_to_quad9(points, np.zeros(points.shape[0]), cells)
+        normal = _cell_normals(p9, c9, "quad9")[:, :8]
+    elif cell_type.startswith("tri"):  # (the plane of the corners)
+        x = points[cells]
+        flat = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+        normal = np.repeat(flat[:, None, :], cells.shape[1], axis=1)
+    else:
+        normal = _cell_normals(points, cells, cell_type)
+    return normal / np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-300)
+
+
 def knots(points: np.ndarray, cells: np.ndarray, cell_type: str, limit: float = 20.0) -> list[tuple[int, int, int,
                                                                                                      float]]:
     """The nodes where CalculiX's shell expansion makes a knot because the normals of the cells there spread: per
     node, the normals x_xi x x_eta of its cells at it (``cells`` oriented consistently), and a knot where one of them
     makes more than ``limit`` degrees with the first cell's (CalculiX's reference normal: the cells within 20 degrees
     of it share one normal, the others another). Returns (node, first cell, other cell, angle) per such node."""
-    if cell_type == "quad8":  # (its serendipity surface, as quad9 with the centre node)
-        points, _, cells = _quad8_to_quad9(points, np.zeros(points.shape[0]), cells)
-        cell_type = "quad9"
-    if cell_type.startswith("tri"):  # (the plane of the corners)
-        x = points[cells]
-        flat = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
-        normal = np.repeat(flat[:, None, :], cells.shape[1], axis=1)
-    else:
-        normal = _cell_normals(points, cells, cell_type)
-    normal /= np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-300)
+    normal = _node_normals(points, cells, cell_type)
     node, cell = cells.ravel(), np.repeat(np.arange(len(cells)), cells.shape[1])
     first = np.full(points.shape[0], -1, dtype=np.int64)
     order = np.argsort(cell, kind="stable")
@@ -192,6 +198,38 @@ def knots(points: np.ndarray, cells: np.ndarray, cell_type: str, limit: float = 
             out.append((int(node[k]), int(cell[first[node[k]]]), int(cell[k]),
                         float(np.degrees(np.arccos(np.clip(cos[k], -1.0, 1.0))))))
     return out
+
+
+def normal_clusters(points: np.ndarray, cells: np.ndarray, cell_type: str, rank=None, key=None,
+                    limit: float = 20.0) -> np.ndarray:
+    """CalculiX's subsets of the cells at each node (its shell expansion, gen3delem): the cell of lowest ``rank``
+    (its element label; default the cell's place) among those left is the reference, and the cells left whose normal
+    at the node lies within ``limit`` degrees of the reference's and whose ``key`` there (thickness, (ne, nen)) is the
+    same join its subset; repeated until no cell is left. ``cells`` oriented consistently. Returns (ne, nen): the
+    subset of each cell at each of its nodes, 0 the reference cell's; a node in more than one subset is a knot."""
+    ne, nen = cells.shape
+    rank = np.arange(ne) if rank is None else np.asarray(rank)
+    key = np.zeros((ne, nen)) if key is None else np.asarray(key, dtype=float)
+    normal = _node_normals(points, cells, cell_type).reshape(-1, 3)
+    node, flat_key = cells.ravel(), key.ravel()
+    occ = np.lexsort((np.repeat(rank, nen), node))  # (occurrences by node, then by the cell's rank)
+    starts = np.flatnonzero(np.r_[True, node[occ][1:] != node[occ][:-1]])
+    first = np.repeat(occ[starts], np.diff(np.r_[starts, occ.size]))  # (each occurrence's node's reference)
+    cos_limit = np.cos(np.radians(limit))
+    same = (np.einsum("ki,ki->k", normal[occ], normal[first]) >= cos_limit) & (flat_key[occ] == flat_key[first])
+    out = np.zeros(ne * nen, dtype=np.int64)
+    bad_nodes = np.unique(node[occ[~same]])
+    for v in bad_nodes:  # (only where one subset does not hold them all)
+        mine = occ[node[occ] == v]   # (by rank)
+        left = list(mine)
+        c = 0
+        while left:
+            ref = left[0]
+            take = [k for k in left if normal[k] @ normal[ref] >= cos_limit and flat_key[k] == flat_key[ref]]
+            out[take] = c
+            left = [k for k in left if k not in take]
+            c += 1
+    return out.reshape(ne, nen)
 
 
 def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thickness, offset="middle",
@@ -288,12 +326,21 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             if np.any(~up):
                 chosen.append(bottom_faces[sel[~up]])
         if chosen:
+            if len({c.shape[1] for c in chosen}) > 1:  # (hex18 faces beside edge halves: each as its four quarters)
+                chosen = [_quarters(c) if c.shape[1] == 9 else c for c in chosen]
             f = np.vstack(chosen)
             mesh.add_face_set(name, f)
             if name not in mesh.node_sets:
                 mesh.add_node_set(name, np.unique(f))
     mesh.shell_creases = creases  # (surface cells a, b, surface node, angle in degrees) per such node
     return mesh
+
+
+def _quarters(faces: np.ndarray) -> np.ndarray:
+    """Each 9-node face (corners, mid-side nodes, centre) as its four 4-node quarters, in its orientation: a face set
+    that also holds the 4-node halves of hex18 side faces (_edge_faces) is of one face type."""
+    q = np.array([[0, 4, 8, 7], [4, 1, 5, 8], [8, 5, 2, 6], [7, 8, 6, 3]])
+    return faces[:, q].reshape(-1, 4)
 
 
 #: the sides of a face set row that name a quad4 cell's edge k (from its corner k to corner k + 1, in the cell's node

@@ -13,6 +13,8 @@ import numpy as np
 from ..assembly.system import System
 from ..contact.assembly import CouplingPattern
 from ..contact.manager import ContactManager
+from ..contact.setup import ContactSetupError
+from ..io.validate import InputError
 from ..elements.follower import follower_set
 from ..elements.springs import add_blocks, spring_set
 from .stages import Loading, StagePlan
@@ -52,7 +54,10 @@ class Model:
         self._rigid_links = None
         self._mpcs = None
         self.tangent = tangent
-        self.contact = ContactManager(problem, self.system, tangent)
+        try:
+            self.contact = ContactManager(problem, self.system, tangent)
+        except ContactSetupError as exc:  # (a tie whose surfaces do not meet: the input's)
+            raise InputError(f"{problem.source or 'the problem'}: {exc}") from None
         self.symmetric = self.contact.symmetric and all(b.solid.symmetric_tangent for b in self.system.blocks)
         blocks = [b.cells + blk.offset for blk, body in zip(self.system.blocks, problem.bodies) for b in body.mesh.blocks]
         #: springs and dashpots (``covcontact.elements.springs``), None without: element blocks beside the bodies'

@@ -1,0 +1,180 @@
+"""Knots of shell decks (io/deck_shells.py; docs/input.md, "Abaqus and CalculiX decks"; docs/theory.md, section 25):
+where a shell node's elements disagree on the normal by more than 20 degrees or on the thickness, or where a moment or
+a non-zero rotation acts on it, the node is expanded once per subset of its elements and the expansions are joined by
+a rigid body whose reference is the node, as CalculiX's knot joins them. Checked against closed forms of beam theory
+(folded cantilevers, a strip rolled by its end rotation, an end moment) and against the subsets CalculiX's manual
+describes."""
+
+from __future__ import annotations
+
+import tomllib
+
+import numpy as np
+import pytest
+
+from covcontact.io.deck import DeckError
+from covcontact.io.deck_import import import_deck
+from covcontact.mesh.shell import normal_clusters
+from test_deck_shells import E, NU, _cli, _dat, _run_deck, _write, plate_deck
+
+#: the plate strip's bending stiffness per unit width, E t^3 / (12 (1 - nu^2)), of plate_deck's t = 0.1
+D = E * 0.1 ** 3 / (12.0 * (1.0 - NU ** 2))
+
+
+def folded(fold: float, kind: str = "S4", P: float = 1e-4) -> str:
+    """plate_deck's cantilever (L = 10, B = 8) folded about the line x = 5 by ``fold`` degrees (its second half rises
+    in the x-z plane), the tip force P along x."""
+    a = np.radians(fold)
+    out, in_cload = [], False
+    for line in plate_deck(kind, P=P).splitlines():
+        if line.startswith("*"):
+            in_cload = line.upper().startswith("*CLOAD")
+            out.append(line)
+            continue
+        f = line.split(", ")
+        if in_cload and len(f) == 3:
+            f[1] = "1"
+        elif len(f) == 4 and f[0].isdigit():
+            x = float(f[1])
+            if x > 5.0:
+                f[1], f[3] = repr(float(5.0 + (x - 5.0) * np.cos(a))), repr(float((x - 5.0) * np.sin(a)))
+        out.append(", ".join(f))
+    return "\n".join(out) + "\n"
+
+
+def test_subsets_as_calculix_makes_them():
+    """normal_clusters: at each node the lowest-ranked cell is the reference, the cells within 20 degrees of it and
+    of its thickness share its subset, the others make further subsets: an L junction (two subsets at the fold's
+    nodes), a T junction of three cells (the two flanges one subset, the web another), the Y junction of a honeycomb
+    (three walls at 120 degrees, whose normals cancel: three subsets), a 10 degree crease (one) and a step in
+    thickness on a flat plate (two)."""
+    L = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [1, 0, -1], [1, 1, -1.0]])
+    assert normal_clusters(L, np.array([[0, 1, 2, 3], [1, 4, 5, 2]]), "quad4").tolist() == [[0] * 4, [1, 0, 0, 1]]
+    T = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [2, 1, 0], [1, 0, -1], [1, 1, -1.0]])
+    cells = np.array([[0, 1, 2, 3], [1, 4, 5, 2], [1, 2, 7, 6]])
+    assert normal_clusters(T, cells, "quad4").tolist() == [[0] * 4, [0] * 4, [1, 1, 0, 0]]
+    assert normal_clusters(T, cells, "quad4", rank=[2, 1, 0]).tolist() == [[0, 1, 1, 0], [1, 0, 0, 1], [0] * 4]
+    ang = np.radians([90.0, 210.0, 330.0])
+    Y = np.vstack([[0, 0, 0], [0, 0, 1.0]] + [[[np.cos(a), np.sin(a), 0], [np.cos(a), np.sin(a), 1]] for a in ang])
+    cells = np.array([[0, 2, 3, 1], [0, 4, 5, 1], [0, 6, 7, 1]])
+    sub = normal_clusters(Y, cells, "quad4")
+    assert sorted(sub[:, 0].tolist()) == [0, 1, 2] and sub[:, 1:3].max() == 0
+    c = np.radians(10.0)
+    crease = np.vstack([L[:4], [[1 + np.cos(c), 0, -np.sin(c)], [1 + np.cos(c), 1, -np.sin(c)]]])
+    assert normal_clusters(crease, np.array([[0, 1, 2, 3], [1, 4, 5, 2]]), "quad4").max() == 0
+    flat = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [2, 1, 0.0]])
+    thick = np.array([[0.1] * 4, [0.2] * 4])
+    assert normal_clusters(flat, np.array([[0, 1, 2, 3], [1, 4, 5, 2]]), "quad4", key=thick).tolist() == \
+        [[0] * 4, [1, 0, 0, 1]]
+
+
+@pytest.mark.parametrize("fold, kind", [(90.0, "S4"), (90.0, "S8R"), (30.0, "S4")])
+def test_folded_cantilever_against_beam_theory(tmp_path, fold, kind):
+    """The cantilever folded by 90 or 30 degrees, the tip force P along x: its fold is a line of knots (its nodes'
+    elements' normals 90 or 30 degrees apart), which carry the moment around the corner. Beam theory with the plate's
+    stiffness D B (axial strains neglected), by the unit-load method over the two legs of length l = 5 at the angle a:
+    u_x = P sin^2 a (l^3 / 3 + l^3) / (D B), u_z = -P sin a (l^3 cos a / 3 + l^3 / 2 + l^3 cos a) / (D B). The tip's
+    mean within 3 % (measured +1.8 % .. +2.3 %; the flat cantilever plate against P L^3 / (3 D B): +4 %, CalculiX's
+    own S4 +2 %), and the knots are rigid bodies named after their nodes."""
+    dat, proc = _run_deck(tmp_path, folded(fold, kind), "fold")
+    assert proc.returncode == 0, proc.stderr
+    assert "knots in the shell part" in proc.stderr, proc.stderr
+    U = np.array(list(_dat(dat)["U"].values())).mean(axis=0)
+    a, l, P, B = np.radians(fold), 5.0, 1e-4, 8.0
+    ux = P * np.sin(a) ** 2 * (l ** 3 / 3 + l ** 3) / (D * B)
+    uz = -P * np.sin(a) * (l ** 3 * np.cos(a) / 3 + l ** 3 / 2 + l ** 3 * np.cos(a)) / (D * B)
+    assert U[0] == pytest.approx(ux, rel=3e-2)
+    assert U[2] == pytest.approx(uz, rel=3e-2)
+    imp = import_deck(tmp_path / "fold.inp", tmp_path / "i" / "fold.toml")
+    rigid = tomllib.loads(imp.problem.read_text())["rigid"]
+    ny = 4 if kind == "S4" else 8
+    assert len(rigid) == ny + 1 and all(r["name"].startswith("KNOT") for r in rigid)
+    assert all(r["free"] == ["x", "y", "z", "rx", "ry", "rz"] for r in rigid)
+    assert all(r["reference"][0] == pytest.approx(5.0) and r["reference"][2] == pytest.approx(0.0) for r in rigid)
+
+
+@pytest.mark.parametrize("kind", ["S4", "S8R"])
+def test_prescribed_end_rotation_rolls_a_circular_arc(tmp_path, kind):
+    """A strip (L = 10, B = 1) clamped at x = 0 whose tip nodes are turned by theta = 1 about y (*BOUNDARY dof 5,
+    NLGEOM), their translations free: each tip node is a knot (a rigid body of its expansion, the rotation about the
+    normal held) and the strip, loaded by nothing but the end rotation, bends into a circular arc of radius L / theta:
+    u_x = L (sin theta / theta - 1), u_z = -L (1 - cos theta) / theta, within 1 % (measured 0.5 % and 0.3 %; CalculiX's
+    mean rotation of the same deck: 1.2 % S4, 0.5 % S8R)."""
+    text = plate_deck(kind, nx=10, ny=1, B=1.0, loads=False).replace("*STEP\n*STATIC\n",
+                                                                     "*STEP, NLGEOM\n*STATIC\n0.25, 1.0\n")
+    text = text.replace("*NODE PRINT, NSET=TIP", "*BOUNDARY\nTIP, 5, 5, 1.0\n*NODE PRINT, NSET=TIP")
+    dat, proc = _run_deck(tmp_path, text, "roll")
+    assert proc.returncode == 0, proc.stderr
+    assert "for a moment or a non-zero rotation" in proc.stderr
+    L, theta = 10.0, 1.0
+    for u in _dat(dat)["U"].values():
+        assert u[0] == pytest.approx(L * (np.sin(theta) / theta - 1.0), rel=1e-2)
+        assert u[2] == pytest.approx(-L * (1.0 - np.cos(theta)) / theta, rel=1e-2)
+
+
+def test_end_moment_on_shell_nodes(tmp_path):
+    """A moment (*CLOAD dof 5) on the tip nodes of the strip (B / t = 10): each a knot carrying its share. The tip
+    deflection M L^2 / (2 K) lies between the plate's (K = D B) and the beam's (K = E B t^3 / 12) closed forms (the
+    strip's free edges let it bend partly as a beam): measured within 0.6 % of the beam's."""
+    text = plate_deck("S4", nx=10, ny=1, B=1.0, loads=False)
+    text = text.replace("*NODE PRINT, NSET=TIP", "*CLOAD\nTIP, 5, 5.0e-5\n*NODE PRINT, NSET=TIP")
+    dat, proc = _run_deck(tmp_path, text, "moment")
+    assert proc.returncode == 0, proc.stderr
+    M, L = 1e-4, 10.0
+    plate, beam = M * L ** 2 / (2 * D), M * L ** 2 / (2 * E * 0.1 ** 3 / 12)
+    for u in _dat(dat)["U"].values():
+        assert plate < -u[2] < beam * 1.01
+
+
+def test_step_in_thickness_is_a_knot(tmp_path):
+    """Two sections of different thickness meeting on a flat plate: CalculiX's subsets differ by thickness too, so the
+    nodes of the line where they meet are knots (before, a refusal); a moment about the normal on a knot on one line
+    is dropped with a note, as CalculiX drops it."""
+    section = ("*ELSET, ELSET=A\n" + ", ".join(str(k) for k in range(1, 41) if (k - 1) % 10 < 5)
+               + "\n*ELSET, ELSET=B\n" + ", ".join(str(k) for k in range(1, 41) if (k - 1) % 10 >= 5)
+               + "\n*SHELL SECTION, ELSET=A, MATERIAL=STEEL\n0.1\n*SHELL SECTION, ELSET=B, MATERIAL=STEEL\n0.08")
+    dat, proc = _run_deck(tmp_path, plate_deck(section=section), "step")
+    assert proc.returncode == 0, proc.stderr
+    assert "5 knots in the shell part" in proc.stderr
+    thin = plate_deck(section="*SHELL SECTION, ELSET=PLATE, MATERIAL=STEEL\n0.08")
+    dat_thin, proc = _run_deck(tmp_path, thin, "thin")
+    thick = _dat(dat_thin)["U"][55][2]
+    full = _dat(_run_deck(tmp_path, plate_deck(), "full")[0])["U"][55][2]
+    w = _dat(dat)["U"][55][2]
+    assert full < w < thick  # (half of it thinner: between the two uniform plates)
+    drill = plate_deck(section=section).replace("*NODE PRINT, NSET=TIP", "*CLOAD\n6, 6, 1e-5\n*NODE PRINT, NSET=TIP")
+    dat_d, proc = _run_deck(tmp_path, drill, "drill")
+    assert proc.returncode == 0, proc.stderr
+    assert "a drilling moment (about the normal) on shell node 6: dropped" in proc.stderr
+    assert _dat(dat_d)["U"][55][2] == pytest.approx(w, rel=1e-9)
+
+
+def test_rigid_body_on_shell_nodes_and_refusals(tmp_path):
+    """A *RIGID BODY of shell nodes holds both layers of each (the tip of the cantilever plate as a rigid cap loaded
+    through its REF NODE: its deflection is the plate's under the same force, stiffer by the cap); a *RIGID BODY that
+    holds a knot's node, or a moment on a knot on one line whose normal is no global axis, is one line (exit 2)."""
+    cap = plate_deck(loads=False).replace("*MATERIAL", "*NODE\n999, 10.0, 4.0, 0.0\n*RIGID BODY, NSET=TIP, "
+                                          "REF NODE=999\n*MATERIAL").replace("*NODE PRINT, NSET=TIP",
+                                                                             "*CLOAD\n999, 3, 1e-4\n*NODE PRINT, NSET=TIP")
+    dat, proc = _run_deck(tmp_path, cap, "cap")
+    assert proc.returncode == 0, proc.stderr
+    free = _dat(_run_deck(tmp_path, plate_deck(), "free")[0])["U"]
+    capped = _dat(dat)["U"]
+    w = np.array([capped[k][2] for k in sorted(free)])
+    assert np.allclose(w, w[0], rtol=1e-6) and 0.97 * free[33][2] < w[0] < free[33][2]
+    bad = folded(90.0).replace("*MATERIAL", "*NODE\n999, 5.0, 4.0, 0.0\n*RIGID BODY, NSET=M, REF NODE=999\n*MATERIAL")
+    bad = bad.replace("*NSET, NSET=TIP", "*NSET, NSET=M\n6, 17\n*NSET, NSET=TIP")
+    with pytest.raises(DeckError, match="RIGID BODY on shell node 6, a knot of the shell expansion"):
+        import_deck(_write(tmp_path / "bad.inp", bad), tmp_path / "b" / "bad.toml")
+    a = np.radians(30.0)
+    tilted = []
+    for line in plate_deck(nx=10, ny=1, B=1.0, loads=False).splitlines():
+        f = line.split(", ")
+        if len(f) == 4 and f[0].isdigit() and not line.startswith("*"):
+            x = float(f[1])
+            f[1], f[3] = repr(float(x * np.cos(a))), repr(float(x * np.sin(a)))
+        tilted.append(", ".join(f))
+    text = "\n".join(tilted).replace("*NODE PRINT, NSET=TIP", "*CLOAD\nTIP, 5, 1e-5\n*NODE PRINT, NSET=TIP") + "\n"
+    proc = _cli(["run", _write(tmp_path / "tilt.inp", text), "--out", tmp_path / "t", "--quiet"])
+    assert proc.returncode == 2
+    assert "is no global axis: its knot" in proc.stderr, proc.stderr
