@@ -526,3 +526,49 @@ def test_s8_edges_as_master(tmp_path):
     assert "the master surface SHELLEDGE holds curved edges of S8/S8R elements" in proc.stderr, proc.stderr
 
 
+
+
+#: produced by running CalculiX 2.20 (Debian's ccx) on test_edge_load_ednor's decks: u_x of the tip's corner node
+#: (11 of the S4 plate, 21 of the S8R plate) under EDNOR2 = -1 on the tip elements' edges
+_CCX_EDNOR_TIP_X = {"S4": 4.713240e-04, "S8R": 4.717399e-04}
+
+
+@pytest.mark.parametrize("kind", ["S4", "S8R"])
+def test_edge_load_ednor(tmp_path, kind):
+    """*DLOAD EDNOR2 (force per length normal to the edge, in the shell; positive pushing into the element, as a
+    pressure) on the tip edges of the cantilever plate: a pressure -1 / t on the solid-shells' side faces there. The
+    tip's u_x equals CalculiX's to 1e-4 (measured 7e-5 S4, 2e-5 S8R: on S8R's six-node side faces, taken as their two
+    4-node halves, the pressure is weighted 0 at the corners and 2 at the mid-side nodes, so that the nodal forces are
+    the quadratic edge's 1/6, 2/3, 1/6; uniform on the halves, 1/4, 1/2, 1/4, the corner moved 8 % more) and the
+    deflection of the same load given as those consistent nodal forces (*CLOAD) to 1e-6."""
+    els = "\n".join(f"{k}, EDNOR2, -1.0" for k in (10, 20, 30, 40))
+    text = plate_deck(kind, loads=False, fix="1, 3").replace("*NODE PRINT, NSET=TIP",
+                                                             f"*DLOAD\n{els}\n*NODE PRINT, NSET=TIP")
+    dat, proc = _run_deck(tmp_path, text, "ednor")
+    assert proc.returncode == 0, proc.stderr
+    U = _dat(dat)["U"]
+    corner = 11 if kind == "S4" else 21
+    assert U[corner][0] == pytest.approx(_CCX_EDNOR_TIP_X[kind], rel=1e-4)
+    tip = sorted(U)
+    h = 8.0 / 4  # (the tip elements' edge length)
+    shares = (0.5, 0.5) if kind == "S4" else (1 / 6, 2 / 3, 1 / 6)
+    w: dict[int, float] = {}
+    step = len(shares) - 1
+    for k in range(4):
+        for n, s in zip(tip[step * k: step * k + len(shares)], shares, strict=True):
+            w[n] = w.get(n, 0.0) + s * h
+    cl = "\n".join(f"{n}, 1, {v:.12e}" for n, v in w.items())
+    ref = plate_deck(kind, loads=False, fix="1, 3").replace("*NODE PRINT, NSET=TIP", f"*CLOAD\n{cl}\n*NODE PRINT, "
+                                                                                      f"NSET=TIP")
+    dat_ref, proc = _run_deck(tmp_path, ref, "cload")
+    assert proc.returncode == 0, proc.stderr
+    for n in tip:
+        np.testing.assert_allclose(U[n], _dat(dat_ref)["U"][n], rtol=1e-6, atol=1e-9)
+
+
+def test_edge_load_on_a_solid_is_one_line(tmp_path):
+    text = TIED_EDGE.replace("*STATIC\n1.0, 1.0\n", "*STATIC\n1.0, 1.0\n*DLOAD\n1, EDNOR1, 1.0\n")
+    deck = _write(tmp_path / "e.inp", text)
+    proc = _cli(["run", deck, "--out", tmp_path / "e", "--quiet"])
+    assert proc.returncode == 2 and "EDNOR1 on element 1, a hex8 element: edge loads act on the edges of shell" \
+        in proc.stderr, proc.stderr

@@ -260,12 +260,13 @@ class System:
         faces = mesh.face_sets[load.set]
         off = self.offset(load.body)
         body = self.bodies[load.body]
-        if isinstance(load, Pressure) and load.profile is not None:  # (varying over the faces: the follower
-            # pressure's forces at the reference positions are the dead pressure's)
+        weights = mesh.face_weights.get(load.set)
+        if isinstance(load, Pressure) and (load.profile is not None or weights is not None):  # (varying over the
+            # faces: the follower pressure's forces at the reference positions are the dead pressure's)
             from ..elements.follower import edge_blocks, face_blocks, point_factors
 
             p, planar = float(value.reshape(-1)[0]), is_planar(body)
-            factor = point_factors(mesh.points, faces, load.profile, planar)
+            factor = point_factors(mesh.points, faces, load.profile, planar, weights)
             R = (edge_blocks(mesh.points, faces, p, body.formulation, float(body.options.get("thickness", 1.0)),
                              False, factor) if planar else face_blocks(mesh.points, faces, p, False, factor))[0]
             np.add.at(f, faces.ravel() + off, -R.reshape(-1, 3))

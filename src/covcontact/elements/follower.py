@@ -49,14 +49,21 @@ def _rule(nfn: int, planar: bool):
     return N, dN, w
 
 
-def point_factors(X: np.ndarray, faces: np.ndarray, profile, planar: bool = False) -> np.ndarray | None:
+def point_factors(X: np.ndarray, faces: np.ndarray, profile, planar: bool = False,
+                  weights: np.ndarray | None = None) -> np.ndarray | None:
     """The factor c + g . X_g of a pressure's ``profile`` (c, gx, gy, gz) at each integration point of the faces
-    (or edges), X_g the point's reference position; None without a profile (a uniform pressure)."""
-    if profile is None:
+    (or edges), X_g the point's reference position, times the interpolated nodal ``weights`` (nf, nfn) of faces that
+    are pieces of larger ones (``Mesh.face_weights``); None without either (a uniform pressure)."""
+    if profile is None and weights is None:
         return None
     N = _rule(faces.shape[1], planar)[0]
-    Xg = np.einsum("pa,fai->fpi", N, X[faces])
-    return float(profile[0]) + Xg @ np.asarray(profile[1:], dtype=float)
+    out = 1.0
+    if profile is not None:
+        Xg = np.einsum("pa,fai->fpi", N, X[faces])
+        out = float(profile[0]) + Xg @ np.asarray(profile[1:], dtype=float)
+    if weights is not None:
+        out = out * (weights @ N.T)
+    return out
 
 
 def face_blocks(x: np.ndarray, faces: np.ndarray, p: float, want_K: bool = True, factor: np.ndarray | None = None):
@@ -119,7 +126,8 @@ class FollowerSet:
             body = system.bodies[load.body]
             local = body.mesh.face_sets[load.set]
             form = body.formulation if getattr(body, "formulation", "solid") in FORMULATIONS else ""
-            factor = point_factors(body.mesh.points, local, getattr(load, "profile", None), bool(form))
+            factor = point_factors(body.mesh.points, local, getattr(load, "profile", None), bool(form),
+                                   body.mesh.face_weights.get(load.set))
             self.items.append((key, np.ascontiguousarray(local + system.offset(load.body), dtype=np.int64), form,
                                float(body.options.get("thickness", 1.0)) if form else 1.0, factor))
 

@@ -57,6 +57,10 @@ class Mesh:
     face_groups: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
     #: the cell blocks of a mixed mesh (``cell_type == "mixed"``): (cell type, cells) in element order
     mixed_blocks: list[tuple[str, np.ndarray]] = field(default_factory=list, repr=False)
+    #: nodal weights (nface, nodes per face) of a pressure on face sets whose faces are pieces of larger faces
+    #: (mesh.shell: the 4-node halves of a hex18's six-node side face, the quarters of a 9-node face), so that a
+    #: uniform pressure on the pieces gives the whole face's consistent nodal forces
+    face_weights: dict[str, np.ndarray] = field(default_factory=dict, repr=False)
 
     def __post_init__(self) -> None:
         self.points = np.ascontiguousarray(self.points, dtype=np.float64)

@@ -326,14 +326,30 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             if np.any(~up):
                 chosen.append(bottom_faces[sel[~up]])
         if chosen:
+            pieces = surface_type == "quad8" and any(side in EDGE_SIDES for _, side in rows)
+            weights = []
             if len({c.shape[1] for c in chosen}) > 1:  # (hex18 faces beside edge halves: each as its four quarters)
+                weights = [_QUARTER_WEIGHT * (_quarters(c) == np.repeat(c[:, 8], 4)[:, None]) if c.shape[1] == 9
+                           else None for c in chosen]
                 chosen = [_quarters(c) if c.shape[1] == 9 else c for c in chosen]
             f = np.vstack(chosen)
             mesh.add_face_set(name, f)
+            if pieces:  # (a uniform pressure on the pieces: the consistent forces of the six-node side faces)
+                mid = np.zeros(2 * n, dtype=bool)
+                mid[np.concatenate([given[:, 4:8].ravel(), given[:, 4:8].ravel() + n])] = True
+                weights = weights or [None] * len(chosen)
+                mesh.face_weights[name] = np.vstack([2.0 * mid[c] if w is None else w
+                                                     for c, w in zip(chosen, weights)])
             if name not in mesh.node_sets:
                 mesh.add_node_set(name, np.unique(f))
     mesh.shell_creases = creases  # (surface cells a, b, surface node, angle in degrees) per such node
     return mesh
+
+
+#: the nodal weight of the centre of each quarter of a 9-node face (_quarters; 0 at its other nodes) under which a
+#: uniform pressure gives the 9-node face's consistent nodal forces (corners 1/36, mid-sides 1/9, centre 4/9 of the
+#: force on a flat face)
+_QUARTER_WEIGHT = 4.0
 
 
 def _quarters(faces: np.ndarray) -> np.ndarray:
@@ -357,7 +373,6 @@ def _edge_faces(name, side, given, surface_type, cell_of, ids, points) -> np.nda
     if surface_type not in ("quad4", "quad8"):
         raise ShellMeshError(f"face set {name!r}: {side} names an edge of a quad4 or quad8 shell cell (a deck's S4, "
                              f"S4R, S8, S8R); these cells are {surface_type}")
-    n = points.shape[0] // 2
     k = EDGE_SIDES.index(side)
     corners = given[:, :4]
     count: dict = {}
