@@ -132,13 +132,22 @@ class FollowerSet:
                                float(body.options.get("thickness", 1.0)) if form else 1.0, factor))
 
     def blocks(self, x: np.ndarray, values: dict, want_K: bool = True) -> list:
-        out = []
+        """One block per kind of face (or edge) and thickness: the loads' pressures folded into the point factors, so
+        that a deck's hundreds of one-face pressures cost one call."""
+        groups: dict = {}
         for key, faces, form, t, factor in self.items:
             p = float(values.get(key, 0.0))
             if p == 0.0:
                 continue
-            R, K = (edge_blocks(x, faces, p, form, t, want_K, factor) if form
-                    else face_blocks(x, faces, p, want_K, factor))
+            n_points = _rule(faces.shape[1], bool(form))[2].size
+            f = p * (np.ones((faces.shape[0], n_points)) if factor is None else factor)
+            groups.setdefault((form, t, faces.shape[1]), []).append((faces, f))
+        out = []
+        for (form, t, _), parts in groups.items():
+            faces = np.concatenate([f for f, _ in parts]) if len(parts) > 1 else parts[0][0]
+            factor = np.concatenate([c for _, c in parts]) if len(parts) > 1 else parts[0][1]
+            R, K = (edge_blocks(x, faces, 1.0, form, t, want_K, factor) if form
+                    else face_blocks(x, faces, 1.0, want_K, factor))
             out.append((faces, R, K))
         return out
 

@@ -15,6 +15,8 @@ Evaluated in numpy: the elements call them once, at their integration points.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .quadrature import gauss_1d, gauss_tensor
@@ -201,9 +203,21 @@ def face_rule(ftype: str) -> tuple[np.ndarray, np.ndarray]:
     return np.array([[a, b] for b in pts for a in pts]), np.array([u * v for v in w for u in w])
 
 
+@functools.lru_cache(maxsize=None)
 def any_face(nfn: int, n_gauss: int | None = None):
     """(N (npts, nfn), dN (npts, nfn, 2), weights) of the face type with ``nfn`` nodes (quad4, quad9 by their Gauss
-    rules of ``n_gauss`` points per direction, default full; tri3, tri6, quad8 by :func:`face_rule`)."""
+    rules of ``n_gauss`` points per direction, default full; tri3, tri6, quad8 by :func:`face_rule`); computed once
+    per face type and rule (read-only arrays: pressures ask for them at every evaluation)."""
+    return tuple(_read_only(a) for a in _any_face(nfn, n_gauss))
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a = np.array(a)
+    a.flags.writeable = False
+    return a
+
+
+def _any_face(nfn: int, n_gauss: int | None = None):
     from .quadrature import gauss_quad
     from .shapes import shape_functions
 
