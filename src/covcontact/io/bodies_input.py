@@ -83,6 +83,11 @@ def build_shell(shell: Section, sec: Section, base: Path):
                        f"{suggest(offset, list(OFFSETS))}", "offset")
     elif isinstance(offset, bool) or not isinstance(offset, (int, float)) or not -0.5 <= offset <= 0.5:
         shell.fail(f"must be \"middle\", \"top\", \"bottom\" or a number in [-0.5, 0.5], got {offset!r}", "offset")
+    creases = shell.get("creases", "str", "mean", choices=("mean", "knots"))
+    knot_angle = shell.get("knot_angle", "float", 20.0, positive=True)
+    if shell.has("knot_angle") and creases != "knots":
+        shell.fail("is the angle between normals beyond which a node becomes a knot: it needs creases = \"knots\"",
+                   "knot_angle")
     faces = shell.get("faces", "table", None)
     face_rows = {}
     if faces is not None:  # NAME = [["ELSET", "top" | "bottom"], ...]: the faces of those cells on that side
@@ -115,7 +120,8 @@ def build_shell(shell: Section, sec: Section, base: Path):
             shell.fail(f"faces: no element set {missing[0]!r} in {fname}", "faces")
         face_sets = {name: [(element_sets[e], side) for e, side in rows] for name, rows in face_rows.items()}
         return extrude_surface(points, cell_type, cells, np.asarray(values, dtype=float) if per_node else thickness,
-                               offset, node_sets, element_sets, face_sets)
+                               offset, node_sets, element_sets, face_sets,
+                               knot_angle if creases == "knots" else None)
     except ShellMeshError as exc:
         sec.fail(str(exc), "file")
 

@@ -365,44 +365,24 @@ class DeckShells:
         return out
 
     def _split_knots(self, nodes, cells, points, tc, cell, rank, forced):
-        """The part's surface with every knot node expanded once per subset of its elements (normal within 20
-        degrees, the same thickness: mesh.shell.normal_clusters) and once at a node of ``forced``: (its node labels,
-        the expansions after the deck's with labels of their own; cells; points; thicknesses; [(knot label, its
-        expansions' places)])."""
-        from ..mesh.shell import _REVERSE, ShellMeshError, _orient, normal_clusters
+        """The part's surface split at its knots (mesh.shell.split_at_knots: subsets by normal within 20 degrees and
+        by thickness, and the nodes of ``forced``): (its node labels, the expansions after the deck's with labels of
+        their own; cells; points; thicknesses; [(knot label, its expansions' places)])."""
+        from ..mesh.shell import ShellMeshError, split_at_knots
 
         try:
-            oriented = _orient(cells, cell)
+            points, cells_new, source, found = split_at_knots(points, cells, cell, rank=rank, key=tc,
+                                                              forced=np.isin(nodes, list(forced)))
         except ShellMeshError:  # (extrude_surface says so)
             t = np.zeros(nodes.size)
             t[cells.ravel()] = tc.ravel()
             return nodes, cells, points, t, []
-        turned = np.flatnonzero(np.any(oriented != cells, axis=1))
-        perm = _REVERSE[cell]
-        key = tc.copy()
-        key[turned] = tc[turned][:, perm]
-        sub = normal_clusters(points, oriented, cell, rank=rank, key=key)
-        given = sub.copy()
-        given[np.ix_(turned, perm)] = sub[turned]
-        knot = np.zeros(nodes.size, dtype=bool)
-        knot[cells[given > 0]] = True
-        knot |= np.isin(nodes, list(forced))
-        kept = np.flatnonzero(~knot)
-        node, subset = cells.ravel(), given.ravel()
-        at_knot = knot[node]
-        S = int(given.max()) + 1
-        pairs, inverse = np.unique(node[at_knot] * S + subset[at_knot], return_inverse=True)
-        new = np.full(nodes.size, -1, dtype=np.int64)
-        new[kept] = np.arange(kept.size)
-        flat = new[node]
-        flat[at_knot] = kept.size + inverse.ravel()
-        source = np.concatenate([kept, pairs // S])
-        labels = np.concatenate([nodes[kept], self._next + np.arange(pairs.size)])
-        self._next += pairs.size
+        copies = source.size - (nodes.size - len(found))
+        labels = np.concatenate([nodes[source[: source.size - copies]], self._next + np.arange(copies)])
+        self._next += copies
         t = np.zeros(source.size)
-        t[flat] = tc.ravel()
-        found = [(int(nodes[i]), kept.size + np.flatnonzero(pairs // S == i)) for i in np.flatnonzero(knot)]
-        return labels, flat.reshape(cells.shape), points[source], t, found
+        t[cells_new.ravel()] = tc.ravel()
+        return labels, cells_new, points, t, [(int(nodes[i]), places) for i, places in found]
 
     def _knot(self, lab: int, copies: np.ndarray, d: np.ndarray, where: str) -> None:
         """Shell node ``lab`` as a knot: a rigid body (appended to the deck's *RIGID BODYs) of its expansions

@@ -20,7 +20,7 @@ from .dynamics_input import check_densities, read_dynamics, read_initial_velocit
 from .fields import read_steps
 from .mpc_input import read_mpcs
 from .options_input import read_output, read_solver
-from .rigid_input import check_attached, read_rigid
+from .rigid_input import check_attached, knot_bodies, read_rigid
 from .springs_input import read_springs
 from .stage_input import named_conditions, stage
 from .validate import InputError, Section, suggest
@@ -62,6 +62,7 @@ def problem_from_dict(raw: dict, path: Path) -> Problem:
 
     bodies = read_bodies(top, base)
     rigid = read_rigid(top, base, bodies)
+    rigid += knot_bodies(bodies, rigid)  # (shells with creases = "knots": a rigid body per knot)
     sets = SetRefs(bodies, rigid)
     dirichlet = read_dirichlet(top, sets)
     forces, pressures, tractions = read_loads(top, sets)

@@ -150,6 +150,23 @@ def _read_profile(r: Section) -> dict:
     return params
 
 
+def knot_bodies(bodies: list, rigid: list) -> list[RigidBody]:
+    """The rigid bodies of shell bodies' knots (``shell = { creases = "knots" }``, mesh.shell ``extrude_surface``):
+    one per knot, ``BODY_knotK``, its expansions attached, its reference the knot's point, its six components
+    free."""
+    out = []
+    taken = {r.name for r in rigid} | {b.name for b in bodies}
+    for b in bodies:
+        for k, (point, _) in enumerate(getattr(b.mesh, "shell_knots", None) or []):
+            name = f"{b.name}_knot{k + 1}"
+            while name in taken:
+                name += "_"
+            taken.add(name)
+            out.append(RigidBody(name, free=(0, 1, 2, 3, 4, 5), reference=tuple(float(v) for v in point),
+                                 attach=((b.name, f"_knot{k + 1}"),)))
+    return out
+
+
 def check_attached(top: Section, rigid: list, bodies: list, dirichlet: list, equations: list) -> None:
     """Attached nodes follow their rigid body alone (in the components it holds, ``attach_components``): not
     prescribed there by a Dirichlet condition, not the dependent dof of an equation there, not attached to two bodies
@@ -171,9 +188,12 @@ def check_attached(top: Section, rigid: list, bodies: list, dirichlet: list, equ
         hit = [int(n) for n in meshes[bc.body].node_sets[bc.set] if (bc.body, int(n)) in owner
                and held[owner[(bc.body, int(n))]] & set(bc.components)]
         if hit:
+            knot = owner[(bc.body, hit[0])].startswith(f"{bc.body}_knot")
             top.fail(f"set {bc.body}.{bc.set} holds node {hit[0]} attached to rigid body "
-                     f"{owner[(bc.body, hit[0])]!r}: an attached node follows its body; prescribe the rigid body's "
-                     f"motion instead", f"dirichlet[{i}].set")
+                     f"{owner[(bc.body, hit[0])]!r}: an attached node follows its body; " + (
+                         "that body is a knot of the shell (creases = \"knots\"), which a support in a problem file "
+                         "cannot hold yet: support the shell away from the junction, or leave creases at \"mean\""
+                         if knot else "prescribe the rigid body's motion instead"), f"dirichlet[{i}].set")
     for i, eq in enumerate(equations):
         bname, sname, comp = eq.terms[0][0], eq.terms[0][1], eq.terms[0][2]
         if bname not in meshes:

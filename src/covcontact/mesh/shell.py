@@ -232,15 +232,55 @@ def normal_clusters(points: np.ndarray, cells: np.ndarray, cell_type: str, rank=
     return out.reshape(ne, nen)
 
 
+def split_at_knots(points: np.ndarray, cells: np.ndarray, cell_type: str, rank=None, key=None,
+                   forced: np.ndarray | None = None, limit: float = 20.0):
+    """The surface with every knot node expanded once per subset of its cells (normal_clusters of the consistently
+    oriented cells, ``key`` (ne, nen) a value the cells of a subset share, e.g. the thickness), and once at the nodes
+    ``forced`` (a mask: a node of one subset made a knot). Returns (points, cells, source: the given node of each node,
+    knots: [(given node, its expansions' indices)]): the nodes that are no knot first, in their order, then each
+    knot's expansions, subset by subset. The cells keep their node order as given. ShellMeshError where the surface
+    cannot be oriented."""
+    oriented = _orient(cells, cell_type)
+    turned = np.flatnonzero(np.any(oriented != cells, axis=1))
+    perm = _REVERSE[cell_type]
+    ordered = None
+    if key is not None:
+        ordered = np.array(key, dtype=float)
+        ordered[turned] = np.asarray(key, dtype=float)[turned][:, perm]
+    sub = normal_clusters(points, oriented, cell_type, rank=rank, key=ordered, limit=limit)
+    given = sub.copy()
+    given[np.ix_(turned, perm)] = sub[turned]
+    n = points.shape[0]
+    knot = np.zeros(n, dtype=bool)
+    knot[cells[given > 0]] = True
+    if forced is not None:
+        knot |= forced
+    kept = np.flatnonzero(~knot)
+    node, subset = cells.ravel(), given.ravel()
+    at_knot = knot[node]
+    S = int(given.max()) + 1
+    pairs, inverse = np.unique(node[at_knot] * S + subset[at_knot], return_inverse=True)
+    new = np.full(n, -1, dtype=np.int64)
+    new[kept] = np.arange(kept.size)
+    flat = new[node]
+    flat[at_knot] = kept.size + inverse.ravel()
+    source = np.concatenate([kept, pairs // S])
+    found = [(int(i), kept.size + np.flatnonzero(pairs // S == i)) for i in np.flatnonzero(knot)]
+    return points[source], flat.reshape(cells.shape), source, found
+
+
 def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thickness, offset="middle",
                     node_sets: dict | None = None, element_sets: dict | None = None,
-                    face_sets: dict | None = None) -> Mesh:
+                    face_sets: dict | None = None, knot_angle: float | None = None) -> Mesh:
     """The solid-shell mesh (hex8 or hex18, one element through the thickness) of the surface mesh (``points``,
     ``cell_type`` in SURFACE_CELLS, ``cells``) with ``thickness`` (a number, or one per surface node) and ``offset``
     ("middle", "top", "bottom" or a number in [-1/2, 1/2]); the module docstring says how. ``face_sets``: name ->
     [(surface cells, "top" or "bottom")], the face set (and node set, unless one of that name exists) of those cells'
     faces on that side of each cell's own normal (by its corner order as given, whichever way the orientation turned
-    it: a deck's SPOS and SNEG). ShellMeshError (a ValueError) for a surface that cannot be made into one."""
+    it: a deck's SPOS and SNEG). ``knot_angle`` (degrees): the surface split at its knots first (split_at_knots:
+    the nodes whose cells' normals differ by more than that), each expansion with its own director; then
+    ``mesh.shell_knots`` lists (the node's point, the mesh nodes of its expansions), each also the node set "_knotK"
+    (K from 1) that a rigid body joins. ShellMeshError (a ValueError) for a surface that cannot be made into one."""
     points = np.asarray(points, dtype=np.float64)
     cells = np.asarray(cells, dtype=np.int64)
     if cell_type not in SURFACE_CELLS:
@@ -256,6 +296,13 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     o = OFFSETS.get(offset) if isinstance(offset, str) else float(offset)
     if o is None or not -0.5 <= o <= 0.5:
         raise ShellMeshError(f"offset must be 'middle', 'top', 'bottom' or a number in [-0.5, 0.5], got {offset!r}")
+    knot_groups, given_points = [], points
+    if knot_angle is not None:
+        points, cells, source, knot_groups = split_at_knots(points, cells, cell_type, limit=float(knot_angle))
+        t = t[source]
+        n_surface = points.shape[0]
+        node_sets = {name: np.flatnonzero(np.isin(source, np.asarray(ids, dtype=np.int64)))
+                     for name, ids in (node_sets or {}).items()}
     cell_of = np.arange(cells.shape[0])  # the surface cell each new cell comes from
     surface_type = cell_type
     if cell_type == "quad8":
@@ -343,6 +390,11 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
             if name not in mesh.node_sets:
                 mesh.add_node_set(name, np.unique(f))
     mesh.shell_creases = creases  # (surface cells a, b, surface node, angle in degrees) per such node
+    mesh.shell_knots = []
+    for k, (i, places) in enumerate(knot_groups):
+        nodes = np.concatenate([places, places + n])
+        mesh.add_node_set(f"_knot{k + 1}", nodes)
+        mesh.shell_knots.append((given_points[i], nodes))
     return mesh
 
 
