@@ -13,7 +13,10 @@ node becomes a bottom and a top node on its director. What the deck says of a sh
 - the import's part (:class:`DeckShells`): the bodies, their surface mesh files and ``shell = { ... }`` tables,
   the node labels, the *BOUNDARY mapping of shell nodes (CalculiX's gen3dboun: a translation of a shell node
   prescribes the mean of its expanded nodes, a rotation the mean rotation of the line of them), *CLOAD split
-  between the layers, pressures on shells, and the contact surfaces of shell faces.
+  between the layers, pressures and edge loads on shells, and the contact surfaces of shell faces;
+- knots: a node whose elements make several subsets (normals more than 20 degrees apart, another thickness) or
+  that carries a moment or a non-zero rotation is expanded once per subset, and the expansions are attached to a
+  rigid body whose reference is the node (``DeckShells.knots``, made *RIGID BODY entries that ``deck_rigid`` writes).
 """
 
 from __future__ import annotations
@@ -258,7 +261,7 @@ class DeckShells:
         self.n = kinds.size
         sections = self._sections(labels)
         self._thickness = {e: sec[2] for e, sec in sections.items()}  # (element label -> its section's thickness)
-        forced = self._forced_knots(labels.size and np.unique(np.concatenate([c.ravel() for c in conn])))
+        forced = self._forced_knots(np.unique(np.concatenate([c.ravel() for c in conn])))
         conn_rows = [row for c in conn for row in c]
         for j in range(self.n):
             mine = np.flatnonzero(of_element == j)
@@ -309,13 +312,16 @@ class DeckShells:
                 self._knot(lab, nodes[copies], d[copies], forced.get(lab, where[mine[0]]))
             if knots_here:
                 spread = sum(1 for lab, c in knots_here if c.size > 1)
+                why = [f"{spread} where its elements' normals differ by more than 20 degrees or their thicknesses "
+                       f"differ"] if spread else []
+                why += [f"{len(knots_here) - spread} for a moment or a non-zero rotation"] if spread < len(knots_here) \
+                    else []
                 self.notes.append(
                     f"{where[mine[0]]}: {len(knots_here)} knot{'s' if len(knots_here) > 1 else ''} in the shell part "
-                    f"of element {int(labels[mine[0]])} ({spread} where its elements' normals differ by more than 20 "
-                    f"degrees or their thicknesses differ, {len(knots_here) - spread} for a moment or a non-zero "
-                    f"rotation): as in CalculiX each such node is expanded once per normal and the expansions are "
-                    f"joined by a rigid body whose reference is the node (its dofs 1-6 the body's translation and "
-                    f"rotation); CalculiX's knot may also expand uniformly, covcontact's holds the thickness there")
+                    f"of element {int(labels[mine[0]])} ({', '.join(why)}): as in CalculiX each such node is expanded "
+                    f"once per normal and the expansions are joined by a rigid body whose reference is the node (its "
+                    f"dofs 1-6 the body's translation and rotation); CalculiX's knot may also expand uniformly, "
+                    f"covcontact's holds the thickness there")
             flipped = self._flipped(cell, cells)
             if flipped.any():
                 if sections[int(labels[mine[0]])][3] != 0.0:
