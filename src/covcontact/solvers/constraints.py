@@ -14,6 +14,30 @@ import numpy as np
 import scipy.sparse as sp
 
 
+def reduce_matrix(K, keep: np.ndarray, dependent: np.ndarray, rows, extra=None) -> sp.csr_matrix:
+    """T^T K T for T = diag(keep) + A, A zero but in the rows ``dependent`` (``rows``: those rows, |D| x n), keep 0
+    at the dependent dofs and 1 elsewhere: E K E + E K_:D A_D + A_D^T K_D: E + A_D^T K_DD A_D with E = diag(keep).
+    The product is formed on K's entries (those in a dependent row or column dropped) and thin matrices, not as two
+    products with n x n matrices; ``extra`` (sparse, n x n) is added with the thin terms."""
+    K = K.tocsr()
+    E = keep.astype(bool)
+    data = np.where(np.repeat(E, np.diff(K.indptr)) & E[K.indices], K.data, 0.0)
+    out = sp.csr_matrix((data, K.indices, K.indptr), shape=K.shape)
+    small = extra
+    if len(dependent):
+        rows = sp.csr_matrix(rows)
+        KD = K[:, dependent]                         # (n, |D|)
+        DK = K[dependent, :]                         # (|D|, n)
+        Ed = sp.diags(keep.astype(float))
+        small = Ed @ (KD @ rows) + (rows.T @ DK) @ Ed + rows.T @ (DK[:, dependent] @ rows) + (
+            0 if extra is None else extra)
+    if small is not None:
+        out = out + small                            # (one sum of K's size)
+    out = out.tocsr()
+    out.sort_indices()
+    return out
+
+
 def unit_diagonal(mask: np.ndarray, system) -> sp.csr_matrix:
     """The diagonal that a constraint layer adds to its reduced tangent so that the held dofs keep their diagonal
     in the pattern: 1 at its dependent dofs (``mask``) and at the z-dofs of planar bodies (held: their zero diagonal,
@@ -93,8 +117,7 @@ class LinearConstraints:
         """(T^T R, T^T K T) (K may be None)."""
         R = self.Tt @ R
         if K is not None:
-            K = (self.Tt @ K @ self.T + self.unit).tocsr()
-            K.sort_indices()
+            K = reduce_matrix(K, ~self.mask, self.dependent, self.rows, self.unit)
         return R, K
 
 
@@ -189,7 +212,6 @@ class RigidLinks:
         Rn = Pt @ R
         if K is None:
             return Rn, None
-        K = Pt @ K @ P + self.unit
         G_rows, G_cols, G_vals = [], [], []
         for ref, nodes, ry, T, theta, comps in parts:
             f = np.zeros((len(nodes), 3))
@@ -200,9 +222,8 @@ class RigidLinks:
             G_rows.append(np.repeat(b, 3))
             G_cols.append(np.tile(b, 3))
             G_vals.append(G.ravel())
-        K = (K + sp.csr_matrix((np.concatenate(G_vals), (np.concatenate(G_rows), np.concatenate(G_cols))),
-                               shape=K.shape)).tocsr()
-        K.sort_indices()
+        G = sp.csr_matrix((np.concatenate(G_vals), (np.concatenate(G_rows), np.concatenate(G_cols))), shape=K.shape)
+        K = reduce_matrix(K, ~self.mask, self.dependent, P[self.dependent], self.unit + G)
         return Rn, _with_diagonal(K, self._ref_dofs)
 
 
