@@ -572,3 +572,36 @@ def test_edge_load_on_a_solid_is_one_line(tmp_path):
     proc = _cli(["run", deck, "--out", tmp_path / "e", "--quiet"])
     assert proc.returncode == 2 and "EDNOR1 on element 1, a hex8 element: edge loads act on the edges of shell" \
         in proc.stderr, proc.stderr
+
+
+#: produced by running CalculiX 2.20 (Debian's ccx) on test_el_print_of_shells' deck: element 1's points 1 and 2
+#: (sxx) and point 1 (sxz), CalculiX's S4 expanded into a C3D8I brick
+_CCX_S4_POINT_STRESS = {"sxx1": 3.248249e-02, "sxx2": 3.246941e-02, "sxz1": 1.250000e-04}
+
+
+def test_el_print_of_shells(tmp_path):
+    """*EL PRINT S on S4 elements: each element's solid-shell's eight Gauss points in CalculiX's order of a C3D8
+    (the bottom four first): the bending stress sxx at the clamp within 3 % of CalculiX's at its points 1 and 2
+    (measured 2.2 % and 2.2 %; the elements differ: ANS + EAS against incompatible modes), the transverse shear sxz
+    within 1 % (0.3 %), the top points the bottom ones' negatives; E on shells is said in a note, not left empty
+    silently; S6 elements (three solid-shells each) are not printed, with a note."""
+    text = plate_deck("S4", nx=2, ny=1).replace("*END STEP", "*EL PRINT, ELSET=PLATE\nS\n*EL PRINT, ELSET=PLATE\nE\n"
+                                                             "*END STEP")
+    dat, proc = _run_deck(tmp_path, text, "elp")
+    assert proc.returncode == 0, proc.stderr
+    assert "*EL PRINT E on shell elements (PLATE): not printed for them" in proc.stderr, proc.stderr
+    rows = {}
+    block = dat.read_text().split("stresses")[1].split("strains")[0]
+    for line in block.splitlines():
+        f = line.split()
+        if len(f) == 8 and f[0].isdigit():
+            rows[(int(f[0]), int(f[1]))] = np.array([float(x) for x in f[2:]])
+    assert len(rows) == 16
+    assert rows[(1, 1)][0] == pytest.approx(_CCX_S4_POINT_STRESS["sxx1"], rel=3e-2)
+    assert rows[(1, 2)][0] == pytest.approx(_CCX_S4_POINT_STRESS["sxx2"], rel=3e-2)
+    assert rows[(1, 1)][4] == pytest.approx(_CCX_S4_POINT_STRESS["sxz1"], rel=1e-2)
+    np.testing.assert_allclose(rows[(1, 5)][[0, 1, 3]], -rows[(1, 1)][[0, 1, 3]], rtol=1e-5)
+    tri = plate_deck("S6", nx=2, ny=1).replace("*END STEP", "*EL PRINT, ELSET=PLATE\nS\n*END STEP")
+    dat, proc = _run_deck(tmp_path, tri, "tri")
+    assert proc.returncode == 0, proc.stderr
+    assert "S3 and S6 are each three solid-shells" in proc.stderr

@@ -414,6 +414,13 @@ class SolidShellBody(ElementBody):
                          self.dNc, self.weights, self.tie_ptr, self.tie_pt, self.tie_w, self.eas_comp, self.eas_val,
                          want_K, Ke, fe, flags, nblocks, hist_n, hist)
 
+    def point_stresses(self, u: np.ndarray, state: dict | None = None) -> np.ndarray:
+        """(ne, ng, 6) Cauchy stress (xx, yy, zz, xy, yz, xz) at the Gauss points (r fastest, then s, then the
+        thickness coordinate t: a hex8's eight in CalculiX's order of a C3D8), at the EAS parameters solved for ``u``
+        and the history of ``state`` (read as the committed one)."""
+        ng = self.weights.size
+        return self._fields(u, 3, 7 * ng, state).reshape(self.n_elements, ng, 7)[..., :6]
+
     def shell_resultants(self, u: np.ndarray, state: dict | None = None) -> dict[str, np.ndarray]:
         """Per element, in the deformed configuration (docs/theory.md section 6, "Stress resultants"): ``frame``
         (ne, 3, 3) rows e1, e2, e3 (e3 the element's mean director, the bottom-to-top node vectors' mean; e1 the

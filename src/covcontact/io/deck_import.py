@@ -762,6 +762,17 @@ class _Writer(ContactMapping):
                   for s, _ in self.stage_steps]
         el_prints = [[[elset, list(v), totals, order[w]] for elset, v, w, totals in self.m.steps[s].el_print]
                      for s, _ in self.stage_steps]
+        for st in self.m.steps:  # (the solid-shells' strains are assumed ones, not Gauss-point gradients)
+            for elset, v, w, _ in st.el_print:
+                tri = self.shells.n and any(t in ("S3", "S6") and np.intersect1d(labs, self.m.elsets.get(elset, [])).size
+                                            for t, _, labs, _ in self.m.shell_blocks)
+                gone = list(v) if tri else [x for x in v if x in ("E", "ENER", "ELSE")]
+                if gone and self.shells.n and np.any(self.shells.elements_body(self.m.elsets.get(elset, [])) >= 0):
+                    note = (f"{w}: *EL PRINT {', '.join(gone)} on shell elements ({elset}): not printed for them (" + (
+                        "S3 and S6 are each three solid-shells)" if tri else "the solid-shells' strains are assumed, "
+                        "enhanced ones; S, PEEQ and EVOL are printed at their Gauss points)"))
+                    if note not in self.notes:
+                        self.notes.append(note)
         contact_prints = [list(self.m.steps[s].contact_print) for s, _ in self.stage_steps]
         printing = [self.m.steps[s].contact_card[0] for s, _ in self.stage_steps if self.m.steps[s].contact_print]
         contact = {name: (sb, sts) for name, (sb, sts, tied) in getattr(self, "_plane_pairs", {}).items()
@@ -887,13 +898,10 @@ class _Writer(ContactMapping):
             mesh, text = self.shell_meshes[path]
             path.write_text(text)
             self.meshes[path] = mesh
-            # (a split triangle's three cells: the deck's label, then labels after the deck's largest)
+            # (a split triangle's three cells: labels after the deck's largest, so that no deck label names a third of
+            # a triangle in the .dat's element tables)
             split = info["cell"] in ("tri3", "tri6")
-            per_cell = np.repeat(info["elements"], 3) if split else info["elements"]
+            per_cell = start + np.arange(3 * info["elements"].size) if split else info["elements"]
             if split:
-                extra = np.ones(per_cell.size, dtype=bool)
-                extra[::3] = False
-                per_cell = per_cell.copy()
-                per_cell[extra] = start + np.arange(int(extra.sum()))
-                start += int(extra.sum())
+                start += per_cell.size
             self.element_labels[self.body_names[k]] = per_cell.tolist()
