@@ -605,3 +605,40 @@ def test_el_print_of_shells(tmp_path):
     dat, proc = _run_deck(tmp_path, tri, "tri")
     assert proc.returncode == 0, proc.stderr
     assert "S3 and S6 are each three solid-shells" in proc.stderr
+
+
+def test_shell_node_shared_with_a_solid_is_a_hinge(tmp_path):
+    """Shell elements sharing nodes with a solid element: CalculiX joins them there by a hinge (its manual: the
+    connection between 3D elements and shells is always hinged), here the equations u_b + u_t - 2 u_s = 0, the mean of
+    the shell node's layers following the solid node, the rotation free. A strip simply supported at both ends and
+    loaded at its middle, its left end's nodes shared with a C3D8 block held in place: the same deflection as the strip
+    pinned there by *BOUNDARY 1-3 (to 1e-6), where without the hinge the strip's end would be free."""
+    pinned = plate_deck(nx=10, ny=1, B=1.0, fix="1, 3", both_ends=True)
+    block = ("*NODE\n901, -1.0, 0.0, 0.0\n902, -1.0, 1.0, 0.0\n903, -1.0, 0.0, 1.0\n904, 0.0, 0.0, 1.0\n"
+             "905, 0.0, 1.0, 1.0\n906, -1.0, 1.0, 1.0\n*ELEMENT, TYPE=C3D8, ELSET=BLOCK\n"
+             "901, 901, 1, 12, 902, 903, 904, 905, 906\n*NSET, NSET=BLK\n901, 902, 903, 904, 905, 906, 1, 12\n"
+             "*SOLID SECTION, ELSET=BLOCK, MATERIAL=STEEL\n")
+    hinged = pinned.replace("*MATERIAL", block + "*MATERIAL", 1).replace("*STEP", "*BOUNDARY\nBLK, 1, 3\n*STEP", 1)
+    w = {}
+    for name, text in (("pinned", pinned), ("hinged", hinged)):
+        dat, proc = _run_deck(tmp_path, text, name)
+        assert proc.returncode == 0, proc.stderr
+        w[name] = _dat(dat)["U"][6][2]
+    assert abs(w["pinned"]) > 1e-4
+    assert w["hinged"] == pytest.approx(w["pinned"], rel=1e-6)
+    imp = import_deck(tmp_path / "hinged.inp", tmp_path / "i" / "h.toml")
+    eqs = [e for e in tomllib.loads(imp.problem.read_text())["equation"] if e["name"].startswith("hinge")]
+    assert len(eqs) == 6 and all(e["terms"][2][2] == -2.0 for e in eqs)
+
+
+def test_equation_on_shell_nodes_holds_their_mean(tmp_path):
+    """*EQUATION on shell nodes: a shell node's displacement is the mean of its two layers (CalculiX's expanded
+    nodes), so each term c u becomes c/2 on each layer: the tip corners of the cantilever plate held to the same
+    deflection while only one of them is loaded move alike (the .dat's U, the layers' mean, equal to 1e-6)."""
+    text = plate_deck(loads=False).replace("*STEP", "*EQUATION\n2\n11, 3, 1.0, 55, 3, -1.0\n*STEP", 1)
+    text = text.replace("*NODE PRINT, NSET=TIP", "*CLOAD\n11, 3, 1e-4\n*NODE PRINT, NSET=TIP")
+    dat, proc = _run_deck(tmp_path, text, "eq")
+    assert proc.returncode == 0, proc.stderr
+    U = _dat(dat)["U"]
+    assert U[11][2] > 1e-4 and U[55][2] == pytest.approx(U[11][2], rel=1e-6)
+    assert U[33][2] != pytest.approx(U[11][2], rel=1e-3)  # (the edge between them is free)

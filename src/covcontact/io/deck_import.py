@@ -696,14 +696,23 @@ class _Writer(ContactMapping):
             for node, dof, coef in terms:
                 if not 1 <= dof <= 3:
                     break
-                if self.shells.n and self.shells.is_shell(np.array([node]))[0]:
-                    raise DeckError(f"{where}: *EQUATION on shell node {node}: not supported (CalculiX ties its "
-                                    f"expanded nodes to it; covcontact's shell node is two nodes, bottom and top)")
+                if self.shells.n and self.shells.is_shell(np.array([node]))[0]:  # (its mean: half on each layer,
+                    body = int(self.shells.label_body[node])                       # as CalculiX's expanded nodes)
+                    self.shells.equation_nodes.setdefault(body, set()).add(int(node))
+                    out += [[self._ref(body, f"_SN{node}_{side}"), _COMP[dof - 1], 0.5 * coef] for side in "bt"]
+                    continue
                 (body, set_name), = self._node_targets(str(node), np.array([node]), where)
                 out.append([self._ref(body, set_name), _COMP[dof - 1], coef])
             else:
                 text += _table("[[equation]]", {"name": f"eq{k + 1}", "terms": out})
         for entry in self.shells.equations(self._ref):  # (shell nodes' conditions: deck_shells)
+            text += _table("[[equation]]", entry)
+
+        def solid_ref(lab: int) -> str:
+            (body, set_name), = [t for t in self._node_targets(str(lab), np.array([lab]), "") if t[0] < self.b.n]
+            return self._ref(body, set_name)
+
+        for entry in self.shells.hinges(self._ref, solid_ref):  # (shell nodes on solid elements: hinges)
             text += _table("[[equation]]", entry)
         return text
 

@@ -215,6 +215,7 @@ class DeckShells:
         self._unused: set = set()
         self.equation_nodes: dict[int, set] = {}
         self._thickness: dict[int, float | None] = {}
+        self.shared: set[int] = set()
         #: (shell node label, component) -> the right-hand side 2 v of its mean's equation at the first stage's end
         self.sum_values: dict[tuple, float] = {}
         #: knots (covcontact.io.deck_rigid): rigid body (its place in m.rigid_bodies) -> (the shell node's label, the
@@ -247,13 +248,9 @@ class DeckShells:
                                zip(conn, np.cumsum([0] + [len(c) for c in conn])[:-1])])
         cols = np.concatenate([index[c.ravel()] for c in conn])
         nn = m.node_labels.size
-        solid = parts.of_node[cols] >= 0
-        if solid.any():
-            k = int(np.flatnonzero(solid)[0])
-            raise DeckError(f"{where[rows[k]]}: shell element {int(labels[rows[k]])} shares node "
-                            f"{int(m.node_labels[cols[k]])} with a solid element: CalculiX joins them there by a "
-                            f"knot (a hinge) of its expansion, which covcontact does not have; tie the shell to the "
-                            f"solid with *TIE instead")
+        # (shell nodes that solid elements share: CalculiX's hinge, the mean of the node's expansion following the
+        # solid's node, its rotation free: equations, ``hinges``)
+        self.shared = {int(v) for v in m.node_labels[np.unique(cols[parts.of_node[cols] >= 0])]}
         g = coo_matrix((np.ones(rows.size), (rows, ne + cols)), shape=(ne + nn, ne + nn))
         _, comp = connected_components(g, directed=False)
         kinds = np.unique(comp[:ne])
@@ -343,6 +340,8 @@ class DeckShells:
             self._grow(int(nodes.max()) + 1)
             self.label_body[nodes] = self.first + j
             self.label_index[nodes] = np.arange(nodes.size)
+            for lab in self.shared.intersection(nodes.tolist()):
+                self.equation_nodes.setdefault(self.first + j, set()).add(lab)
             for e in labels[mine]:
                 self.el_body[int(e)] = self.first + j
 
@@ -394,6 +393,9 @@ class DeckShells:
         """Shell node ``lab`` as a knot: a rigid body (appended to the deck's *RIGID BODYs) of its expansions
         ``copies`` (labels; ``d`` their directors) with the node as REF NODE. Expansions on one line leave the
         rotation about it to nothing: held where the line is a global axis, else listed."""
+        if lab in self.shared:
+            raise DeckError(f"{where}: shell node {lab} is a knot of the shell expansion and a node of a solid element: "
+                            f"not supported (tie the shell to the solid with *TIE there)")
         drill = None
         if np.all(np.linalg.norm(np.cross(d, d[0]), axis=1) < 1e-6):
             k = int(np.argmax(np.abs(d[0])))
@@ -458,7 +460,25 @@ class DeckShells:
         return np.array([self.el_body.get(int(e), -1) for e in np.asarray(labels).ravel()], dtype=np.int64)
 
     def is_shell(self, labels) -> np.ndarray:
-        return self.nodes_body(labels) >= 0
+        """Whether each label is a shell node whose conditions and loads are the shell's (a node shared with a solid
+        element is the solid's: the shell's expansion follows it through the hinge equations)."""
+        out = self.nodes_body(labels) >= 0
+        if self.shared:
+            out &= ~np.isin(np.asarray(labels, dtype=np.int64), list(self.shared))
+        return out
+
+    def hinges(self, ref, solid_ref) -> list[dict]:
+        """The [[equation]] entries of the nodes shared with solid elements (CalculiX: a hinge): per component the
+        mean of the shell node's two layers equals the solid node's displacement, u_b + u_t - 2 u_s = 0
+        (``solid_ref(label)``: the solid node's single-node set reference)."""
+        out = []
+        for lab in sorted(self.shared):
+            body = int(self.label_body[lab])
+            if body < 0:
+                continue
+            b, t, s = ref(body, f"_SN{lab}_b"), ref(body, f"_SN{lab}_t"), solid_ref(lab)
+            out += [{"name": f"hinge{lab}_{c}", "terms": [[b, c, 1.0], [t, c, 1.0], [s, c, -2.0]]} for c in "xyz"]
+        return out
 
     # -- boundary conditions --------------------------------------------------------------------------------------
     def plan_boundaries(self) -> None:
@@ -671,6 +691,8 @@ class DeckShells:
         ns, es, ns_lab, es_lab = {}, {}, {}, {}
         for name, labs in nsets.items():
             labs = np.intersect1d(np.asarray(labs, dtype=np.int64), nodes)
+            if self.shared:  # (a node shared with a solid: the solid's; the shell's layers follow it)
+                labs = labs[~np.isin(labs, list(self.shared))]
             if labs.size:
                 ns[name], ns_lab[name] = np.searchsorted(nodes, labs), labs
         order = np.argsort(elements, kind="stable")
