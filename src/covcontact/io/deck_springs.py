@@ -245,6 +245,12 @@ class DeckSprings:
             if n >= index.size or index[n] < 0:
                 raise DeckError(f"{where}: *ELEMENT: element {lab} refers to node {int(n)}, which no *NODE defines")
         nodes = [int(n) for n in nodes]
+        shell = [n for n in nodes if self.w.shells.n and self.w.shells.is_shell(np.array([n]))[0]]
+        if shell:  # (its two layers: no single node for the spring's end)
+            self.w.unsupported.append(f"{where}: {etype} element {lab}: its node {shell[0]} is a shell node (two "
+                                      f"nodes here, bottom and top): springs and dashpots on shell nodes are not "
+                                      f"supported; with --ignore-unsupported the element is left out")
+            return None
         ends = [self._end(n, where) for n in nodes]
         law = ({"coefficient": card.constant} if etype == "DASHPOTA" else
                {"stiffness": card.constant} if card.table is None else {"table": [list(p) for p in card.table]})
