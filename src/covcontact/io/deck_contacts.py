@@ -11,8 +11,35 @@ from .deck import DeckError
 from .deck_mesh import safe_name as _name
 from .deck_model import Interaction
 from .deck_planar import planar_contact
-from .deck_shells import quadratic_edges
 from .deck_toml import _table
+
+
+
+def quadratic_edges(m, name: str) -> str | None:
+    """Whether the shell surface ``name`` holds edges (S3..S6) of S8 or S8R elements: the side faces of their 18-node
+    solid-shells have six nodes, each taken as its two 4-node halves (mesh.shell), which serve slave surfaces (nodes
+    and their tributary areas). As a master they are exact where the edge is straight (its mid-side node on the chord
+    of its corners: "straight", the halves then are the side face's two halves, their displacement linear along the
+    edge where the element's is quadratic) and chords of a curved edge ("curved"); None: no such edges."""
+    rows = m.shell_surfaces.get(name, [])
+    eight = [(labs, c) for t, _, labs, c in m.shell_blocks if t in ("S8", "S8R")]
+    out = None
+    index = m.node_index()
+    for els, side, _ in rows:
+        if not side.startswith("EDGE"):
+            continue
+        k = int(side[4:]) - 1
+        for labs, conn in eight:
+            rows_here = conn[np.isin(labs, els)]
+            if not rows_here.size:
+                continue
+            out = "straight"
+            x = m.X[index[rows_here[:, [k, (k + 1) % 4, 4 + k]]]]   # (corner a, corner b, the mid-side node)
+            chord = x[:, 1] - x[:, 0]
+            off = np.cross(x[:, 2] - x[:, 0], chord)
+            if np.any(np.linalg.norm(off, axis=1) > 1e-6 * np.einsum("ij,ij->i", chord, chord)):
+                return "curved"
+    return out
 
 
 class ContactMapping:

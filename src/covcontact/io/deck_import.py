@@ -26,6 +26,7 @@ from .deck_model import ELEMENTS, NFACES, Boundary, DeckModel, Load, nlgeom_step
 from .deck_coupling import DeckCouplings
 from .deck_planar import contact_print_labels, element_names, is_planar_type, planar_body, planar_dof3
 from .deck_rigid import DeckRigid
+from .deck_knots import hinge_equations
 from .deck_shells import DeckShells
 from .deck_mpc import DeckMPCs
 from .deck_springs import DeckSprings
@@ -712,7 +713,7 @@ class _Writer(ContactMapping):
             (body, set_name), = [t for t in self._node_targets(str(lab), np.array([lab]), "") if t[0] < self.b.n]
             return self._ref(body, set_name)
 
-        for entry in self.shells.hinges(self._ref, solid_ref):  # (shell nodes on solid elements: hinges)
+        for entry in hinge_equations(self.shells, self._ref, solid_ref):  # (shell nodes on solid elements: hinges)
             text += _table("[[equation]]", entry)
         return text
 

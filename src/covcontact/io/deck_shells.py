@@ -24,6 +24,8 @@ from __future__ import annotations
 import numpy as np
 
 from .deck import Card, DeckError, numbers
+from .deck_knots import forced_knots, knot_note, register_knot, split_part
+from .deck_shell_conditions import ShellConditions
 
 #: the shell elements read: deck type -> the surface cell type of its mid-surface
 SHELL_ELEMENTS = {"S3": "tri3", "S4": "quad4", "S4R": "quad4", "S6": "tri6", "S8": "quad8", "S8R": "quad8"}
@@ -110,33 +112,6 @@ def read_shell_card(reader, c: Card) -> None:
     m.shell_sections.append((elset, material, thickness, _offset(c), c.where()))
 
 
-def quadratic_edges(m, name: str) -> str | None:
-    """Whether the shell surface ``name`` holds edges (S3..S6) of S8 or S8R elements: the side faces of their 18-node
-    solid-shells have six nodes, each taken as its two 4-node halves (mesh.shell), which serve slave surfaces (nodes
-    and their tributary areas). As a master they are exact where the edge is straight (its mid-side node on the chord
-    of its corners: "straight", the halves then are the side face's two halves, their displacement linear along the
-    edge where the element's is quadratic) and chords of a curved edge ("curved"); None: no such edges."""
-    rows = m.shell_surfaces.get(name, [])
-    eight = [(labs, c) for t, _, labs, c in m.shell_blocks if t in ("S8", "S8R")]
-    out = None
-    index = m.node_index()
-    for els, side, _ in rows:
-        if not side.startswith("EDGE"):
-            continue
-        k = int(side[4:]) - 1
-        for labs, conn in eight:
-            rows_here = conn[np.isin(labs, els)]
-            if not rows_here.size:
-                continue
-            out = "straight"
-            x = m.X[index[rows_here[:, [k, (k + 1) % 4, 4 + k]]]]   # (corner a, corner b, the mid-side node)
-            chord = x[:, 1] - x[:, 0]
-            off = np.cross(x[:, 2] - x[:, 0], chord)
-            if np.any(np.linalg.norm(off, axis=1) > 1e-6 * np.einsum("ij,ij->i", chord, chord)):
-                return "curved"
-    return out
-
-
 def shell_surface_row(reader, c: Card, k: int, row: list[str], name: str) -> bool:
     """Whether line ``k`` of an element *SURFACE names a shell face (SPOS, SNEG; S1 = SNEG and S2 = SPOS of shell
     elements, as CalculiX numbers them), which is then kept in ``shell_surfaces``; an edge (S3..S6) of a shell
@@ -192,7 +167,7 @@ def _shell_labels(m) -> set:
 
 
 # -- importing -------------------------------------------------------------------------------------------------------
-class DeckShells:
+class DeckShells(ShellConditions):
     """The shell bodies of a deck: each connected part of its shell elements (elements joined through shared nodes),
     numbered after the solid bodies (``first``). A shell node is the bottom node i and the top node i + n of its
     body's solid-shell mesh (i its place among the part's node labels in increasing order)."""
@@ -258,7 +233,7 @@ class DeckShells:
         self.n = kinds.size
         sections = self._sections(labels)
         self._thickness = {e: sec[2] for e, sec in sections.items()}  # (element label -> its section's thickness)
-        forced = self._forced_knots(np.unique(np.concatenate([c.ravel() for c in conn])))
+        forced = forced_knots(m, np.unique(np.concatenate([c.ravel() for c in conn])))
         conn_rows = [row for c in conn for row in c]
         for j in range(self.n):
             mine = np.flatnonzero(of_element == j)
@@ -296,8 +271,7 @@ class DeckShells:
                                           f"its thickness {sec[2]:g} holds (as in CalculiX and Abaqus)")
                     tc[r, q] = sec[2]
             points = m.X[index[nodes]]
-            nodes, cells, points, t, knots_here = self._split_knots(nodes, cells, points, tc, cell, labels[mine],
-                                                                    forced)
+            nodes, cells, points, t, knots_here = split_part(self, nodes, cells, points, tc, cell, labels[mine], forced)
             try:
                 mesh0 = extrude_surface(points, cell, cells, t, offs.pop())
             except ShellMeshError as exc:
@@ -306,19 +280,9 @@ class DeckShells:
             d = mesh0.points[half: half + nodes.size] - mesh0.points[: nodes.size]
             d /= np.linalg.norm(d, axis=1)[:, None]
             for lab, copies in knots_here:
-                self._knot(lab, nodes[copies], d[copies], forced.get(lab, where[mine[0]]))
+                register_knot(self, lab, nodes[copies], d[copies], forced.get(lab, where[mine[0]]))
             if knots_here:
-                spread = sum(1 for lab, c in knots_here if c.size > 1)
-                why = [f"{spread} where its elements' normals differ by more than 20 degrees or their thicknesses "
-                       f"differ"] if spread else []
-                why += [f"{len(knots_here) - spread} for a moment or a non-zero rotation"] if spread < len(knots_here) \
-                    else []
-                self.notes.append(
-                    f"{where[mine[0]]}: {len(knots_here)} knot{'s' if len(knots_here) > 1 else ''} in the shell part "
-                    f"of element {int(labels[mine[0]])} ({', '.join(why)}): as in CalculiX each such node is expanded "
-                    f"once per normal and the expansions are joined by a rigid body whose reference is the node (its "
-                    f"dofs 1-6 the body's translation and rotation); CalculiX's knot may also expand uniformly, "
-                    f"covcontact's holds the thickness there")
+                self.notes.append(knot_note(where[mine[0]], int(labels[mine[0]]), knots_here))
             flipped = self._flipped(cell, cells)
             if flipped.any():
                 if sections[int(labels[mine[0]])][3] != 0.0:
@@ -351,62 +315,6 @@ class DeckShells:
             extra = size - self.label_body.size
             self.label_body = np.concatenate([self.label_body, np.full(extra, -1, dtype=np.int64)])
             self.label_index = np.concatenate([self.label_index, np.full(extra, -1, dtype=np.int64)])
-
-    def _forced_knots(self, shell_nodes: np.ndarray) -> dict[int, str]:
-        """Shell node label -> the card that gives it a non-zero rotation (*BOUNDARY, dofs 4-6) or a moment (*CLOAD,
-        dofs 4-6) in some step: a knot (CalculiX's dynamic steps make one; its static ones a mean rotation, which
-        leaves the thickness there free)."""
-        m = self.m
-        out: dict[int, str] = {}
-        for b in list(m.model_boundary) + [b for st in m.steps for b in st.boundary]:
-            if b.value not in (None, 0.0) and any(d >= 4 for d in b.dofs):
-                for lab in np.intersect1d(b.nodes, shell_nodes).tolist():
-                    out.setdefault(int(lab), b.where)
-        for st in m.steps:
-            for ld in st.loads:
-                if ld.kind == "cload" and ld.dof >= 4 and ld.value != 0.0:
-                    for lab in np.intersect1d(ld.nodes, shell_nodes).tolist():
-                        out.setdefault(int(lab), ld.where)
-        return out
-
-    def _split_knots(self, nodes, cells, points, tc, cell, rank, forced):
-        """The part's surface split at its knots (mesh.shell.split_at_knots: subsets by normal within 20 degrees and
-        by thickness, and the nodes of ``forced``): (its node labels, the expansions after the deck's with labels of
-        their own; cells; points; thicknesses; [(knot label, its expansions' places)])."""
-        from ..mesh.shell import ShellMeshError, split_at_knots
-
-        try:
-            points, cells_new, source, found = split_at_knots(points, cells, cell, rank=rank, key=tc,
-                                                              forced=np.isin(nodes, list(forced)))
-        except ShellMeshError:  # (extrude_surface says so)
-            t = np.zeros(nodes.size)
-            t[cells.ravel()] = tc.ravel()
-            return nodes, cells, points, t, []
-        copies = source.size - (nodes.size - len(found))
-        labels = np.concatenate([nodes[source[: source.size - copies]], self._next + np.arange(copies)])
-        self._next += copies
-        t = np.zeros(source.size)
-        t[cells_new.ravel()] = tc.ravel()
-        return labels, cells_new, points, t, [(int(nodes[i]), places) for i, places in found]
-
-    def _knot(self, lab: int, copies: np.ndarray, d: np.ndarray, where: str) -> None:
-        """Shell node ``lab`` as a knot: a rigid body (appended to the deck's *RIGID BODYs) of its expansions
-        ``copies`` (labels; ``d`` their directors) with the node as REF NODE. Expansions on one line leave the
-        rotation about it to nothing: held where the line is a global axis, else listed."""
-        if lab in self.shared:
-            raise DeckError(f"{where}: shell node {lab} is a knot of the shell expansion and a node of a solid element: "
-                            f"not supported (tie the shell to the solid with *TIE there)")
-        drill = None
-        if np.all(np.linalg.norm(np.cross(d, d[0]), axis=1) < 1e-6):
-            k = int(np.argmax(np.abs(d[0])))
-            if abs(d[0][k]) < 1.0 - 1e-9:
-                self.unsupported.append(f"{where}: a moment or a non-zero rotation on shell node {lab}, whose normal "
-                                        f"{_vec(d[0])} is no global axis: its knot (a rigid body of the node's "
-                                        f"expansion along the normal) cannot hold the rotation about the normal; "
-                                        f"not supported")
-            drill = k
-        self.knots[len(self.m.rigid_bodies)] = (lab, drill)
-        self.m.rigid_bodies.append((np.asarray(copies, dtype=np.int64), lab, None, where))
 
     def _sections(self, labels: np.ndarray) -> dict:
         """element label -> its *SHELL SECTION (elset, material, thickness, offset, where); one line for an element
@@ -465,174 +373,6 @@ class DeckShells:
         out = self.nodes_body(labels) >= 0
         if self.shared:
             out &= ~np.isin(np.asarray(labels, dtype=np.int64), list(self.shared))
-        return out
-
-    def hinges(self, ref, solid_ref) -> list[dict]:
-        """The [[equation]] entries of the nodes shared with solid elements (CalculiX: a hinge): per component the
-        mean of the shell node's two layers equals the solid node's displacement, u_b + u_t - 2 u_s = 0
-        (``solid_ref(label)``: the solid node's single-node set reference)."""
-        out = []
-        for lab in sorted(self.shared):
-            body = int(self.label_body[lab])
-            if body < 0:
-                continue
-            b, t, s = ref(body, f"_SN{lab}_b"), ref(body, f"_SN{lab}_t"), solid_ref(lab)
-            out += [{"name": f"hinge{lab}_{c}", "terms": [[b, c, 1.0], [t, c, 1.0], [s, c, -2.0]]} for c in "xyz"]
-        return out
-
-    # -- boundary conditions --------------------------------------------------------------------------------------
-    def plan_boundaries(self) -> None:
-        """The mapping of every shell node's *BOUNDARY dofs (those of the model data and the first step, which hold
-        over the run) onto its two layers, after CalculiX's gen3dboun (static steps, no knot):
-
-        - a translation c of the shell node prescribes the mean of its expanded nodes (u_1 + u_3 = 2 u(n)): the mean
-          of the bottom and top node, an equation u_b,c + u_t,c = 2 v whose right-hand side follows the deck's values
-          over the steps (``sum_values``: its first stage's, the later ones as stage targets);
-        - a rotation about a tangent axis a fixes the mean rotation of the line of expanded nodes about a; with both
-          tangent rotations fixed (a clamp) the line keeps its direction: the tangential components of u_t - u_b
-          vanish (exact at any rotation), its thickness change stays free as in CalculiX; the drilling rotation
-          (an axis within 0.999 of the normal) is dropped, as CalculiX drops it;
-        - a single tangent rotation is kept where it makes a symmetry plane: the shell's normal and the rotation axis
-          along global axes and the translation normal to the plane fixed: then both layers hold that translation.
-
-        Where the pair's component is held alike (a clamped or symmetric tangential component) both layers get the
-        *BOUNDARY (any value, amplitudes, later steps); the rest are [[equation]]s holding from the first step on:
-        the means with the deck's values, the rotations' differences at zero. Everything else is one line
-        (DeckError)."""
-        m = self.m
-        first = list(m.model_boundary) + (list(m.steps[0].boundary) if m.steps else [])
-        dofs: dict[int, set] = {}
-        wh: dict[int, str] = {}
-        nonzero: dict[tuple, str] = {}
-        for b in first:
-            shell = b.nodes[self.is_shell(b.nodes)]
-            if shell.size and b.fixed:
-                raise DeckError(f"{b.where}: *BOUNDARY, FIXED on shell node {int(shell[0])}: not supported on shells")
-            for lab in shell.tolist():
-                dofs.setdefault(lab, set()).update(b.dofs)
-                wh.setdefault(lab, b.where)
-                if b.value not in (None, 0.0):
-                    for d in b.dofs:
-                        nonzero.setdefault((lab, d), b.where)
-        for lab, D in dofs.items():
-            self.plan[lab] = self._classify(lab, D, wh[lab], nonzero)
-        for st in m.steps[1:]:
-            for b in st.boundary:
-                for lab in b.nodes[self.is_shell(b.nodes)].tolist():
-                    both, sums = self.plan.get(lab, (set(), []))[:2]
-                    extra = [d for d in b.dofs if d > 3 or d - 1 not in both]
-                    valued = [d for d in extra if d > 3 or d - 1 not in sums]  # (a mean takes any value)
-                    if extra and (set(b.dofs) - dofs.get(lab, set()) or b.fixed
-                                  or (valued and b.value not in (None, 0.0))):
-                        raise DeckError(f"{b.where}: *BOUNDARY on dof {extra[0]} of shell node {lab} in a later step: "
-                                        f"a shell node's rotations and the translations its two layers share through "
-                                        f"an equation are held from the first step on (model data or the first step), "
-                                        f"at zero")
-            if st.boundary_new and any(self.plan[lab][1] or self.plan[lab][2] for lab in self.plan):
-                raise DeckError(f"{st.where}: *BOUNDARY, OP=NEW in a step of a deck with shell nodes held through "
-                                f"equations (their conditions hold over the whole run here)")
-
-    def _classify(self, lab: int, D: set, where: str, nonzero: dict):
-        body = self.bodies[self.label_body[lab] - self.first]
-        d = body["d"][self.label_index[lab]]
-        T = sorted(c - 1 for c in D if c <= 3)
-        R = sorted(c - 4 for c in D if c >= 4)
-        rot = [c for c in D if c >= 4 and (lab, c) in nonzero]
-        if rot:
-            raise DeckError(f"{nonzero[(lab, rot[0])]}: *BOUNDARY: a rotation (dof {rot[0]}) prescribed non-zero on "
-                            f"shell node {lab}: not supported (a rotation of the line of its two layers)")
-        drill = [r for r in R if abs(d[r]) > 0.999]
-        if drill and where not in self._drilled:
-            self._drilled.add(where)
-            self.notes.append(f"{where}: *BOUNDARY: dof {drill[0] + 4} of shell node {lab} (and of the others there "
-                              f"whose normal it is) is a drilling rotation (about the normal): dropped, as CalculiX "
-                              f"drops it")
-        R = [r for r in R if r not in drill]
-        P = np.array([np.eye(3)[r] - d[r] * d for r in R]).reshape(-1, 3)
-        rank = int(np.linalg.matrix_rank(P, tol=1e-6)) if R else 0
-        k = int(np.argmax(np.abs(d))) if np.max(np.abs(d)) > 1.0 - 1e-9 else None
-        both: set = set()
-        sums: list = []
-        diffs: list = []
-        if rank == 2:
-            if k is not None:
-                for c in range(3):
-                    if c == k:
-                        continue
-                    if c in T:
-                        both.add(c)
-                    else:
-                        diffs.append(np.eye(3)[c])
-                sums = [k] if k in T else []
-            else:
-                sums = list(T)
-                e1 = P[0] / np.linalg.norm(P[0])
-                e2 = np.cross(d, e1)
-                diffs = [e1, e2]
-        elif rank == 1:
-            if k is None or len(R) != 1:
-                raise DeckError(f"{where}: *BOUNDARY: rotation dof {R[0] + 4} of shell node {lab} alone (its other "
-                                f"tangent rotation free) on a shell whose normal {_vec(d)} is no global axis: only "
-                                f"symmetry planes (e.g. XSYMM: 1, 5, 6 on a flat shell) map exactly; not supported")
-            i = 3 - k - R[0]
-            if i not in T:
-                raise DeckError(f"{where}: *BOUNDARY: rotation dof {R[0] + 4} of shell node {lab} without the "
-                                f"translation {i + 1} normal to its symmetry plane: only symmetry planes (e.g. XSYMM: "
-                                f"1, 5, 6 on a flat shell) map exactly; not supported")
-            both.add(i)
-            sums = [c for c in T if c != i]
-        else:
-            sums = list(T)
-        for row in diffs:
-            if np.count_nonzero(np.abs(row) > 1e-14) > 1 and any((lab, c + 1) in nonzero for c in T):
-                raise DeckError(f"{where}: *BOUNDARY: non-zero values on shell node {lab} of a curved shell: not "
-                                f"supported")
-        if sums or diffs:
-            self.equation_nodes.setdefault(int(self.label_body[lab]), set()).add(lab)
-        return both, sums, diffs
-
-    def boundary_split(self, labels: np.ndarray, dofs) -> tuple[np.ndarray, dict[int, np.ndarray]]:
-        """(the labels that are no shell nodes, {component: the shell labels whose two layers both take it})."""
-        shell = self.is_shell(labels)
-        out = {}
-        for d in dofs:
-            if d <= 3:
-                labs = [lab for lab in labels[shell].tolist() if d - 1 in self.plan.get(lab, (set(),))[0]]
-                if labs:
-                    out[d - 1] = np.asarray(labs, dtype=np.int64)
-        return labels[~shell], out
-
-    def equations(self, ref) -> list[dict]:
-        """The [[equation]] entries of the plan (``ref(body, set)``: the set's reference in the problem file)."""
-        out = []
-        comps = "xyz"
-        for lab, (_, sums, diffs) in sorted(self.plan.items()):
-            body = int(self.label_body[lab])
-            b, t = ref(body, f"_SN{lab}_b"), ref(body, f"_SN{lab}_t")
-            for c in sums:
-                value = self.sum_values.get((lab, c), 0.0)
-                out.append({"name": f"shell{lab}_{comps[c]}", "terms": [[t, comps[c], 1.0], [b, comps[c], 1.0]]}
-                           | ({"value": value} if value else {}))
-            rows = [np.asarray(r, dtype=float) for r in diffs]
-            if len(rows) == 2:  # (two rows, their dependents distinct: eliminated with pivoting)
-                c1 = int(np.argmax(np.abs(rows[0])))
-                rows[1] = rows[1] - rows[1][c1] / rows[0][c1] * rows[0]
-            for j, r in enumerate(rows):
-                c1 = int(np.argmax(np.abs(r)))
-                terms = [[b, comps[c1], -float(r[c1])], [t, comps[c1], float(r[c1])]]
-                terms += [[x, comps[c], s * float(r[c])] for c in range(3) if c != c1 and abs(r[c]) > 1e-14
-                          for x, s in ((t, 1.0), (b, -1.0))]
-                out.append({"name": f"shell{lab}_r{j + 1}", "terms": terms})
-        return out
-
-    def layer_sets(self, body: int) -> dict:
-        """The single-node sets of the equations' nodes of shell body ``body`` (its ``sets`` table)."""
-        info = self.bodies[body - self.first]
-        out = {}
-        for lab in sorted(self.equation_nodes.get(body, ())):
-            i = int(self.label_index[lab])
-            out[f"_SN{lab}_b"] = {"nodes": [i]}
-            out[f"_SN{lab}_t"] = {"nodes": [i + info["n"]]}
         return out
 
     # -- pressures ------------------------------------------------------------------------------------------------
@@ -740,7 +480,3 @@ class DeckShells:
             out.append(start + np.arange(2 * info["n"]))
             start += 2 * info["n"]
         return out
-
-
-def _vec(v) -> str:
-    return "(" + ", ".join(f"{x:.3g}" for x in v) + ")"
