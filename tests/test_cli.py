@@ -375,3 +375,12 @@ def test_energy_growth_warns_and_strict_fails(tmp_path, capsys):
     s = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert s["status"] == "failed" and s["reason"].startswith(f"--strict: step {s['energy_growth']['step']}:")
     assert len(s["steps"]) == s["energy_growth"]["step"]
+
+
+def test_ranks_with_a_deck_is_said_not_ignored(tmp_path, capsys):
+    """`covcontact run DECK.inp --ranks 2`: a deck runs in one process, so the option is one line (exit 2), not
+    dropped in silence."""
+    deck = Path(__file__).resolve().parents[1] / "examples" / "decks" / "punch_slide.inp"
+    assert main(["run", str(deck), "--out", str(tmp_path), "--ranks", "2", "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--ranks 2: a deck runs in one process" in err[0]

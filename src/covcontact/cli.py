@@ -207,6 +207,9 @@ def _run_deck(args) -> int:
     from .solvers.run import solve_problem
 
     deck = Path(args.problem)
+    if args.ranks not in ("auto", 1):  # (said, not ignored)
+        raise InputError(f"--ranks {args.ranks}: a deck runs in one process; import it (covcontact import "
+                         f"{deck.name}) and run the problem file with --ranks")
     out = Path(args.out) if args.out else Path("results") / deck.stem
     imported = _import(deck, out / "deck" / f"{deck.stem}.toml", args.ignore_unsupported,
                        getattr(args, "dialect", "auto"))
