@@ -356,3 +356,32 @@ def test_l_junction_of_calculix_s_shell2(tmp_path):
         assert proc.returncode == 0, proc.stderr
         (u,) = _dat(dat)["U"].values()
         assert u[0] == pytest.approx(_CCX_L16_MID_X, rel=2.5e-2)
+
+
+#: produced by running CalculiX 2.20 (Debian's ccx) on test_offsets_that_differ_make_knots' S4 deck: the tip node
+#: 22's u_x and u_z
+_CCX_OFFSET_STEP_TIP = (-1.234489e-06, 2.199867e-04)
+
+
+def test_offsets_that_differ_make_knots(tmp_path):
+    """The cantilever plate whose clamped half has OFFSET = 0.5 (its given surface is the top) and whose tip half has
+    none: where the two sections meet the node lies on both at another height, so CalculiX and covcontact make a knot
+    there (before, a refusal). The step in the mid-surface makes the bending load stretch the plate: the tip moves
+    along x by -1.26e-6, 2.1 % from CalculiX's (the flat plate: -3e-9), and its deflection is 1.7 % above CalculiX's
+    (the flat plate's solid-shells: 1.9 %)."""
+    def rows(labels):
+        return "\n".join(", ".join(map(str, labels[i:i + 16])) for i in range(0, len(labels), 16))
+
+    section = ("*ELSET, ELSET=A\n" + rows([k for k in range(1, 41) if (k - 1) % 10 < 5])
+               + "\n*ELSET, ELSET=B\n" + rows([k for k in range(1, 41) if (k - 1) % 10 >= 5])
+               + "\n*SHELL SECTION, ELSET=A, MATERIAL=STEEL, OFFSET=0.5\n0.1\n"
+               + "*SHELL SECTION, ELSET=B, MATERIAL=STEEL\n0.1")
+    dat, proc = _run_deck(tmp_path, plate_deck("S4", section=section), "off")
+    assert proc.returncode == 0, proc.stderr
+    assert "5 knots in the shell part" in proc.stderr and "offsets differ" in proc.stderr
+    u = _dat(dat)["U"][22]
+    assert u[0] == pytest.approx(_CCX_OFFSET_STEP_TIP[0], rel=4e-2)
+    assert u[2] == pytest.approx(_CCX_OFFSET_STEP_TIP[1], rel=3e-2)
+    imp = import_deck(tmp_path / "off.inp", tmp_path / "i" / "off.toml")
+    offsets = tomllib.loads(imp.problem.read_text())["bodies"][0]["shell"]["offset"]
+    assert sorted(set(offsets)) == [0.0, 0.5]

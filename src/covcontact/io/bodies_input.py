@@ -77,11 +77,19 @@ def build_shell(shell: Section, sec: Section, base: Path):
                    f"{thickness if not per_node else next((v for v in values if not (isinstance(v, (int, float)) and v > 0)), values)!r}",
                    "thickness")
     offset = shell.get("offset", "any", "middle")
+
+    def number(v) -> bool:
+        return isinstance(v, (int, float)) and not isinstance(v, bool) and -0.5 <= v <= 0.5
+
     if isinstance(offset, str):
         if offset not in OFFSETS:
             shell.fail(f"must be \"middle\", \"top\", \"bottom\" or a number in [-0.5, 0.5], got {offset!r}"
                        f"{suggest(offset, list(OFFSETS))}", "offset")
-    elif isinstance(offset, bool) or not isinstance(offset, (int, float)) or not -0.5 <= offset <= 0.5:
+    elif isinstance(offset, list):  # (one per node of the surface file: a deck's sections of different OFFSET)
+        if not offset or not all(number(v) for v in offset):
+            shell.fail(f"an array of offsets must hold numbers in [-0.5, 0.5], got "
+                       f"{next((v for v in offset if not number(v)), offset)!r}", "offset")
+    elif not number(offset):
         shell.fail(f"must be \"middle\", \"top\", \"bottom\" or a number in [-0.5, 0.5], got {offset!r}", "offset")
     creases = shell.get("creases", "str", "mean", choices=("mean", "knots"))
     knot_angle = shell.get("knot_angle", "float", 20.0, positive=True)
@@ -115,12 +123,15 @@ def build_shell(shell: Section, sec: Section, base: Path):
         points, cell_type, cells, node_sets, element_sets = read_surface(path)
         if per_node and len(values) != points.shape[0]:
             shell.fail(f"has {len(values)} values for the {points.shape[0]} nodes of {fname}", "thickness")
+        if isinstance(offset, list) and len(offset) != points.shape[0]:
+            shell.fail(f"has {len(offset)} values for the {points.shape[0]} nodes of {fname}", "offset")
         missing = [e for rows in face_rows.values() for e, _ in rows if e not in element_sets]
         if missing:
             shell.fail(f"faces: no element set {missing[0]!r} in {fname}", "faces")
         face_sets = {name: [(element_sets[e], side) for e, side in rows] for name, rows in face_rows.items()}
         return extrude_surface(points, cell_type, cells, np.asarray(values, dtype=float) if per_node else thickness,
-                               offset, node_sets, element_sets, face_sets,
+                               np.asarray(offset, dtype=float) if isinstance(offset, list) else offset, node_sets,
+                               element_sets, face_sets,
                                knot_angle if creases == "knots" else None)
     except ShellMeshError as exc:
         sec.fail(str(exc), "file")

@@ -26,25 +26,27 @@ def forced_knots(m, shell_nodes: np.ndarray) -> dict[int, str]:
     return out
 
 
-def split_part(shells, nodes, cells, points, tc, cell, rank, forced):
-    """The part's surface split at its knots (mesh.shell.split_at_knots: subsets by normal within 20 degrees and
-    by thickness, and the nodes of ``forced``): (its node labels, the expansions after the deck's with labels of
-    their own (``shells._next`` on); cells; points; thicknesses; [(knot label, its expansions' places)])."""
+def split_part(shells, nodes, cells, points, tc, oc, cell, rank, forced):
+    """The part's surface split at its knots (mesh.shell.split_at_knots: subsets by normal within 20 degrees, by
+    thickness ``tc`` and by offset ``oc`` (each element's at each of its nodes), and the nodes of ``forced``): (its
+    node labels, the expansions after the deck's with labels of their own (``shells._next`` on); cells; points;
+    thicknesses; offsets; [(knot label, its expansions' places)])."""
     from ..mesh.shell import ShellMeshError, split_at_knots
 
+    pairs = np.stack([tc.ravel(), oc.ravel()], axis=1)
+    key = np.unique(pairs, axis=0, return_inverse=True)[1].reshape(tc.shape).astype(float)  # (one per pair)
     try:
-        points, cells_new, source, found = split_at_knots(points, cells, cell, rank=rank, key=tc,
+        points, cells_new, source, found = split_at_knots(points, cells, cell, rank=rank, key=key,
                                                           forced=np.isin(nodes, list(forced)))
     except ShellMeshError:  # (extrude_surface says so)
-        t = np.zeros(nodes.size)
-        t[cells.ravel()] = tc.ravel()
-        return nodes, cells, points, t, []
-    copies = source.size - (nodes.size - len(found))
-    labels = np.concatenate([nodes[source[: source.size - copies]], shells._next + np.arange(copies)])
-    shells._next += copies
-    t = np.zeros(source.size)
-    t[cells_new.ravel()] = tc.ravel()
-    return labels, cells_new, points, t, [(int(nodes[i]), places) for i, places in found]
+        cells_new, labels, found = cells, nodes, []
+    else:
+        copies = source.size - (nodes.size - len(found))
+        labels = np.concatenate([nodes[source[: source.size - copies]], shells._next + np.arange(copies)])
+        shells._next += copies
+    t, o = np.zeros(labels.size), np.zeros(labels.size)
+    t[cells_new.ravel()], o[cells_new.ravel()] = tc.ravel(), oc.ravel()
+    return labels, cells_new, points, t, o, [(int(nodes[i]), places) for i, places in found]
 
 
 def register_knot(shells, lab: int, copies: np.ndarray, d: np.ndarray, where: str) -> None:
@@ -84,7 +86,7 @@ def hinge_equations(shells, ref, solid_ref) -> list[dict]:
 def knot_note(where: str, first: int, found: list) -> str:
     """The note that says a shell part's knots (``found``: [(label, its expansions' places)])."""
     spread = sum(1 for _, c in found if c.size > 1)
-    why = [f"{spread} where its elements' normals differ by more than 20 degrees or their thicknesses differ"] \
+    why = [f"{spread} where its elements' normals differ by more than 20 degrees or their thicknesses or offsets differ"] \
         if spread else []
     why += [f"{len(found) - spread} for a moment or a non-zero rotation"] if spread < len(found) else []
     return (f"{where}: {len(found)} knot{'s' if len(found) > 1 else ''} in the shell part of element {first} "

@@ -248,11 +248,7 @@ class DeckShells(ShellConditions):
             cmat = np.vstack([conn_rows[e] for e in mine])
             nodes = np.unique(cmat)
             cells = np.searchsorted(nodes, cmat)
-            offs = {sections[int(labels[e])][3] for e in mine}
-            if len(offs) > 1:
-                raise DeckError(f"{where[mine[0]]}: the shell part of element {int(labels[mine[0]])} has sections of "
-                                f"different OFFSETs ({', '.join(f'{o:g}' for o in sorted(offs))}): CalculiX makes knots "
-                                f"where they meet, covcontact's shell bodies have one offset")
+            oc = np.repeat([[sections[int(labels[e])][3]] for e in mine], cells.shape[1], axis=1)  # (its OFFSET)
             tc = np.zeros(cells.shape)  # (the thickness of each element at each of its nodes)
             for r, (e, row) in enumerate(zip(mine, cells)):
                 sec = sections[int(labels[e])]
@@ -271,9 +267,11 @@ class DeckShells(ShellConditions):
                                           f"its thickness {sec[2]:g} holds (as in CalculiX and Abaqus)")
                     tc[r, q] = sec[2]
             points = m.X[index[nodes]]
-            nodes, cells, points, t, knots_here = split_part(self, nodes, cells, points, tc, cell, labels[mine], forced)
+            nodes, cells, points, t, o, knots_here = split_part(self, nodes, cells, points, tc, oc, cell, labels[mine],
+                                                                forced)
+            offset = float(o[0]) if np.all(o == o[0]) else o
             try:
-                mesh0 = extrude_surface(points, cell, cells, t, offs.pop())
+                mesh0 = extrude_surface(points, cell, cells, t, offset)
             except ShellMeshError as exc:
                 raise DeckError(f"{where[mine[0]]}: the shell part of element {int(labels[mine[0]])}: {exc}") from None
             half = mesh0.points.shape[0] // 2
@@ -285,7 +283,7 @@ class DeckShells(ShellConditions):
                 self.notes.append(knot_note(where[mine[0]], int(labels[mine[0]]), knots_here))
             flipped = self._flipped(cell, cells)
             if flipped.any():
-                if sections[int(labels[mine[0]])][3] != 0.0:
+                if np.any(oc != 0.0):
                     raise DeckError(f"{where[mine[0]]}: shell elements {int(labels[mine[0]])} and "
                                     f"{int(labels[mine[flipped]][0])} are numbered with opposite normals in a part "
                                     f"with an OFFSET: CalculiX makes knots there; number the elements of the part "
@@ -299,7 +297,7 @@ class DeckShells(ShellConditions):
                 if np.intersect1d(m.elsets.get(s, np.zeros(0, np.int64)), labels[mine]).size:
                     secs.append((s, mat, w))
             self.bodies.append({"elements": labels[mine], "cell": cell, "cells": cells, "nodes": nodes,
-                                "points": points, "t": t, "offset": sections[int(labels[mine[0]])][3],
+                                "points": points, "t": t, "offset": offset,
                                 "n": half, "d": d, "flipped": flipped, "sections": secs, "where": where[mine[0]]})
             self._grow(int(nodes.max()) + 1)
             self.label_body[nodes] = self.first + j
@@ -465,8 +463,9 @@ class DeckShells(ShellConditions):
         mesh = extrude_surface(info["points"], info["cell"], info["cells"], info["t"], info["offset"], ns, es,
                                face_sets=face_sets)
         t = info["t"]
+        o = info["offset"]
         table = {"thickness": float(t[0]) if np.all(t == t[0]) else [float(v) for v in t],
-                 "offset": info["offset"]}
+                 "offset": o if np.ndim(o) == 0 else [float(v) for v in o]}
         if rows:
             table["faces"] = rows
         return mesh, self.surface_text(j, ns_lab, es_lab, rows), table

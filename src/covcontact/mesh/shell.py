@@ -274,8 +274,8 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
                     face_sets: dict | None = None, knot_angle: float | None = None) -> Mesh:
     """The solid-shell mesh (hex8 or hex18, one element through the thickness) of the surface mesh (``points``,
     ``cell_type`` in SURFACE_CELLS, ``cells``) with ``thickness`` (a number, or one per surface node) and ``offset``
-    ("middle", "top", "bottom" or a number in [-1/2, 1/2]); the module docstring says how. ``face_sets``: name ->
-    [(surface cells, "top" or "bottom")], the face set (and node set, unless one of that name exists) of those cells'
+    ("middle", "top", "bottom" or a number in [-1/2, 1/2], or one number per surface node); the module docstring
+    says how. ``face_sets``: name -> [(surface cells, "top" or "bottom")], the face set (and node set, unless one of that name exists) of those cells'
     faces on that side of each cell's own normal (by its corner order as given, whichever way the orientation turned
     it: a deck's SPOS and SNEG). ``knot_angle`` (degrees): the surface split at its knots first (split_at_knots:
     the nodes whose cells' normals differ by more than that), each expansion with its own director; then
@@ -293,25 +293,36 @@ def extrude_surface(points: np.ndarray, cell_type: str, cells: np.ndarray, thick
     if not np.all(np.isfinite(t)) or np.any(t <= 0.0):
         bad = int(np.flatnonzero(~(t > 0.0))[0])
         raise ShellMeshError(f"the thickness must be positive, got {t[bad]:g} at node {bad} (0-based)")
-    o = OFFSETS.get(offset) if isinstance(offset, str) else float(offset)
-    if o is None or not -0.5 <= o <= 0.5:
-        raise ShellMeshError(f"offset must be 'middle', 'top', 'bottom' or a number in [-0.5, 0.5], got {offset!r}")
+    if isinstance(offset, str):
+        o = OFFSETS.get(offset)
+        if o is None:
+            raise ShellMeshError(f"offset must be 'middle', 'top', 'bottom' or a number in [-0.5, 0.5], got "
+                                 f"{offset!r}")
+    o = np.broadcast_to(np.asarray(o if isinstance(offset, str) else offset, dtype=np.float64),
+                        (n_surface,)).copy()  # (one per node: a deck's sections of different OFFSET meet at knots)
+    if not np.all((o >= -0.5) & (o <= 0.5)):
+        bad = int(np.flatnonzero(~((o >= -0.5) & (o <= 0.5)))[0])
+        raise ShellMeshError(f"offset must be 'middle', 'top', 'bottom' or a number in [-0.5, 0.5], got {o[bad]:g}"
+                             + (f" at node {bad} (0-based)" if np.ndim(offset) else ""))
     knot_groups, given_points = [], points
     if knot_angle is not None:
         points, cells, source, knot_groups = split_at_knots(points, cells, cell_type, limit=float(knot_angle))
-        t = t[source]
+        t, o = t[source], o[source]
         n_surface = points.shape[0]
         node_sets = {name: np.flatnonzero(np.isin(source, np.asarray(ids, dtype=np.int64)))
                      for name, ids in (node_sets or {}).items()}
     cell_of = np.arange(cells.shape[0])  # the surface cell each new cell comes from
     surface_type = cell_type
-    if cell_type == "quad8":
+    if cell_type == "quad8":  # (the offsets of new points interpolated as the thicknesses: a cell's are alike)
+        o = _quad8_to_quad9(points, o, cells)[1]
         points, t, cells = _quad8_to_quad9(points, t, cells)
         cell_type = "quad9"
     elif cell_type == "tri3":
+        o = _split_triangles(points, o, cells)[1]
         points, t, cells, cell_of = _split_triangles(points, t, cells)
         cell_type = "quad4"
     elif cell_type == "tri6":
+        o = _split_tri6(points, o, cells)[1]
         points, t, cells, cell_of = _split_tri6(points, t, cells)
         cell_type = "quad4"
     given = cells
