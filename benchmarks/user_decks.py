@@ -501,15 +501,16 @@ def frd_blocks(path: Path, upto: int | None = None) -> dict:
     return {key: {k: v for k, v in b.items() if int(k) <= upto} for key, b in blocks.items()}
 
 
-def frd_compare(mine: Path, ref: Path, upto: int | None) -> list[dict]:
+def frd_compare(mine: Path, ref: Path, upto: int | None, shells: bool = False) -> list[dict]:
     """compare_blocks of the two .frd files on the deck's own nodes (labels up to ``upto``); where they share none
-    (a deck of shells alone: both files hold only the expanded nodes, numbered each in its own way), on the nodes
-    whose reference positions coincide (both codes expand a shell node along the same normal to its bottom and top
-    layer), marked ``expanded``."""
+    and the deck has shells (``shells``: both files hold only the expanded nodes, numbered each in its own way), the
+    displacements of the nodes whose reference positions coincide (both codes expand a shell node along the same
+    normal to its bottom and top layer; the forces are shared out among the layers differently), marked
+    ``expanded``."""
     blocks = compare_blocks(frd_blocks(mine, upto), frd_blocks(ref, upto)) if upto is not None else []
-    if blocks:
+    if blocks or not shells:
         return blocks
-    return [dict(b, expanded=True) for b in compare_blocks(*by_position(mine, ref))]
+    return [dict(b, expanded=True) for b in compare_blocks(*by_position(mine, ref)) if b["kind"] == "displacements"]
 
 
 def by_position(mine: Path, ref: Path) -> tuple[dict, dict]:
@@ -609,8 +610,10 @@ def run_deck(info: dict, root: Path, work_root: Path, args) -> dict:
         blocks = compare(dat.read_text(errors="replace"), ref.read_text(errors="replace"))
         lacking = {"displacements", "forces"} - {b["kind"] for b in blocks}
         upto = deck_labels_end(work / deck.name)
+        shells = any(str(t).upper().startswith("S") and str(t).upper()[1:2].isdigit() for t in row.get("types", ()))
         if lacking:   # (U or RF not printed to the .dat: those of the .frd files, at the ends of the deck's steps)
-            blocks += [b for b in frd_compare(out / f"{job}.frd", work / f"{job}.frd", upto) if b["kind"] in lacking]
+            blocks += [b for b in frd_compare(out / f"{job}.frd", work / f"{job}.frd", upto, shells)
+                       if b["kind"] in lacking]
         row["blocks"] = len(blocks)
         row["diff"] = _summarise_blocks(blocks)
         worst = max([v["rel_diff"] for k, v in row["diff"].items() if k in ("displacements", "forces")], default=None)
@@ -627,7 +630,8 @@ def run_deck(info: dict, root: Path, work_root: Path, args) -> dict:
             if c2["finishes"]:
                 nb = compare(dat.read_text(errors="replace"), (nl / f"{job}.dat").read_text(errors="replace"))
                 lacking = {"displacements", "forces"} - {b["kind"] for b in nb}
-                nb += [b for b in frd_compare(out / f"{job}.frd", nl / f"{job}.frd", upto) if b["kind"] in lacking]
+                nb += [b for b in frd_compare(out / f"{job}.frd", nl / f"{job}.frd", upto, shells)
+                       if b["kind"] in lacking]
                 row["diff_vs_ccx_nlgeom"] = _summarise_blocks(nb)
     return row
 
