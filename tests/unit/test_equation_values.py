@@ -71,3 +71,29 @@ def test_right_hand_side_in_a_dynamic_problem_is_one_line(tmp_path):
     path.write_text(text)
     with pytest.raises(InputError, match=r"equation\[0\]\.value: a right-hand side .* dynamic stages"):
         load_problem(path)
+
+
+def test_reduce_matrix_is_the_triple_product():
+    """solvers.constraints.reduce_matrix forms T^T K T (T = diag(keep) + A, A's rows at the dependent dofs) from K's
+    entries and thin products: equal to the product with the n x n map to round-off, on an unsymmetric random K with
+    dependents that refer to each other's neighbours, with an extra matrix added."""
+    import scipy.sparse as sp
+
+    from covcontact.solvers.constraints import reduce_matrix
+
+    rng = np.random.default_rng(3)
+    n = 40
+    K = sp.random(n, n, density=0.2, random_state=4, format="csr") + sp.eye(n)
+    dependent = np.array([3, 11, 25, 31])
+    keep = np.ones(n)
+    keep[dependent] = 0.0
+    A = sp.lil_matrix((n, n))
+    for d in dependent:
+        for c in rng.choice(np.flatnonzero(keep), 3, replace=False):
+            A[d, c] = rng.standard_normal()
+    A = A.tocsr()
+    T = sp.diags(keep) + A
+    extra = sp.random(n, n, density=0.05, random_state=5, format="csr")
+    want = (T.T @ K @ T + extra).toarray()
+    got = reduce_matrix(K, keep.astype(bool), dependent, A[dependent], extra).toarray()
+    np.testing.assert_allclose(got, want, atol=1e-13 * np.abs(want).max())

@@ -383,3 +383,38 @@ def test_dynamic_energy_account_counts_the_follower_work(tmp_path):
     steps = res.summary["steps"]
     assert len(steps) == 50 and steps[-1]["energy"]["external_work"] > 1.0
     assert max(abs(s["energy"]["balance_error"]) for s in steps) < 1e-4
+
+
+def test_weighted_pieces_give_the_whole_face_s_forces_and_exact_stiffness():
+    """A pressure on pieces of larger faces (Mesh.face_weights, mesh.shell: the two 4-node halves of a hex18's
+    six-node side face, weighted 0 at their corners and 2 at their mid-side nodes; the four quarters of a 9-node face,
+    weighted 4 at its centre): on a flat face the nodal forces are the whole face's consistent ones (the quadratic
+    edge's 1/6, 2/3, 1/6 through each layer; the 9-node face's 1/36, 1/9, 4/9) to 1e-12, and the follower's load
+    stiffness with those weights is exact (central differences, 1e-8), also on a distorted piece."""
+    from covcontact.elements.follower import point_factors
+
+    # the side face a (0) - m (1) - b (2) at the bottom, a' m' b' (3, 4, 5) at the top, along x (length 2), height 1
+    x = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 0, 1], [1, 0, 1], [2, 0, 1]], dtype=float)
+    halves = np.array([[0, 1, 4, 3], [1, 2, 5, 4]])
+    w = 2.0 * np.isin(halves, [1, 4])
+    R, _ = face_blocks(x, halves, 1.0, False, point_factors(x, halves, None, False, w))
+    f = np.zeros((6, 3))
+    np.add.at(f, halves.ravel(), R.reshape(-1, 3))
+    np.testing.assert_allclose(np.abs(f[:, 1]), [1 / 6, 2 / 3, 1 / 6] * 2, atol=1e-12)  # (area 2: 1/2 per layer)
+    q = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0, 1], [-1, 0], [0, 0]], dtype=float)
+    x9 = np.column_stack([q, np.zeros(9)])
+    from covcontact.mesh.shell import _QUARTER_WEIGHT, _quarters
+
+    face = np.arange(9)[None, :]
+    quarters = _quarters(face)
+    w9 = _QUARTER_WEIGHT * (quarters == 8)
+    R, _ = face_blocks(x9, quarters, 1.0, False, point_factors(x9, quarters, None, False, w9))
+    f = np.zeros((9, 3))
+    np.add.at(f, quarters.ravel(), R.reshape(-1, 3))
+    np.testing.assert_allclose(np.abs(f[:, 2]), 4.0 * np.array([1, 1, 1, 1, 4, 4, 4, 4, 16]) / 36, atol=1e-12)
+    xd = _distorted(4, 7)
+    faces = np.arange(8).reshape(2, 4)
+    wd = np.array([[0.0, 2.0, 2.0, 0.0], [0.0, 0.0, 4.0, 0.0]])
+    factor = point_factors(xd, faces, None, False, wd)
+    err = _fd_error(lambda y: face_blocks(y, faces, 2.9, True, factor), xd, faces)
+    assert err < 1e-8
