@@ -158,7 +158,20 @@ class RigidLinks:
         keep = np.flatnonzero(~self.mask)
         self._keep = sp.csr_matrix((np.ones(keep.size), (keep, keep)), shape=(n, n))
         self.unit = unit_diagonal(self.mask, system)
-        self._theta = [np.zeros(3) for _ in self.links]  # each body's rotation vector at the last ``complete``
+        # every attached node of every link at once: its link, its Y, the components it follows
+        self._node = np.concatenate([nodes for _, nodes, _, _ in self.links]) if self.links else np.zeros(0, int)
+        self._link = np.concatenate([np.full(len(nodes), k) for k, (_, nodes, _, _) in enumerate(self.links)]) \
+            if self.links else np.zeros(0, int)
+        self._Y = np.vstack([Y for _, _, Y, _ in self.links]) if self.links else np.zeros((0, 3))
+        follows = np.zeros((len(self._node), 3), dtype=bool)
+        start = 0
+        for _, nodes, _, comps in self.links:
+            follows[start: start + len(nodes), comps] = True
+            start += len(nodes)
+        self._rows, self._comps = np.nonzero(follows)     # (attached node, component) of every eliminated dof
+        self._A = np.array([ref.A for ref, *_ in self.links], dtype=np.int64)
+        self._B = np.array([ref.B for ref, *_ in self.links], dtype=np.int64)
+        self._theta = np.zeros((len(self.links), 3))  # each body's rotation vector at the last ``complete``
         # the bodies' dofs (t, theta): their diagonal kept in the pattern (a component no eliminated dof depends on,
         # such as a translation a partial coupling does not hold, has no entries; prescribed, it needs its diagonal)
         self._ref_dofs = np.array([3 * node + k for ref, *_ in self.links for node in (ref.A, ref.B)
@@ -166,32 +179,26 @@ class RigidLinks:
 
     def complete(self, u: np.ndarray) -> None:
         """Set the attached nodes' displacements (in place) from their bodies' (t, theta)."""
-        from ..motion import rotation_matrix
-
-        for k, (ref, nodes, Y, comps) in enumerate(self.links):
-            t, theta = u[3 * ref.A: 3 * ref.A + 3], u[3 * ref.B: 3 * ref.B + 3].copy()
-            u.reshape(-1, 3)[nodes[:, None], comps] = (t + Y @ rotation_matrix(theta).T - Y)[:, comps]
-            self._theta[k] = theta
+        u3 = u.reshape(-1, 3)
+        self._theta = u3[self._B].copy()
+        ry = np.einsum("nij,nj->ni", _rotations(self._theta)[self._link], self._Y)
+        new = u3[self._A][self._link] + ry - self._Y
+        u3[self._node[self._rows], self._comps] = new[self._rows, self._comps]
 
     def _map(self):
-        """P (n x n) at the displacement of the last ``complete`` and per link (rows R Y_i, T)."""
-        from ..contact.reference import skew, tangent_map
-        from ..motion import rotation_matrix
+        """P (n x n) at the displacement of the last ``complete``, the attached nodes' R Y_i and the links' T."""
+        from ..contact.reference import skew
 
-        rows, cols, vals, parts = [], [], [], []
-        for (ref, nodes, Y, comps), theta in zip(self.links, self._theta):
-            T = tangent_map(theta)
-            ry = Y @ rotation_matrix(theta).T
-            B = (-skew(ry) @ T)[:, comps, :]                       # (m, c, 3): the eliminated rows
-            r0 = 3 * nodes[:, None] + comps                        # (m, c)
-            rows += [r0.ravel(), np.repeat(r0.ravel(), 3)]
-            cols += [np.tile(3 * ref.A + comps, len(nodes)),
-                     np.tile(3 * ref.B + np.arange(3), r0.size)]
-            vals += [np.ones(r0.size), B.ravel()]
-            parts.append((ref, nodes, ry, T, theta, comps))
-        P = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(self.n, self.n)) + self._keep
-        return P.tocsr(), parts
+        T = _tangents(self._theta)
+        ry = np.einsum("nij,nj->ni", _rotations(self._theta)[self._link], self._Y)
+        B = -np.einsum("nij,njk->nik", skew(ry), T[self._link])[self._rows, self._comps]   # (eliminated dofs, 3)
+        r0 = 3 * self._node[self._rows] + self._comps
+        link = self._link[self._rows]
+        rows = np.concatenate([r0, np.repeat(r0, 3)])
+        cols = np.concatenate([3 * self._A[link] + self._comps, (3 * self._B[link][:, None] + np.arange(3)).ravel()])
+        vals = np.concatenate([np.ones(r0.size), B.ravel()])
+        P = sp.csr_matrix((vals, (rows, cols)), shape=(self.n, self.n)) + self._keep
+        return P.tocsr(), ry, T
 
     def mass(self, M):
         """P^T M P at the displacement of the last ``complete``: the attached nodes' mass on their bodies' (t, theta)."""
@@ -205,26 +212,67 @@ class RigidLinks:
 
     def transform(self, R: np.ndarray, K):
         """(P^T R, P^T K P + the rotation's second-order part) (K may be None)."""
-        from ..contact.reference import skew, tangent_map_derivatives
+        from ..contact.reference import skew
 
-        P, parts = self._map()
-        Pt = P.T.tocsr()
-        Rn = Pt @ R
+        P, ry, T = self._map()
+        Rn = P.T.tocsr() @ R
         if K is None:
             return Rn, None
-        G_rows, G_cols, G_vals = [], [], []
-        for ref, nodes, ry, T, theta, comps in parts:
-            f = np.zeros((len(nodes), 3))
-            f[:, comps] = R.reshape(-1, 3)[nodes][:, comps]   # (the forces at the eliminated components)
-            G = T.T @ np.einsum("mij,mjk->ik", skew(f), skew(ry)) @ T
-            G += np.einsum("i,ijk->jk", np.cross(ry, f).sum(axis=0), tangent_map_derivatives(theta))
-            b = 3 * ref.B + np.arange(3)
-            G_rows.append(np.repeat(b, 3))
-            G_cols.append(np.tile(b, 3))
-            G_vals.append(G.ravel())
-        G = sp.csr_matrix((np.concatenate(G_vals), (np.concatenate(G_rows), np.concatenate(G_cols))), shape=K.shape)
+        f = np.zeros((len(self._node), 3))
+        f[self._rows, self._comps] = R.reshape(-1, 3)[self._node[self._rows], self._comps]   # (eliminated ones)
+        m = len(self.links)
+        S = np.zeros((m, 3, 3))
+        np.add.at(S, self._link, np.einsum("nij,njk->nik", skew(f), skew(ry)))
+        moment = np.zeros((m, 3))
+        np.add.at(moment, self._link, np.cross(ry, f))
+        G = np.einsum("lji,ljk,lkm->lim", T, S, T) + np.einsum("li,lijk->ljk", moment, _tangent_derivatives(self._theta))
+        b = 3 * self._B[:, None] + np.arange(3)                       # (m, 3)
+        G = sp.csr_matrix((G.ravel(), (np.repeat(b, 3, axis=1).ravel(), np.tile(b, (1, 3)).ravel())), shape=K.shape)
         K = reduce_matrix(K, ~self.mask, self.dependent, P[self.dependent], self.unit + G)
         return Rn, _with_diagonal(K, self._ref_dofs)
+
+
+def _skews(theta: np.ndarray) -> np.ndarray:
+    K = np.zeros(theta.shape[:-1] + (3, 3), dtype=theta.dtype)
+    K[..., 0, 1], K[..., 0, 2] = -theta[..., 2], theta[..., 1]
+    K[..., 1, 0], K[..., 1, 2] = theta[..., 2], -theta[..., 0]
+    K[..., 2, 0], K[..., 2, 1] = -theta[..., 1], theta[..., 0]
+    return K
+
+
+def _rotations(theta: np.ndarray) -> np.ndarray:
+    """(m, 3, 3) rotation matrices of the rotation vectors ``theta`` (m, 3): motion.rotation_matrix, batched."""
+    K = _skews(theta)
+    t = np.linalg.norm(theta, axis=1)
+    small = t < 1e-8
+    ts = np.where(small, 1.0, t)
+    s = np.where(small, 1.0 - t * t / 6.0, np.sin(ts) / ts)
+    c = np.where(small, 0.5 - t * t / 24.0, (1.0 - np.cos(ts)) / (ts * ts))
+    return np.eye(3) + s[:, None, None] * K + c[:, None, None] * (K @ K)
+
+
+def _tangents(theta: np.ndarray) -> np.ndarray:
+    """(m, 3, 3) T(theta) of contact.reference.tangent_map, batched (real or complex theta)."""
+    K = _skews(theta)
+    t2 = np.einsum("mi,mi->m", theta, theta)
+    small = np.abs(t2) < 1e-6
+    t2s = np.where(small, 1.0, t2)
+    t = np.sqrt(t2s)
+    a = np.where(small, 0.5 - t2 / 24.0 + t2 * t2 / 720.0, (1.0 - np.cos(t)) / t2s)
+    b = np.where(small, 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0, (t - np.sin(t)) / (t2s * t))
+    return np.eye(3) + a[:, None, None] * K + b[:, None, None] * (K @ K)
+
+
+def _tangent_derivatives(theta: np.ndarray) -> np.ndarray:
+    """(m, 3, 3, 3) D[l, i] = d(T(theta_l)^T e_i)/d theta (contact.reference.tangent_map_derivatives, batched), by
+    complex steps."""
+    h = 1e-30
+    out = np.zeros(theta.shape + (3, 3))
+    for k in range(3):
+        th = theta.astype(complex)
+        th[:, k] += 1j * h
+        out[:, :, :, k] = _tangents(th).imag / h
+    return out
 
 
 def _with_diagonal(K, dofs: np.ndarray):
