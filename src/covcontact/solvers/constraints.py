@@ -232,17 +232,11 @@ class RigidLinks:
         return Rn, _with_diagonal(K, self._ref_dofs)
 
 
-def _skews(theta: np.ndarray) -> np.ndarray:
-    K = np.zeros(theta.shape[:-1] + (3, 3), dtype=theta.dtype)
-    K[..., 0, 1], K[..., 0, 2] = -theta[..., 2], theta[..., 1]
-    K[..., 1, 0], K[..., 1, 2] = theta[..., 2], -theta[..., 0]
-    K[..., 2, 0], K[..., 2, 1] = -theta[..., 1], theta[..., 0]
-    return K
-
-
 def _rotations(theta: np.ndarray) -> np.ndarray:
     """(m, 3, 3) rotation matrices of the rotation vectors ``theta`` (m, 3): motion.rotation_matrix, batched."""
-    K = _skews(theta)
+    from ..contact.reference import skew
+
+    K = skew(theta)
     t = np.linalg.norm(theta, axis=1)
     small = t < 1e-8
     ts = np.where(small, 1.0, t)
@@ -253,7 +247,9 @@ def _rotations(theta: np.ndarray) -> np.ndarray:
 
 def _tangents(theta: np.ndarray) -> np.ndarray:
     """(m, 3, 3) T(theta) of contact.reference.tangent_map, batched (real or complex theta)."""
-    K = _skews(theta)
+    from ..contact.reference import skew
+
+    K = skew(theta)
     t2 = np.einsum("mi,mi->m", theta, theta)
     small = np.abs(t2) < 1e-6
     t2s = np.where(small, 1.0, t2)
